@@ -1,0 +1,258 @@
+#include "calibration/cal_file.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace ftstack::cal {
+namespace {
+
+std::array<std::uint32_t, 256> MakeCrcTable() {
+  std::array<std::uint32_t, 256> t{};
+  for (std::uint32_t i = 0; i < 256; ++i) {
+    std::uint32_t c = i;
+    for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+    t[i] = c;
+  }
+  return t;
+}
+
+std::string Hex32(std::uint32_t v) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%08x", v);
+  return buf;
+}
+
+double Finite(const nlohmann::json& v, const std::string& path, const std::string& what) {
+  if (!v.is_number()) throw CalFileError(path + ": " + what + " is not a number");
+  const double d = v.get<double>();
+  if (!std::isfinite(d)) throw CalFileError(path + ": " + what + " is not finite");
+  return d;
+}
+
+}  // namespace
+
+std::uint32_t Crc32(const std::string& bytes) {
+  static const auto kTable = MakeCrcTable();
+  std::uint32_t c = 0xFFFFFFFFu;
+  for (unsigned char b : bytes) c = kTable[(c ^ b) & 0xFFu] ^ (c >> 8);
+  return c ^ 0xFFFFFFFFu;
+}
+
+std::uint32_t ContentCrc(const nlohmann::json& j) {
+  nlohmann::json copy = j;
+  copy.erase("crc32");
+  return Crc32(copy.dump());
+}
+
+hal::AdcInfo DefaultAdc(std::uint8_t channels) {
+  hal::AdcInfo a;
+  a.channel_count = channels;
+  a.max_counts = (1 << 23) - 1;
+  a.min_counts = -(1 << 23);
+  a.full_scale_nvv = 3906250;
+  a.rate_hz = 1000;
+  return a;
+}
+
+fw::FixedCalibration ToFixed(const CalFile& file, const hal::AdcInfo& adc, fw::LoadReport* report) {
+  fw::FixedCalibration fixed{};
+  fw::LoadReport rep{};
+  const fw::LoadStatus s = fw::LoadCalibration(file.cal, adc, &fixed, &rep);
+  if (report != nullptr) *report = rep;
+  if (s != fw::LoadStatus::kOk) {
+    throw CalFileError(std::string("calibration refused by the fixed-point loader: ") +
+                       fw::ToString(s));
+  }
+  return fixed;
+}
+
+nlohmann::json ToJson(const CalFile& f) {
+  using nlohmann::json;
+  const std::size_t n = f.cal.channel_count;
+  json j = f.extra.is_object() ? f.extra : json::object();
+  j["schema"] = kCalSchema;
+  j["serial"] = f.serial;
+  j["date"] = f.date;
+  j["source"] = f.source;
+  j["channels"] = n;
+  j["input_unit"] = f.input_unit;
+  j["units"] = {{"force", "N"}, {"moment", "N*m"}};
+  j["adc"] = {{"min_counts", f.adc.min_counts},
+              {"max_counts", f.adc.max_counts},
+              {"full_scale_nvv", f.adc.full_scale_nvv}};
+  json m = json::array();
+  for (std::size_t r = 0; r < 6; ++r) {
+    json row = json::array();
+    for (std::size_t c = 0; c < n; ++c) row.push_back(f.cal.matrix[r][c]);
+    m.push_back(row);
+  }
+  j["matrix"] = m;
+  j["offset_mvv"] = std::vector<double>(f.cal.offset_mvv.begin(), f.cal.offset_mvv.begin() + n);
+  j["bias"] = f.cal.bias;
+  j["rated"] = f.rated;
+  j["uncertainty"] = f.uncertainty;
+  fw::LoadReport rep{};
+  const fw::FixedCalibration fx = ToFixed(f, f.adc, &rep);
+  json fp = json::object();
+  fp["shift"] = fx.shift;
+  json coef = json::array();
+  for (std::size_t r = 0; r < 6; ++r) {
+    coef.push_back(std::vector<std::int64_t>(fx.coef[r].begin(), fx.coef[r].begin() + n));
+  }
+  fp["coef"] = coef;
+  fp["bias"] = fx.bias;
+  fp["worst_case_error"] = rep.worst_case_error_si;
+  fp["output_lsb"] = {fw::kForceLsbN, fw::kForceLsbN, fw::kForceLsbN,
+                      fw::kMomentLsbNm, fw::kMomentLsbNm, fw::kMomentLsbNm};
+  j["fixed_point"] = fp;
+  j["crc32"] = Hex32(ContentCrc(j));
+  return j;
+}
+
+CalFile FromJson(const nlohmann::json& j, const std::string& path) {
+  if (!j.is_object()) throw CalFileError(path + ": not a JSON object");
+  if (!j.contains("schema") || j["schema"] != kCalSchema) {
+    throw CalFileError(path + ": schema is not '" + std::string(kCalSchema) + "'");
+  }
+  if (!j.contains("crc32") || !j["crc32"].is_string()) {
+    throw CalFileError(path + ": no crc32 field");
+  }
+  const std::uint32_t want = ContentCrc(j);
+  const std::string have = j["crc32"].get<std::string>();
+  if (have != Hex32(want)) {
+    throw CalFileError(path + ": CRC mismatch (file says " + have + ", content gives " +
+                       Hex32(want) + "): the file is corrupt or was edited");
+  }
+  CalFile f;
+  auto str = [&](const char* key, std::string* out) {
+    if (j.contains(key) && j[key].is_string()) *out = j[key].get<std::string>();
+  };
+  str("serial", &f.serial);
+  str("date", &f.date);
+  str("source", &f.source);
+  str("input_unit", &f.input_unit);
+  if (!j.contains("channels") || !j["channels"].is_number_integer()) {
+    throw CalFileError(path + ": channels missing");
+  }
+  const int n = j["channels"].get<int>();
+  if (n < 1 || n > static_cast<int>(hal::kMaxChannels)) {
+    throw CalFileError(path + ": channels must be 1..8, not " + std::to_string(n));
+  }
+  f.cal.channel_count = static_cast<std::uint8_t>(n);
+  const auto& m = j.at("matrix");
+  if (!m.is_array() || m.size() != 6) throw CalFileError(path + ": matrix must have 6 rows");
+  for (std::size_t r = 0; r < 6; ++r) {
+    if (!m[r].is_array() || m[r].size() != static_cast<std::size_t>(n)) {
+      throw CalFileError(path + ": matrix row " + std::to_string(r) + " must have " +
+                         std::to_string(n) + " entries");
+    }
+    for (std::size_t c = 0; c < static_cast<std::size_t>(n); ++c) {
+      f.cal.matrix[r][c] = Finite(m[r][c], path, "matrix[" + std::to_string(r) + "][" +
+                                                     std::to_string(c) + "]");
+    }
+  }
+  auto vec = [&](const char* key, std::size_t len, double* out, bool required) {
+    if (!j.contains(key)) {
+      if (required) throw CalFileError(path + ": " + key + " missing");
+      return;
+    }
+    const auto& a = j[key];
+    if (!a.is_array() || a.size() != len) {
+      throw CalFileError(path + ": " + key + " must have " + std::to_string(len) + " entries");
+    }
+    for (std::size_t i = 0; i < len; ++i) out[i] = Finite(a[i], path, std::string(key) + "[" + std::to_string(i) + "]");
+  };
+  vec("offset_mvv", static_cast<std::size_t>(n), f.cal.offset_mvv.data(), true);
+  vec("bias", 6, f.cal.bias.data(), true);
+  vec("rated", 6, f.rated.data(), true);
+  vec("uncertainty", 6, f.uncertainty.data(), false);
+  const auto& adc = j.at("adc");
+  f.adc.channel_count = static_cast<std::uint8_t>(n);
+  f.adc.min_counts = adc.at("min_counts").get<std::int32_t>();
+  f.adc.max_counts = adc.at("max_counts").get<std::int32_t>();
+  f.adc.full_scale_nvv = adc.at("full_scale_nvv").get<std::int64_t>();
+  for (const auto& [key, value] : j.items()) {
+    static const char* kKnown[] = {"schema", "serial", "date", "source", "channels", "input_unit",
+                                   "units", "adc", "matrix", "offset_mvv", "bias", "rated",
+                                   "uncertainty", "fixed_point", "crc32"};
+    bool known = false;
+    for (const char* k : kKnown) known = known || key == k;
+    if (!known) f.extra[key] = value;
+  }
+  try {
+    (void)ToFixed(f, f.adc);
+  } catch (const CalFileError& e) {
+    throw CalFileError(path + ": " + e.what());
+  }
+  return f;
+}
+
+CalFile LoadCalFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw CalFileError(path + ": cannot open: " + std::strerror(errno));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    // Turn the byte offset into line:column.
+    std::size_t line = 1;
+    std::size_t col = 1;
+    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        col = 1;
+      } else {
+        ++col;
+      }
+    }
+    throw CalFileError(path + ":" + std::to_string(line) + ":" + std::to_string(col) +
+                       ": not valid JSON (truncated or corrupt)");
+  }
+  try {
+    return FromJson(j, path);
+  } catch (const nlohmann::json::exception& e) {
+    throw CalFileError(path + ": " + e.what());
+  }
+}
+
+void SaveCalFile(const std::string& path, const CalFile& file) {
+  const std::string text = ToJson(file).dump(2) + "\n";
+  const std::string tmp = path + ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) throw CalFileError(tmp + ": cannot write: " + std::strerror(errno));
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t w = ::write(fd, text.data() + done, text.size() - done);
+    if (w < 0) {
+      if (errno == EINTR) continue;
+      ::close(fd);
+      throw CalFileError(tmp + ": write failed: " + std::strerror(errno));
+    }
+    done += static_cast<std::size_t>(w);
+  }
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    throw CalFileError(tmp + ": fsync/close failed: " + std::strerror(errno));
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    throw CalFileError(path + ": rename failed: " + std::strerror(errno));
+  }
+  std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  if (dir.empty()) dir = ".";
+  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY);
+  if (dfd >= 0) {
+    (void)::fsync(dfd);
+    ::close(dfd);
+  }
+}
+
+}  // namespace ftstack::cal

@@ -1,0 +1,62 @@
+// Calibration files: versioned JSON with CRC-32, refused whole when corrupt; atomic replacement.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+
+#include "firmware/fixed_calibration.hpp"
+#include "hal/adc.hpp"
+
+namespace ftstack::cal {
+
+/// A calibration file that cannot be used. what() names the file (and line:column for syntax).
+class CalFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// File schema identifier written and accepted by this version.
+inline constexpr const char* kCalSchema = "ftstack-cal/1";
+
+/// The contents of a calibration file.
+struct CalFile {
+  std::string serial = "unknown";
+  std::string date;                 ///< ISO 8601 date of the calibration
+  std::string source = "fit";       ///< "fit", "ideal" (from the sensor model), "ati"
+  std::string input_unit = "mV/V";  ///< unit of the bridge columns the matrix expects
+  fw::FloatCalibration cal{};       ///< matrix (N, N·m per input unit), offsets, bias
+  /// ADC the fixed-point form is made for: rails and full scale (input unit at max_counts).
+  hal::AdcInfo adc{};
+  std::array<double, 6> rated{};    ///< rated range per axis, N and N·m
+  std::array<double, 6> uncertainty{};  ///< per-axis standard uncertainty of the fit, N and N·m
+  nlohmann::json extra = nlohmann::json::object();  ///< fields of later issues, kept verbatim
+};
+
+/// CRC-32 (IEEE 802.3, reflected, as zlib) of a byte string.
+[[nodiscard]] std::uint32_t Crc32(const std::string& bytes);
+
+/// Serialises to JSON including the fixed-point form (recomputed) and the CRC field.
+/// Throws CalFileError if the calibration is refused by the fixed-point loader.
+[[nodiscard]] nlohmann::json ToJson(const CalFile& file);
+/// Parses and checks JSON (schema, CRC, shapes, finiteness, loader acceptance).
+[[nodiscard]] CalFile FromJson(const nlohmann::json& j, const std::string& path);
+/// The CRC-32 stored in / computed for a calibration JSON (over the compact dump without "crc32").
+[[nodiscard]] std::uint32_t ContentCrc(const nlohmann::json& j);
+
+/// Reads and verifies a calibration file. Throws CalFileError naming the file and, for syntax
+/// errors, line and column.
+[[nodiscard]] CalFile LoadCalFile(const std::string& path);
+/// Writes atomically: temporary file, fsync, rename over `path`, fsync of the directory.
+void SaveCalFile(const std::string& path, const CalFile& file);
+
+/// The default ADC of the simulated sensor: 24-bit, ±3.90625 mV/V (gain 128, ratio 0.5).
+[[nodiscard]] hal::AdcInfo DefaultAdc(std::uint8_t channels);
+
+/// Converts to the firmware's integer form for `adc`; throws CalFileError on refusal.
+[[nodiscard]] fw::FixedCalibration ToFixed(const CalFile& file, const hal::AdcInfo& adc,
+                                           fw::LoadReport* report = nullptr);
+
+}  // namespace ftstack::cal

@@ -1,0 +1,13 @@
+// The ideal calibration of a simulated sensor: the pseudo-inverse of its small-signal sensitivity.
+#pragma once
+
+#include "calibration/cal_file.hpp"
+#include "sim/sensor_model.hpp"
+
+namespace ftstack::cal {
+
+/// The calibration a perfect rig would find for `model` read by `adc`: matrix = pinv(S) at zero
+/// load and 20 °C, zero offsets = the model's unloaded outputs.
+[[nodiscard]] CalFile IdealCalibration(const sim::SensorModel& model, const hal::AdcInfo& adc);
+
+}  // namespace ftstack::cal

@@ -1,0 +1,103 @@
+# Target helpers: warning flags, embedded flags and the layer rules that keep the architecture honest.
+#
+# Layers (by target-name prefix) and what each may link:
+#   ftstack_hal        the HAL interface (header-only)            -> nothing of ours
+#   ftstack_hal_*      HAL backends (sim ADC, HX711, SPI ADC)     -> ftstack_hal
+#   ftstack_fw_*       firmware (integer core, sampler, Modbus)   -> ftstack_hal, ftstack_fw_*
+#   ftstack_sim*       physics simulator, recordings (host)       -> ftstack_hal*, ftstack_sim*
+#   ftstack_cal*       calibration fitting and files (host)       -> ftstack_fw_*, ftstack_hal, ftstack_sim*, ftstack_cal*
+#   ftstack_tool_*     logic behind the command-line tools        -> anything above
+# Executables (tools, tests, benchmarks) may link anything; no library may link ftstack_tool_*
+# (except another tool library) and nothing links a test.
+
+add_library(ftstack_warnings INTERFACE)
+target_compile_options(ftstack_warnings INTERFACE -Wall -Wextra -Wshadow -Wnon-virtual-dtor)
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
+  # GCC 12 reports false -Wrestrict positives inside std::string at -O2/-O3 (GCC PR 105329).
+  target_compile_options(ftstack_warnings INTERFACE -Wno-restrict)
+endif()
+if(FTSTACK_WERROR)
+  target_compile_options(ftstack_warnings INTERFACE -Werror)
+endif()
+if(FTSTACK_SANITIZE)
+  add_compile_options(-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=address,undefined)
+endif()
+
+# Embedded code (hal/, firmware/): no exceptions, no RTTI.
+add_library(ftstack_embedded INTERFACE)
+target_compile_options(ftstack_embedded INTERFACE $<$<COMPILE_LANGUAGE:CXX>:-fno-exceptions -fno-rtti>)
+target_link_libraries(ftstack_embedded INTERFACE ftstack_warnings)
+
+set_property(GLOBAL PROPERTY FTSTACK_LIBRARIES "")
+
+# ftstack_library(NAME [STATIC|INTERFACE] [EMBEDDED] SOURCES ...)
+function(ftstack_library name)
+  cmake_parse_arguments(ARG "INTERFACE;EMBEDDED" "" "SOURCES" ${ARGN})
+  if(ARG_INTERFACE)
+    add_library(${name} INTERFACE)
+    target_include_directories(${name} INTERFACE ${PROJECT_SOURCE_DIR})
+  else()
+    add_library(${name} STATIC ${ARG_SOURCES})
+    target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
+    if(ARG_EMBEDDED)
+      target_link_libraries(${name} PRIVATE ftstack_embedded)
+    else()
+      target_link_libraries(${name} PRIVATE ftstack_warnings)
+    endif()
+  endif()
+  set_property(GLOBAL APPEND PROPERTY FTSTACK_LIBRARIES ${name})
+endfunction()
+
+function(_ftstack_layer_of target out)
+  if(target STREQUAL "ftstack_hal")
+    set(${out} "hal_if" PARENT_SCOPE)
+  elseif(target MATCHES "^ftstack_hal_")
+    set(${out} "hal" PARENT_SCOPE)
+  elseif(target MATCHES "^ftstack_fw_")
+    set(${out} "fw" PARENT_SCOPE)
+  elseif(target MATCHES "^ftstack_sim")
+    set(${out} "sim" PARENT_SCOPE)
+  elseif(target MATCHES "^ftstack_cal")
+    set(${out} "cal" PARENT_SCOPE)
+  elseif(target MATCHES "^ftstack_tool_")
+    set(${out} "tool" PARENT_SCOPE)
+  elseif(target MATCHES "^ftstack_test|^test_")
+    set(${out} "test" PARENT_SCOPE)
+  else()
+    set(${out} "external" PARENT_SCOPE)
+  endif()
+endfunction()
+
+function(ftstack_check_layers)
+  set(allowed_hal_if "")
+  set(allowed_hal "hal_if")
+  set(allowed_fw "hal_if;fw")
+  set(allowed_sim "hal_if;hal;sim")
+  set(allowed_cal "hal_if;fw;sim;cal")
+  set(allowed_tool "hal_if;hal;fw;sim;cal;tool")
+  get_property(libs GLOBAL PROPERTY FTSTACK_LIBRARIES)
+  foreach(lib IN LISTS libs)
+    _ftstack_layer_of(${lib} layer)
+    get_target_property(type ${lib} TYPE)
+    if(type STREQUAL "INTERFACE_LIBRARY")
+      get_target_property(deps ${lib} INTERFACE_LINK_LIBRARIES)
+    else()
+      get_target_property(deps ${lib} LINK_LIBRARIES)
+    endif()
+    if(NOT deps)
+      continue()
+    endif()
+    foreach(dep IN LISTS deps)
+      string(REGEX REPLACE "^\\$<LINK_ONLY:(.*)>$" "\\1" dep "${dep}")
+      if(NOT dep MATCHES "^ftstack_" OR dep STREQUAL "ftstack_warnings" OR dep STREQUAL "ftstack_embedded")
+        continue()
+      endif()
+      _ftstack_layer_of(${dep} dep_layer)
+      if(NOT dep_layer IN_LIST allowed_${layer})
+        message(FATAL_ERROR "Architecture violation: ${lib} (layer ${layer}) links ${dep} "
+                            "(layer ${dep_layer}). See docs/architecture.md.")
+      endif()
+    endforeach()
+  endforeach()
+endfunction()

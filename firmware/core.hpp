@@ -1,0 +1,92 @@
+// The per-sample fixed-point core: counts − tare → calibration matrix → wrench, filter, status.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "firmware/fixed_calibration.hpp"
+#include "firmware/status_bits.hpp"
+#include "firmware/wrench.hpp"
+#include "hal/adc.hpp"
+
+namespace ftstack::fw {
+
+/// Largest moving-average length (Modbus holding register 1 accepts 1 … kMaxFilterLength).
+inline constexpr std::uint16_t kMaxFilterLength = 256;
+/// Largest number of samples one tare may average.
+inline constexpr std::uint16_t kMaxTareSamples = 4096;
+
+/// Result of one processed sample.
+struct CoreOutput {
+  WrenchLsb wrench{};             ///< filtered wrench, LSB (mN, 10 µN·m); held on saturation
+  WrenchLsb unfiltered{};         ///< this sample's wrench before the moving average, LSB
+  std::uint16_t status = 0;       ///< StatusBit set that the core decides (0, 2, 3, 4, 5, 7)
+  bool arithmetic_saturated = false;  ///< an intermediate value was clamped this sample
+  bool updated = false;           ///< the wrench was recomputed (false while holding)
+};
+
+/// Fault-detection thresholds (samples).
+struct CoreLimits {
+  std::uint16_t stuck_samples = 64;   ///< identical counts on all channels this long → ADC fault
+  std::uint16_t rail_samples = 8;     ///< a channel pinned at a rail this long → bridge fault
+};
+
+/// The integer-only sample path. Owns no heap; all state is fixed-size. Not thread-safe: one
+/// sampling thread calls Process; commands (tare, filter length) come through the same thread.
+class WrenchCore {
+ public:
+  WrenchCore() = default;
+
+  /// Installs a calibration proven by LoadCalibration. An invalid one clears the wrench and sets
+  /// kStatusCalInvalid until a valid one is installed.
+  void SetCalibration(const FixedCalibration& cal);
+  [[nodiscard]] const FixedCalibration& calibration() const { return cal_; }
+
+  /// Fault thresholds; a zero disables that check.
+  void SetLimits(const CoreLimits& limits) { limits_ = limits; }
+
+  /// Starts a tare over the next `samples` valid samples (1 … kMaxTareSamples); the previous tare
+  /// stays in effect until the new one completes. Returns false for an out-of-range count.
+  [[nodiscard]] bool RequestTare(std::uint16_t samples);
+  /// Removes the tare: the calibration's own zero and bias apply again.
+  void ClearTare();
+  [[nodiscard]] bool tare_active() const { return tare_active_; }
+  [[nodiscard]] bool tare_pending() const { return tare_remaining_ > 0; }
+
+  /// Moving-average length, 1 … kMaxFilterLength; false (and unchanged) otherwise. Restarts the
+  /// filter.
+  [[nodiscard]] bool SetFilterLength(std::uint16_t length);
+  [[nodiscard]] std::uint16_t filter_length() const { return filter_length_; }
+
+  /// Processes one ADC sample (integer arithmetic only).
+  void Process(const hal::AdcSample& in, bool simulated, CoreOutput& out);
+
+  /// The unfiltered matrix step alone (exposed for tests and `ftcal apply`): y = M·(x − zero) + b.
+  /// Counts outside the calibration's rails are clamped and reported through *saturated.
+  void Apply(const std::array<std::int32_t, kMaxChannels>& counts, WrenchLsb& y,
+             bool* saturated) const;
+
+ private:
+  void ResetFilter();
+
+  FixedCalibration cal_{};
+  CoreLimits limits_{};
+  std::array<std::int32_t, kMaxChannels> tare_counts_{};
+  bool tare_active_ = false;
+  std::uint16_t tare_remaining_ = 0;
+  std::uint16_t tare_total_ = 0;
+  std::array<std::int64_t, kMaxChannels> tare_sum_{};
+
+  std::uint16_t filter_length_ = 1;
+  std::uint16_t filter_fill_ = 0;
+  std::uint16_t filter_pos_ = 0;
+  std::array<std::array<std::int32_t, kAxes>, kMaxFilterLength> filter_ring_{};
+  std::array<std::int64_t, kAxes> filter_sum_{};
+
+  WrenchLsb last_valid_{};
+  std::array<std::int32_t, kMaxChannels> last_counts_{};
+  std::uint16_t same_count_run_ = 0;
+  std::array<std::uint16_t, kMaxChannels> rail_run_{};
+};
+
+}  // namespace ftstack::fw

@@ -1,0 +1,16 @@
+#include "sim/simulated_sensor.hpp"
+
+namespace ftstack::sim {
+
+bool SimulatedSensor::Sample(double t_s, double* bridge_mvv, double* temperature_c) {
+  Wrench w;
+  double temp = 20.0;
+  if (!source_.At(t_s, &w, &temp)) return false;
+  last_wrench_ = w;
+  const Eigen::VectorXd b = model_.BridgeOutputs(w, temp);
+  for (Eigen::Index i = 0; i < b.size(); ++i) bridge_mvv[i] = b(i);
+  *temperature_c = temp;
+  return true;
+}
+
+}  // namespace ftstack::sim
