@@ -15,6 +15,7 @@
 #include "sim/simulated_sensor.hpp"
 #include "sim/wrench_source.hpp"
 #include "tools/common.hpp"
+#include "tools/ftd/hardware_adc.hpp"
 
 namespace {
 
@@ -63,9 +64,12 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   if (adc_kind != "sim") {
-    std::fprintf(stderr, "ftd: --adc %s: hardware backends are not built into this version\n",
-                 adc_kind.c_str());
-    return 2;
+    std::string error;
+    tools::HardwareAdcOptions hw{adc_kind, gpiochip, spidev, 6};
+    if (tools::MakeHardwareAdc(hw, &error) == nullptr) {
+      std::fprintf(stderr, "ftd: %s\n", error.c_str());
+      return 2;
+    }
   }
   if (!modbus_tcp.empty() || !modbus_rtu.empty()) {
     std::fprintf(stderr, "ftd: note: Modbus serving is not in this build yet; showing readings only\n");
