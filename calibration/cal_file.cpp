@@ -109,7 +109,7 @@ nlohmann::json ToJson(const CalFile& f) {
   fp["coef"] = coef;
   fp["bias"] = fx.bias;
   fp["worst_case_error"] = rep.worst_case_error_si;
-  fp["output_lsb"] = {fw::kForceLsbN, fw::kForceLsbN, fw::kForceLsbN,
+  fp["output_lsb"] = {fw::kForceLsbN,   fw::kForceLsbN,   fw::kForceLsbN,
                       fw::kMomentLsbNm, fw::kMomentLsbNm, fw::kMomentLsbNm};
   j["fixed_point"] = fp;
   j["crc32"] = Hex32(ContentCrc(j));
@@ -154,8 +154,8 @@ CalFile FromJson(const nlohmann::json& j, const std::string& path) {
                          std::to_string(n) + " entries");
     }
     for (std::size_t c = 0; c < static_cast<std::size_t>(n); ++c) {
-      f.cal.matrix[r][c] = Finite(m[r][c], path, "matrix[" + std::to_string(r) + "][" +
-                                                     std::to_string(c) + "]");
+      f.cal.matrix[r][c] =
+          Finite(m[r][c], path, "matrix[" + std::to_string(r) + "][" + std::to_string(c) + "]");
     }
   }
   auto vec = [&](const char* key, std::size_t len, double* out, bool required) {
@@ -167,7 +167,8 @@ CalFile FromJson(const nlohmann::json& j, const std::string& path) {
     if (!a.is_array() || a.size() != len) {
       throw CalFileError(path + ": " + key + " must have " + std::to_string(len) + " entries");
     }
-    for (std::size_t i = 0; i < len; ++i) out[i] = Finite(a[i], path, std::string(key) + "[" + std::to_string(i) + "]");
+    for (std::size_t i = 0; i < len; ++i)
+      out[i] = Finite(a[i], path, std::string(key) + "[" + std::to_string(i) + "]");
   };
   vec("offset_mvv", static_cast<std::size_t>(n), f.cal.offset_mvv.data(), true);
   vec("bias", 6, f.cal.bias.data(), true);
@@ -179,9 +180,9 @@ CalFile FromJson(const nlohmann::json& j, const std::string& path) {
   f.adc.max_counts = adc.at("max_counts").get<std::int32_t>();
   f.adc.full_scale_nvv = adc.at("full_scale_nvv").get<std::int64_t>();
   for (const auto& [key, value] : j.items()) {
-    static const char* kKnown[] = {"schema", "serial", "date", "source", "channels", "input_unit",
-                                   "units", "adc", "matrix", "offset_mvv", "bias", "rated",
-                                   "uncertainty", "fixed_point", "crc32"};
+    static const char* kKnown[] = {
+        "schema", "serial",     "date", "source", "channels",    "input_unit",  "units", "adc",
+        "matrix", "offset_mvv", "bias", "rated",  "uncertainty", "fixed_point", "crc32"};
     bool known = false;
     for (const char* k : kKnown) known = known || key == k;
     if (!known) f.extra[key] = value;

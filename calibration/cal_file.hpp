@@ -30,7 +30,7 @@ struct CalFile {
   fw::FloatCalibration cal{};       ///< matrix (N, N·m per input unit), offsets, bias
   /// ADC the fixed-point form is made for: rails and full scale (input unit at max_counts).
   hal::AdcInfo adc{};
-  std::array<double, 6> rated{};    ///< rated range per axis, N and N·m
+  std::array<double, 6> rated{};        ///< rated range per axis, N and N·m
   std::array<double, 6> uncertainty{};  ///< per-axis standard uncertainty of the fit, N and N·m
   nlohmann::json extra = nlohmann::json::object();  ///< fields of later issues, kept verbatim
 };

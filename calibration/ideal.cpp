@@ -15,7 +15,8 @@ CalFile IdealCalibration(const sim::SensorModel& model, const hal::AdcInfo& adc)
       f.cal.matrix[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)] = m(r, c);
     }
   }
-  for (int c = 0; c < model.channel_count(); ++c) f.cal.offset_mvv[static_cast<std::size_t>(c)] = zero(c);
+  for (int c = 0; c < model.channel_count(); ++c)
+    f.cal.offset_mvv[static_cast<std::size_t>(c)] = zero(c);
   f.adc = adc;
   f.adc.channel_count = f.cal.channel_count;
   const sim::Wrench rated = model.rated();

@@ -78,7 +78,7 @@ void WrenchCore::Process(const hal::AdcSample& in, bool simulated, CoreOutput& o
     if (v != last_counts_[c]) all_same = false;
     const bool at_rail = cal_.valid && (v >= cal_.max_counts || v <= cal_.min_counts);
     rail_run_[c] = at_rail ? static_cast<std::uint16_t>(rail_run_[c] < 0xFFFF ? rail_run_[c] + 1
-                                                                               : rail_run_[c])
+                                                                              : rail_run_[c])
                            : 0;
     if (limits_.rail_samples > 0 && rail_run_[c] >= limits_.rail_samples) bridge_fault = true;
     last_counts_[c] = v;

@@ -18,17 +18,17 @@ inline constexpr std::uint16_t kMaxTareSamples = 4096;
 
 /// Result of one processed sample.
 struct CoreOutput {
-  WrenchLsb wrench{};             ///< filtered wrench, LSB (mN, 10 µN·m); held on saturation
-  WrenchLsb unfiltered{};         ///< this sample's wrench before the moving average, LSB
-  std::uint16_t status = 0;       ///< StatusBit set that the core decides (0, 2, 3, 4, 5, 7)
+  WrenchLsb wrench{};                 ///< filtered wrench, LSB (mN, 10 µN·m); held on saturation
+  WrenchLsb unfiltered{};             ///< this sample's wrench before the moving average, LSB
+  std::uint16_t status = 0;           ///< StatusBit set that the core decides (0, 2, 3, 4, 5, 7)
   bool arithmetic_saturated = false;  ///< an intermediate value was clamped this sample
-  bool updated = false;           ///< the wrench was recomputed (false while holding)
+  bool updated = false;               ///< the wrench was recomputed (false while holding)
 };
 
 /// Fault-detection thresholds (samples).
 struct CoreLimits {
-  std::uint16_t stuck_samples = 64;   ///< identical counts on all channels this long → ADC fault
-  std::uint16_t rail_samples = 8;     ///< a channel pinned at a rail this long → bridge fault
+  std::uint16_t stuck_samples = 64;  ///< identical counts on all channels this long → ADC fault
+  std::uint16_t rail_samples = 8;    ///< a channel pinned at a rail this long → bridge fault
 };
 
 /// The integer-only sample path. Owns no heap; all state is fixed-size. Not thread-safe: one

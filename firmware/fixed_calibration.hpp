@@ -28,7 +28,7 @@ struct FloatCalibration {
 struct FixedCalibration {
   std::uint8_t channel_count = 0;
   std::array<std::array<std::int64_t, kMaxChannels>, kAxes> coef{};  ///< LSB/count · 2^shift
-  std::array<std::int64_t, kAxes> bias{};  ///< (bias − matrix·offset) in LSB · 2^shift
+  std::array<std::int64_t, kAxes> bias{};   ///< (bias − matrix·offset) in LSB · 2^shift
   std::array<std::uint8_t, kAxes> shift{};  ///< per-row binary point, 0 … 62
   std::int32_t min_counts = 0;              ///< ADC rails the proof was made for
   std::int32_t max_counts = 0;

@@ -11,14 +11,14 @@ namespace ftstack::fw {
 
 /// One published sample: everything a Modbus reply or a log row is made of.
 struct PublishedSample {
-  std::uint32_t sequence = 0;        ///< +1 per published sample, wraps
-  std::uint32_t timestamp_us = 0;    ///< since start, wraps, µs
-  WrenchLsb wrench{};                ///< mN and 10 µN·m
+  std::uint32_t sequence = 0;      ///< +1 per published sample, wraps
+  std::uint32_t timestamp_us = 0;  ///< since start, wraps, µs
+  WrenchLsb wrench{};              ///< mN and 10 µN·m
   std::uint8_t channel_count = 0;
   std::array<std::int32_t, hal::kMaxChannels> raw_counts{};  ///< counts
-  std::int32_t temperature_mdegc = 0;  ///< m°C, valid if has_temperature
+  std::int32_t temperature_mdegc = 0;                        ///< m°C, valid if has_temperature
   bool has_temperature = false;
-  std::uint16_t status = 0;          ///< StatusBit set
+  std::uint16_t status = 0;  ///< StatusBit set
 };
 
 /// Drives one ADC through the core. Call Step() in the sampling thread's loop.

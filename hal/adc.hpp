@@ -1,4 +1,5 @@
-// The ADC interface every bridge read-out backend implements: configuration, data-ready, raw counts.
+// The ADC interface every bridge read-out backend implements: configuration, data-ready, raw
+// counts.
 #pragma once
 
 #include <array>
@@ -61,11 +62,11 @@ struct AdcConfig {
 /// bridge_mvv = counts * full_scale_nvv / max_counts / 1e6.
 struct AdcInfo {
   std::uint8_t channel_count = 0;
-  std::int32_t min_counts = 0;       ///< negative rail, counts (e.g. -2^23 for a 24-bit ADC)
-  std::int32_t max_counts = 0;       ///< positive rail, counts (e.g. 2^23 - 1)
-  std::int64_t full_scale_nvv = 0;   ///< bridge input at max_counts, nV/V
-  std::uint32_t rate_hz = 0;         ///< configured sample rate, Hz
-  bool simulated = false;            ///< true for the simulated backend (status bit 7)
+  std::int32_t min_counts = 0;      ///< negative rail, counts (e.g. -2^23 for a 24-bit ADC)
+  std::int32_t max_counts = 0;      ///< positive rail, counts (e.g. 2^23 - 1)
+  std::int64_t full_scale_nvv = 0;  ///< bridge input at max_counts, nV/V
+  std::uint32_t rate_hz = 0;        ///< configured sample rate, Hz
+  bool simulated = false;           ///< true for the simulated backend (status bit 7)
 };
 
 /// One simultaneous reading of all channels.
@@ -73,7 +74,7 @@ struct AdcSample {
   std::uint8_t channel_count = 0;
   std::array<std::int32_t, kMaxChannels> counts{};  ///< signed raw ADC value per channel, counts
   std::array<std::uint8_t, kMaxChannels> flags{};   ///< ChannelFlag bits per channel
-  std::uint64_t timestamp_us = 0;   ///< time of conversion since the backend started, µs
+  std::uint64_t timestamp_us = 0;      ///< time of conversion since the backend started, µs
   std::int32_t temperature_mdegc = 0;  ///< sensor body temperature, m°C (valid if has_temperature)
   bool has_temperature = false;
 };
@@ -108,7 +109,9 @@ class Adc {
 
   /// Blocks until a new sample is ready or timeout_us elapses (kTimeout). kEndOfData for a
   /// finished replay, kNotConfigured before Configure.
-  [[nodiscard]] Status WaitDataReady(std::uint32_t timeout_us) { return DoWaitDataReady(timeout_us); }
+  [[nodiscard]] Status WaitDataReady(std::uint32_t timeout_us) {
+    return DoWaitDataReady(timeout_us);
+  }
 
   /// Reads the sample that became ready. Sets kChannelSaturated on every channel within 1 % of a
   /// rail. kReadError when the transfer failed (flags then say which channels).

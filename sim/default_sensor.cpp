@@ -28,9 +28,9 @@ std::unique_ptr<SensorModel> MakeDefaultSensor() {
     }
   }
   // A few per cent of cross-talk, as machining and gauge placement leave it.
-  const double xt[6][6] = {{0.02, -0.01, 0, 0.015, 0, -0.02},  {0, 0.01, -0.02, 0, 0.01, 0},
+  const double xt[6][6] = {{0.02, -0.01, 0, 0.015, 0, -0.02},    {0, 0.01, -0.02, 0, 0.01, 0},
                            {-0.015, 0, 0.01, -0.01, 0.02, 0.01}, {0.01, 0.02, 0, 0, -0.015, 0},
-                           {0, -0.02, 0.015, 0.01, 0, 0.02},    {0.02, 0, -0.01, 0.02, 0.01, 0}};
+                           {0, -0.02, 0.015, 0.01, 0, 0.02},     {0.02, 0, -0.01, 0.02, 0.01, 0}};
   for (int i = 0; i < 6; ++i) {
     for (int j = 0; j < 6; ++j) s(i, j) += kRatedMvv * xt[i][j] / rated(j);
   }

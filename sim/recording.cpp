@@ -217,7 +217,8 @@ void CheckAligned(const Recording& sim, const Recording& real) {
   for (std::size_t i = 0; i < ts.size(); ++i) {
     if (std::fabs(ts[i] - tr[i]) > 1e-6) {
       const int col = sim.Find("t");
-      throw RecordingError(sim.path + ":" + std::to_string(sim.data_lines.empty() ? i + 2 : sim.data_lines[i]) +
+      throw RecordingError(sim.path + ":" +
+                           std::to_string(sim.data_lines.empty() ? i + 2 : sim.data_lines[i]) +
                            ":" + std::to_string(col + 1) + ": t = " + std::to_string(ts[i]) +
                            " does not match " + real.path + " (t = " + std::to_string(tr[i]) + ")");
     }

@@ -18,11 +18,11 @@ class RecordingError : public std::runtime_error {
 
 /// A recording held column-major: columns[i] is named names[i].
 struct Recording {
-  std::string path;                    ///< where it came from (for messages)
-  std::vector<std::string> metadata;   ///< "# key: value" lines before the header, without "# "
-  std::vector<std::string> names;      ///< header, in file order
+  std::string path;                   ///< where it came from (for messages)
+  std::vector<std::string> metadata;  ///< "# key: value" lines before the header, without "# "
+  std::vector<std::string> names;     ///< header, in file order
   std::vector<std::vector<double>> columns;
-  std::vector<std::size_t> data_lines; ///< file line number of each row (1-based)
+  std::vector<std::size_t> data_lines;  ///< file line number of each row (1-based)
 
   [[nodiscard]] std::size_t rows() const { return columns.empty() ? 0 : columns[0].size(); }
   /// Index of a column, or -1.

@@ -72,28 +72,35 @@ SensorDescription LoadSensorDescription(const std::string& path) {
   Eigen::MatrixXd sens(n, 6);
   for (int i = 0; i < n; ++i) {
     if (!s[static_cast<std::size_t>(i)].is_array() || s[static_cast<std::size_t>(i)].size() != 6) {
-      throw SensorDescriptionError(path + ": sensitivity row " + std::to_string(i) + " needs 6 numbers");
+      throw SensorDescriptionError(path + ": sensitivity row " + std::to_string(i) +
+                                   " needs 6 numbers");
     }
     for (int k = 0; k < 6; ++k) {
-      sens(i, k) = Num(s[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)], path, "sensitivity");
+      sens(i, k) =
+          Num(s[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)], path, "sensitivity");
     }
   }
   Wrench rated = DefaultRated();
   if (m.contains("rated")) {
-    for (int k = 0; k < 6; ++k) rated(k) = Num(m["rated"].at(static_cast<std::size_t>(k)), path, "rated");
+    for (int k = 0; k < 6; ++k)
+      rated(k) = Num(m["rated"].at(static_cast<std::size_t>(k)), path, "rated");
   }
   Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
   if (m.contains("zero_mvv")) {
-    for (int i = 0; i < n; ++i) zero(i) = Num(m["zero_mvv"].at(static_cast<std::size_t>(i)), path, "zero_mvv");
+    for (int i = 0; i < n; ++i)
+      zero(i) = Num(m["zero_mvv"].at(static_cast<std::size_t>(i)), path, "zero_mvv");
   }
   d.model = std::make_shared<LinearSensorModel>(sens, rated, d.name, zero);
   d.adc.noise_rms_mvv = kDefaultNoiseMvv;
   if (j.contains("adc")) {
     const auto& a = j["adc"];
     if (a.contains("noise_mvv")) d.adc.noise_rms_mvv = Num(a["noise_mvv"], path, "adc.noise_mvv");
-    if (a.contains("bits")) d.adc.resolution_bits = static_cast<int>(Num(a["bits"], path, "adc.bits"));
-    if (a.contains("reference_ratio")) d.adc.reference_ratio = Num(a["reference_ratio"], path, "adc.reference_ratio");
-    if (a.contains("gain")) d.adc_gain = static_cast<std::uint16_t>(Num(a["gain"], path, "adc.gain"));
+    if (a.contains("bits"))
+      d.adc.resolution_bits = static_cast<int>(Num(a["bits"], path, "adc.bits"));
+    if (a.contains("reference_ratio"))
+      d.adc.reference_ratio = Num(a["reference_ratio"], path, "adc.reference_ratio");
+    if (a.contains("gain"))
+      d.adc_gain = static_cast<std::uint16_t>(Num(a["gain"], path, "adc.gain"));
     if (a.contains("rate_hz")) d.rate_hz = Num(a["rate_hz"], path, "adc.rate_hz");
   }
   return d;

@@ -1,4 +1,5 @@
-// Sensor description files (JSON): which sensor model, its ADC and rated ranges, for ftsim/ftdiag/ftd.
+// Sensor description files (JSON): which sensor model, its ADC and rated ranges, for
+// ftsim/ftdiag/ftd.
 #pragma once
 
 #include <memory>
@@ -20,7 +21,7 @@ class SensorDescriptionError : public std::runtime_error {
 struct SensorDescription {
   std::string name;
   std::shared_ptr<const SensorModel> model;
-  hal::sim::SimAdcParams adc;   ///< converter (noise in mV/V RMS, resolution, reference ratio)
+  hal::sim::SimAdcParams adc;    ///< converter (noise in mV/V RMS, resolution, reference ratio)
   std::uint16_t adc_gain = 128;  ///< PGA gain
   double rate_hz = 1000.0;       ///< sample rate, Hz
 };

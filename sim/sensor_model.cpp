@@ -23,7 +23,10 @@ Eigen::MatrixXd SensorModel::Sensitivity() const {
 
 LinearSensorModel::LinearSensorModel(Eigen::MatrixXd sensitivity, Wrench rated, std::string name,
                                      Eigen::VectorXd zero_mvv)
-    : s_(std::move(sensitivity)), rated_(rated), name_(std::move(name)), zero_(std::move(zero_mvv)) {
+    : s_(std::move(sensitivity)),
+      rated_(rated),
+      name_(std::move(name)),
+      zero_(std::move(zero_mvv)) {
   if (s_.cols() != 6 || s_.rows() < 1 || s_.rows() > 8) {
     throw std::invalid_argument("sensitivity matrix must be N x 6 with 1 <= N <= 8");
   }

@@ -17,7 +17,8 @@ class SensorModel {
   /// Number of bridges N (1 … 8).
   [[nodiscard]] virtual int channel_count() const = 0;
   /// Bridge outputs in mV/V for wrench `w` at body temperature `temperature_c` (°C).
-  [[nodiscard]] virtual Eigen::VectorXd BridgeOutputs(const Wrench& w, double temperature_c) const = 0;
+  [[nodiscard]] virtual Eigen::VectorXd BridgeOutputs(const Wrench& w,
+                                                      double temperature_c) const = 0;
   /// Rated range per axis (N, N·m), positive.
   [[nodiscard]] virtual Wrench rated() const = 0;
   /// Small-signal sensitivity d(mV/V)/d(wrench) at zero load and 20 °C (N × 6).

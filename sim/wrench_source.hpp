@@ -1,4 +1,5 @@
-// Wrench sources that drive a simulated sensor: constant, piecewise-linear profile, recording replay.
+// Wrench sources that drive a simulated sensor: constant, piecewise-linear profile, recording
+// replay.
 #pragma once
 
 #include <memory>

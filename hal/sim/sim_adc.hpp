@@ -32,7 +32,7 @@ enum class SimFault : std::uint8_t {
 
 /// Electrical parameters of the simulated converter.
 struct SimAdcParams {
-  int resolution_bits = 24;       ///< two's-complement output width, 8 … 31
+  int resolution_bits = 24;  ///< two's-complement output width, 8 … 31
   /// Reference over excitation voltage. The input span is ±reference_ratio / gain of the
   /// excitation: 0.5 gives the HX711's ±0.5·AVDD/gain (3.90625 mV/V at gain 128).
   double reference_ratio = 0.5;
@@ -41,8 +41,8 @@ struct SimAdcParams {
   bool realtime = false;          ///< pace WaitDataReady to the wall clock (false: virtual time)
 };
 
-/// Simulated ratiometric delta-sigma ADC. counts = round(mV/V · max_counts / full_scale_mvv + noise),
-/// clipped to the rails. Time is n / rate_hz for the n-th sample.
+/// Simulated ratiometric delta-sigma ADC. counts = round(mV/V · max_counts / full_scale_mvv +
+/// noise), clipped to the rails. Time is n / rate_hz for the n-th sample.
 class SimAdc final : public Adc {
  public:
   SimAdc(BridgeSignalSource& source, const SimAdcParams& params);

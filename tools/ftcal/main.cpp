@@ -34,10 +34,11 @@ int main(int argc, char** argv) {
       (void)cal::ToFixed(cal, cal.adc, &rep);
       std::printf("%s: OK (schema %s, %d channels, serial %s, CRC valid)\n", cal_path.c_str(),
                   cal::kCalSchema, cal.cal.channel_count, cal.serial.c_str());
-      std::printf("worst-case fixed-point error: Fx %.3g N, Fy %.3g N, Fz %.3g N, Mx %.3g N·m, "
-                  "My %.3g N·m, Mz %.3g N·m\n",
-                  rep.worst_case_error_si[0], rep.worst_case_error_si[1], rep.worst_case_error_si[2],
-                  rep.worst_case_error_si[3], rep.worst_case_error_si[4], rep.worst_case_error_si[5]);
+      std::printf(
+          "worst-case fixed-point error: Fx %.3g N, Fy %.3g N, Fz %.3g N, Mx %.3g N·m, "
+          "My %.3g N·m, Mz %.3g N·m\n",
+          rep.worst_case_error_si[0], rep.worst_case_error_si[1], rep.worst_case_error_si[2],
+          rep.worst_case_error_si[3], rep.worst_case_error_si[4], rep.worst_case_error_si[5]);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ftcal: %s\n", e.what());

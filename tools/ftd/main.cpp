@@ -46,7 +46,8 @@ int main(int argc, char** argv) {
   app.add_option("--adc", adc_kind, "ADC backend: sim, hx711, spi")
       ->check(CLI::IsMember({"sim", "hx711", "spi"}));
   app.add_option("--sim-wrench", sim_wrench, "constant applied wrench FX,FY,FZ,MX,MY,MZ (N, N·m)");
-  app.add_option("--replay", replay, "play the wrench columns of a recording")->check(CLI::ExistingFile);
+  app.add_option("--replay", replay, "play the wrench columns of a recording")
+      ->check(CLI::ExistingFile);
   app.add_option("--rate-hz", rate_hz, "sample rate, Hz")->check(CLI::Range(1u, 100000u));
   app.add_option("--cal", cal_path, "calibration file (default: the simulated sensor's own)");
   app.add_option("--modbus-tcp", modbus_tcp, "serve Modbus TCP on HOST:PORT");
@@ -57,7 +58,8 @@ int main(int argc, char** argv) {
   app.add_option("--log", log_path, "write samples to a recording (CSV)");
   app.add_option("--gpiochip", gpiochip, "GPIO chip for --adc hx711");
   app.add_option("--spidev", spidev, "SPI device for --adc spi");
-  app.add_option("--duration-s", duration_s, "stop after this many seconds (0: run until signalled)");
+  app.add_option("--duration-s", duration_s,
+                 "stop after this many seconds (0: run until signalled)");
   app.add_option("--seed", seed, "noise seed of the simulated ADC");
   app.add_option("--print-hz", print_hz, "rate of the live reading line (0: quiet)");
   app.get_option("--sim-wrench")->excludes(app.get_option("--replay"));
@@ -72,7 +74,8 @@ int main(int argc, char** argv) {
     }
   }
   if (!modbus_tcp.empty() || !modbus_rtu.empty()) {
-    std::fprintf(stderr, "ftd: note: Modbus serving is not in this build yet; showing readings only\n");
+    std::fprintf(stderr,
+                 "ftd: note: Modbus serving is not in this build yet; showing readings only\n");
   }
 
   std::unique_ptr<sim::SensorModel> model = sim::MakeDefaultSensor();
@@ -134,12 +137,13 @@ int main(int argc, char** argv) {
     if (s == hal::Status::kEndOfData) break;
     ++n;
     if (print_every != 0 && n % print_every == 0) {
-      std::printf("%st=%9.3f s  seq=%-8u Fx=%9.3f Fy=%9.3f Fz=%9.3f N  Mx=%8.4f My=%8.4f Mz=%8.4f N·m"
-                  "  status=0x%04x%s",
-                  tty ? "\r" : "", p.timestamp_us * 1e-6, p.sequence, p.wrench[0] * fw::kForceLsbN,
-                  p.wrench[1] * fw::kForceLsbN, p.wrench[2] * fw::kForceLsbN,
-                  p.wrench[3] * fw::kMomentLsbNm, p.wrench[4] * fw::kMomentLsbNm,
-                  p.wrench[5] * fw::kMomentLsbNm, p.status, tty ? "" : "\n");
+      std::printf(
+          "%st=%9.3f s  seq=%-8u Fx=%9.3f Fy=%9.3f Fz=%9.3f N  Mx=%8.4f My=%8.4f Mz=%8.4f N·m"
+          "  status=0x%04x%s",
+          tty ? "\r" : "", p.timestamp_us * 1e-6, p.sequence, p.wrench[0] * fw::kForceLsbN,
+          p.wrench[1] * fw::kForceLsbN, p.wrench[2] * fw::kForceLsbN,
+          p.wrench[3] * fw::kMomentLsbNm, p.wrench[4] * fw::kMomentLsbNm,
+          p.wrench[5] * fw::kMomentLsbNm, p.status, tty ? "" : "\n");
       std::fflush(stdout);
     }
     if (max_samples != 0 && n >= max_samples) break;

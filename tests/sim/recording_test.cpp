@@ -1,0 +1,113 @@
+// The recording reader/writer: columns by name, and refusals that name file, line and column.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "sim/recording.hpp"
+
+namespace ftstack::sim {
+namespace {
+
+std::string ErrorOf(const std::string& text, const ReadOptions& opt = {}) {
+  try {
+    (void)ParseRecording(text, "rec.csv", opt);
+  } catch (const RecordingError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Recording, ReadsColumnsByNameKeepsUnknownColumnsAndMetadata) {
+  const std::string text =
+      "# sensor: demo-3beam\n# rate_hz: 200\n"
+      "t,Fx,Fy,Fz,Mx,My,Mz,b0,b1,extra,temp_C\r\n"
+      "0.0,1,2,3,0.1,0.2,0.3,0.0003572,-4.639e-4,7,23.45\n"
+      "0.005, -1 ,+2,3e0,0.1,0.2,0.3,1,2,8,23.5\n\n";
+  ReadOptions opt;
+  opt.require_wrench = true;
+  opt.require_bridges = true;
+  const Recording r = ParseRecording(text, "rec.csv", opt);
+  EXPECT_EQ(r.rows(), 2u);
+  EXPECT_EQ(r.BridgeCount(), 2u);
+  EXPECT_EQ(r.Meta("sensor"), "demo-3beam");
+  EXPECT_EQ(r.Meta("rate_hz"), "200");
+  EXPECT_DOUBLE_EQ(r.Column("b0")[0], 0.0003572);
+  EXPECT_DOUBLE_EQ(r.Column("b1")[0], -4.639e-4);
+  EXPECT_DOUBLE_EQ(r.Column("Fx")[1], -1.0);
+  EXPECT_DOUBLE_EQ(r.Column("Fy")[1], 2.0);
+  EXPECT_DOUBLE_EQ(r.Column("extra")[1], 8.0);
+  EXPECT_DOUBLE_EQ(r.Column("temp_C")[1], 23.5);
+  EXPECT_EQ(r.data_lines[1], 5u);
+  EXPECT_THROW((void)r.Column("nope"), RecordingError);
+}
+
+TEST(Recording, RefusalsNameLineAndColumn) {
+  EXPECT_EQ(ErrorOf("t,b0\n0,1\n1,abc\n"), "rec.csv:3:3: column 'b0': 'abc' is not a number");
+  EXPECT_EQ(ErrorOf("t,b0\n0,1\n1,nan\n"), "rec.csv:3:3: column 'b0': NaN/infinity is not allowed");
+  EXPECT_EQ(ErrorOf("t,b0\n0,inf\n"), "rec.csv:2:3: column 'b0': NaN/infinity is not allowed");
+  EXPECT_EQ(ErrorOf("t,b0\n0,1\n0,2\n"), "rec.csv:3:1: t is not strictly increasing");
+  EXPECT_EQ(ErrorOf("b0,t\n1,0.5\n2,0.4\n"), "rec.csv:3:3: t is not strictly increasing");
+  EXPECT_EQ(ErrorOf("t,b0\n0,1,2\n"), "rec.csv:2:5: more fields than the header's 2 columns");
+  EXPECT_EQ(ErrorOf("t,b0\n0\n"), "rec.csv:2:2: row has 1 fields, header has 2");
+  EXPECT_EQ(ErrorOf("t,b0\n0,\n"), "rec.csv:2:3: column 'b0': '' is not a number");
+  EXPECT_EQ(ErrorOf("t,,b0\n"), "rec.csv:1:3: empty column name in header");
+  EXPECT_EQ(ErrorOf("t,b0,t\n"), "rec.csv:1:6: duplicate column 't'");
+  EXPECT_EQ(ErrorOf("# only comments\n"), "rec.csv: no header line");
+  ReadOptions opt;
+  opt.require_wrench = true;
+  EXPECT_EQ(ErrorOf("t,Fx,Fy,Fz,Mx,My\n", opt), "rec.csv:1:17: header lacks required column 'Mz'");
+  opt = {};
+  opt.require_bridges = true;
+  EXPECT_EQ(ErrorOf("t,Fx\n", opt), "rec.csv:1:5: header lacks required column 'b0'");
+}
+
+TEST(Recording, WriteThenReadRoundTripsAndAlignmentIsChecked) {
+  const auto dir = std::filesystem::temp_directory_path() / "ftstack_rec_test";
+  std::filesystem::create_directories(dir);
+  Recording r;
+  r.metadata = {"sensor: test"};
+  r.names = {"t", "b0", "b1"};
+  r.columns = {{0.0, 0.001, 0.002}, {1.234567891e-4, -2.5, 3.0}, {0.5, 0.25, -0.125}};
+  const std::string path = (dir / "a.csv").string();
+  WriteRecording(path, r);
+  const Recording back = ReadRecording(path);
+  EXPECT_EQ(back.Meta("sensor"), "test");
+  ASSERT_EQ(back.rows(), 3u);
+  for (std::size_t c = 0; c < 3; ++c) {
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_NEAR(back.columns[c][i], r.columns[c][i], 1e-9 * std::fabs(r.columns[c][i]));
+    }
+  }
+  CheckAligned(back, r);  // same t
+  Recording shifted = back;
+  shifted.path = "sim.csv";
+  shifted.Column("t")[2] += 2e-6;
+  try {
+    CheckAligned(shifted, r);
+    FAIL() << "misaligned t accepted";
+  } catch (const RecordingError& e) {
+    EXPECT_NE(std::string(e.what()).find("sim.csv:"), std::string::npos) << e.what();
+  }
+  Recording shorter = back;
+  shorter.path = "sim.csv";
+  for (auto& col : shorter.columns) col.pop_back();
+  EXPECT_THROW(CheckAligned(shorter, r), RecordingError);
+  EXPECT_THROW((void)ReadRecording((dir / "missing.csv").string()), RecordingError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Recording, StreamingWriterRefusesWrongWidth) {
+  const auto path = (std::filesystem::temp_directory_path() / "ftstack_w.csv").string();
+  RecordingWriter w(path, {}, {"t", "b0"});
+  w.WriteRow({0.0, 1.0});
+  EXPECT_THROW(w.WriteRow({1.0}), RecordingError);
+  w.Flush();
+  const Recording back = ReadRecording(path);
+  EXPECT_EQ(back.rows(), 1u);
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace ftstack::sim
