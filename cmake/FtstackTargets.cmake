@@ -20,7 +20,9 @@ if(FTSTACK_WERROR)
   target_compile_options(ftstack_warnings INTERFACE -Werror)
 endif()
 if(FTSTACK_SANITIZE)
-  add_compile_options(-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
+  # vptr checks need RTTI, which embedded code (-fno-rtti) does not have.
+  add_compile_options(-fsanitize=address,undefined -fno-sanitize=vptr -fno-sanitize-recover=all
+                      -fno-omit-frame-pointer)
   add_link_options(-fsanitize=address,undefined)
 endif()
 
