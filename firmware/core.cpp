@@ -131,8 +131,12 @@ void WrenchCore::Process(const hal::AdcSample& in, bool simulated, CoreOutput& o
   }
   if (filter_fill_ < filter_length_) ++filter_fill_;
   filter_pos_ = static_cast<std::uint16_t>((filter_pos_ + 1) % filter_length_);
-  for (std::size_t r = 0; r < kAxes; ++r) {
-    out.wrench[r] = SatToI32(RoundDiv(filter_sum_[r], filter_fill_), &out.arithmetic_saturated);
+  if (filter_fill_ == 1) {
+    out.wrench = y;  // no averaging: skip the divisions
+  } else {
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      out.wrench[r] = SatToI32(RoundDiv(filter_sum_[r], filter_fill_), &out.arithmetic_saturated);
+    }
   }
   last_valid_ = out.wrench;
   out.updated = true;
