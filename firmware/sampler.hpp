@@ -35,6 +35,8 @@ class Sampler {
   [[nodiscard]] hal::Status Step(PublishedSample& out);
 
   [[nodiscard]] const hal::AdcInfo& info() const { return info_; }
+  /// The core's output for the last successful Step (unfiltered wrench, update flag).
+  [[nodiscard]] const CoreOutput& core_output() const { return core_out_; }
   [[nodiscard]] std::uint32_t read_errors() const { return read_errors_; }
   [[nodiscard]] std::uint32_t timeouts() const { return timeouts_; }
 

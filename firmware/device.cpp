@@ -1,0 +1,124 @@
+#include "firmware/device.hpp"
+
+#include <ctime>
+
+namespace ftstack::fw {
+
+std::uint64_t MonotonicUs() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::uint64_t>(ts.tv_sec) * 1000000u +
+         static_cast<std::uint64_t>(ts.tv_nsec) / 1000u;
+}
+
+DeviceStatus Device::Start(const DeviceConfig& config) {
+  config_ = config;
+  if (config.clock_us != nullptr) clock_ = config.clock_us;
+  if (config.initial_slot >= kCalSlots || !config.slots[config.initial_slot].present) {
+    return DeviceStatus::kNoCalibration;
+  }
+  bool any_rated = false;
+  for (const std::int32_t r : config.rated_lsb) any_rated = any_rated || r != 0;
+  if (any_rated && !overload_.Configure(config.rated_lsb)) return DeviceStatus::kBadRated;
+  if (sampler_.Start(config.adc) != hal::Status::kOk) return DeviceStatus::kAdcConfig;
+  const std::uint32_t rate = sampler_.info().rate_hz > 0 ? sampler_.info().rate_hz : 1;
+  sample_period_us_ = 1000000u / rate > 0 ? 1000000u / rate : 1u;
+  tare_samples_ = config.tare_samples;
+  if (tare_samples_ == 0) {
+    const std::uint32_t n = rate / 10;
+    tare_samples_ =
+        static_cast<std::uint16_t>(n < 1 ? 1 : (n > kMaxTareSamples ? kMaxTareSamples : n));
+  }
+  core_.SetCalibration(config.slots[config.initial_slot].fixed);
+  active_ = DeviceSettings{};
+  active_.cal_slot = config.initial_slot;
+  active_.filter_length = core_.filter_length();
+  initial_settings_ = active_;
+  settings_.Write(active_);
+  settings_seen_ = settings_.writes();
+  last_ = DeviceSample{};
+  last_.cal_slot = active_.cal_slot;
+  last_.cal_crc = config.slots[active_.cal_slot].crc32;
+  last_.publish_period_us = sample_period_us_;
+  last_.publish_time_us = clock_();
+  last_.sample.status = kStatusStale;  // nothing sampled yet
+  published_.Write(last_);
+  return DeviceStatus::kOk;
+}
+
+void Device::ApplySettings() {
+  DeviceSettings s{};
+  if (!settings_.Read(&s)) return;  // retried on the next sample
+  settings_seen_ = settings_.writes();
+  if (s.cal_slot != active_.cal_slot && s.cal_slot < kCalSlots &&
+      config_.slots[s.cal_slot].present) {
+    core_.SetCalibration(config_.slots[s.cal_slot].fixed);  // also clears tare and filter
+    active_.cal_slot = s.cal_slot;
+  }
+  if (s.filter_length != active_.filter_length) {
+    if (core_.SetFilterLength(s.filter_length)) active_.filter_length = s.filter_length;
+  }
+  if (s.decimation >= 1 && s.decimation <= kMaxDecimation) active_.decimation = s.decimation;
+  active_.transform = s.transform;
+  if (s.tare_generation != active_.tare_generation) {
+    active_.tare_generation = s.tare_generation;
+    if (s.tare_kind == 1) {
+      (void)core_.RequestTare(tare_samples_);  // tare_samples_ is within range by construction
+    } else if (s.tare_kind == 2) {
+      core_.ClearTare();
+    }
+  }
+  if (s.clear_generation != active_.clear_generation) {
+    active_.clear_generation = s.clear_generation;
+    overload_.Clear();
+  }
+}
+
+hal::Status Device::Step(bool* published) {
+  *published = false;
+  if (settings_.writes() != settings_seen_) ApplySettings();
+  PublishedSample p{};
+  const hal::Status s = sampler_.Step(p);
+  if (s == hal::Status::kEndOfData) return s;
+  if (s != hal::Status::kOk) {
+    // Publish the fault bits at once; the wrench and sequence stay those of the last sample.
+    last_.sample.status = p.status;
+    published_.Write(last_);
+    *published = true;
+    return s;
+  }
+  ++samples_;
+  const CoreOutput& core = sampler_.core_output();
+  if (core.updated && overload_.configured()) {
+    if (overload_.Update(core.unfiltered)) sticky_status_ |= kStatusOverload;
+  }
+  if (++since_publish_ < active_.decimation) return s;
+  since_publish_ = 0;
+
+  DeviceSample d{};
+  d.sample = p;
+  d.sample.sequence = ++publish_sequence_;
+  std::uint16_t status = static_cast<std::uint16_t>(p.status | sticky_status_);
+  sticky_status_ = 0;
+  if ((status & kStatusCalInvalid) == 0) {
+    bool sat = false;
+    ApplyToolTransform(active_.transform, p.wrench, &d.sample.wrench, &sat);
+  }
+  if (p.has_temperature && (p.temperature_mdegc < config_.temp_min_mdegc ||
+                            p.temperature_mdegc > config_.temp_max_mdegc)) {
+    status |= kStatusTempRange;
+  }
+  d.sample.status = status;
+  d.peaks_lsb = overload_.peaks();
+  d.overload_events = overload_.events();
+  d.cal_slot = active_.cal_slot;
+  d.cal_crc = config_.slots[active_.cal_slot].crc32;
+  d.publish_period_us = sample_period_us_ * active_.decimation;
+  d.publish_time_us = clock_();
+  last_ = d;
+  published_.Write(d);
+  *published = true;
+  return s;
+}
+
+}  // namespace ftstack::fw

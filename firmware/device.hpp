@@ -1,0 +1,123 @@
+// The sensor device: sampling step (ADC → core → transform, overload) publishing the latest sample.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+
+#include "firmware/core.hpp"
+#include "firmware/overload.hpp"
+#include "firmware/sampler.hpp"
+#include "firmware/seqlock.hpp"
+#include "firmware/tool_transform.hpp"
+
+namespace ftstack::fw {
+
+/// Number of calibration slots (Modbus holding register 3).
+inline constexpr std::size_t kCalSlots = 2;
+
+/// What the Modbus side and the logger read: one published sample plus the device's counters, all
+/// from the same instant.
+struct DeviceSample {
+  PublishedSample sample{};  ///< sequence +1 per published sample; wrench in the tool frame
+  WrenchLsb peaks_lsb{};     ///< peak |component| since the last clear, sensor frame, LSB
+  std::uint32_t overload_events = 0;
+  std::uint32_t cal_crc = 0;            ///< CRC-32 of the active calibration slot
+  std::uint8_t cal_slot = 0;            ///< active calibration slot
+  std::uint64_t publish_time_us = 0;    ///< device clock at the last successful publication
+  std::uint32_t publish_period_us = 0;  ///< expected time between publications
+};
+
+/// One calibration slot as the device holds it.
+struct CalSlot {
+  FixedCalibration fixed{};
+  std::uint32_t crc32 = 0;  ///< CRC-32 reported in input registers 72–73
+  bool present = false;
+};
+
+/// Settings and commands written by the Modbus side, read by the sampling thread.
+struct DeviceSettings {
+  std::uint16_t filter_length = 1;  ///< 1 … kMaxFilterLength
+  std::uint16_t decimation = 1;     ///< publish every N-th sample, 1 … kMaxDecimation
+  std::uint8_t cal_slot = 0;
+  FixedToolTransform transform{};
+  std::uint32_t tare_generation = 0;   ///< +1 per tare / clear-tare command
+  std::uint8_t tare_kind = 0;          ///< 1 = tare now, 2 = clear tare (the latest wins)
+  std::uint32_t clear_generation = 0;  ///< +1 per "clear peaks and overload counter"
+};
+
+inline constexpr std::uint16_t kMaxDecimation = 1000;
+
+/// Static configuration of a Device.
+struct DeviceConfig {
+  hal::AdcConfig adc{};
+  std::array<CalSlot, kCalSlots> slots{};
+  std::uint8_t initial_slot = 0;
+  WrenchLsb rated_lsb{};            ///< rated range per axis (overload rule); zeros disable it
+  std::int32_t temp_min_mdegc = 0;  ///< compensated temperature range (status bit 6)
+  std::int32_t temp_max_mdegc = 50000;
+  std::uint16_t tare_samples = 0;         ///< samples averaged by a tare; 0: rate/10 (0.1 s)
+  std::uint64_t (*clock_us)() = nullptr;  ///< monotonic µs; nullptr: CLOCK_MONOTONIC
+};
+
+/// Why Device::Start failed.
+enum class DeviceStatus : std::uint8_t { kOk = 0, kAdcConfig, kNoCalibration, kBadRated };
+
+/// CLOCK_MONOTONIC in µs.
+[[nodiscard]] std::uint64_t MonotonicUs();
+
+/// The firmware main loop's data path. Step() runs in the sampling thread only; ReadLatest,
+/// settings and commands may be used from any thread (settings writes from one thread at a time).
+class Device {
+ public:
+  Device(hal::Adc& adc, WrenchCore& core) : adc_(adc), core_(core), sampler_(adc, core) {}
+
+  [[nodiscard]] DeviceStatus Start(const DeviceConfig& config);
+
+  /// Waits for, processes and (every decimation-th sample) publishes one sample. *published says
+  /// whether this call published. kEndOfData when a replay ended; kTimeout / kReadError publish
+  /// the fault bits with the last wrench (and do not refresh the publication time).
+  [[nodiscard]] hal::Status Step(bool* published);
+
+  /// The latest published sample (consistent copy). False only if the writer starved the reader.
+  [[nodiscard]] bool ReadLatest(DeviceSample* out) const { return published_.Read(out); }
+  /// The last sample Step published (sampling thread only).
+  [[nodiscard]] const DeviceSample& last_published() const { return last_; }
+
+  /// Hands new settings to the sampling thread (applied before its next sample).
+  void WriteSettings(const DeviceSettings& s) { settings_.Write(s); }
+  [[nodiscard]] const DeviceSettings& initial_settings() const { return initial_settings_; }
+
+  [[nodiscard]] bool slot_present(std::size_t slot) const {
+    return slot < kCalSlots && config_.slots[slot].present;
+  }
+  [[nodiscard]] const hal::AdcInfo& adc_info() const { return sampler_.info(); }
+  [[nodiscard]] std::uint64_t NowUs() const { return clock_(); }
+  [[nodiscard]] std::uint32_t sample_period_us() const { return sample_period_us_; }
+  /// Samples processed by Step (successful reads).
+  [[nodiscard]] std::uint64_t samples() const { return samples_; }
+
+ private:
+  void ApplySettings();
+
+  hal::Adc& adc_;
+  WrenchCore& core_;
+  Sampler sampler_;
+  DeviceConfig config_{};
+  std::uint64_t (*clock_)() = &MonotonicUs;
+  OverloadMonitor overload_{};
+  Seqlock<DeviceSample> published_{};
+  Seqlock<DeviceSettings> settings_{};
+  std::uint32_t settings_seen_ = 0;
+  DeviceSettings active_{};
+  DeviceSettings initial_settings_{};
+  DeviceSample last_{};
+  std::uint32_t sample_period_us_ = 1000;
+  std::uint16_t tare_samples_ = 1;
+  std::uint16_t since_publish_ = 0;
+  std::uint16_t sticky_status_ = 0;
+  std::uint32_t publish_sequence_ = 0;
+  std::uint64_t samples_ = 0;
+};
+
+}  // namespace ftstack::fw

@@ -1,0 +1,219 @@
+#include "firmware/register_map.hpp"
+
+#include <bit>
+#include <limits>
+
+#include "firmware/fixed_point.hpp"
+
+namespace ftstack::fw {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+[[nodiscard]] bool HoldingMapped(std::uint32_t a) {
+  return a <= kHoldUnlock || (a >= kHoldTransform && a < kHoldTransform + 12u);
+}
+
+[[nodiscard]] float LsbToSi(std::int32_t v, std::size_t axis) {
+  return static_cast<float>(static_cast<double>(v) * AxisLsb(axis));
+}
+
+}  // namespace
+
+void PackU32(std::uint32_t v, std::uint16_t* regs) {
+  regs[0] = static_cast<std::uint16_t>(v >> 16);
+  regs[1] = static_cast<std::uint16_t>(v & 0xFFFFu);
+}
+void PackI32(std::int32_t v, std::uint16_t* regs) { PackU32(static_cast<std::uint32_t>(v), regs); }
+void PackFloat32(float v, std::uint16_t* regs) { PackU32(std::bit_cast<std::uint32_t>(v), regs); }
+std::uint32_t UnpackU32(const std::uint16_t* regs) {
+  return (static_cast<std::uint32_t>(regs[0]) << 16) | regs[1];
+}
+std::int32_t UnpackI32(const std::uint16_t* regs) {
+  return static_cast<std::int32_t>(UnpackU32(regs));
+}
+float UnpackFloat32(const std::uint16_t* regs) { return std::bit_cast<float>(UnpackU32(regs)); }
+
+void BuildInputRegisters(const DeviceSample& d, const hal::AdcInfo& adc, std::uint64_t now_us,
+                         std::array<std::uint16_t, kInputRegisterCount>* regs) {
+  auto& r = *regs;
+  r = {};
+  const PublishedSample& s = d.sample;
+  std::uint16_t status = s.status;
+  if (now_us > d.publish_time_us &&
+      now_us - d.publish_time_us > 2ull * static_cast<std::uint64_t>(d.publish_period_us)) {
+    status |= kStatusStale;
+  }
+  r[kInMapVersion] = kMapVersion;
+  r[kInStatus] = status;
+  PackU32(s.sequence, &r[kInSequence]);
+  PackU32(s.timestamp_us, &r[kInTimestampUs]);
+  const bool cal_ok = (status & kStatusCalInvalid) == 0;
+  for (std::size_t i = 0; i < kAxes; ++i) {
+    PackFloat32(cal_ok ? LsbToSi(s.wrench[i], i) : kNaN, &r[kInWrenchFloat + 2 * i]);
+    // Forces are already mN; moments go from 10 µN·m to mN·m, rounded to nearest.
+    const std::int32_t v =
+        i < 3 ? s.wrench[i]
+              : static_cast<std::int32_t>(RoundDiv(s.wrench[i], kMomentLsbPerMilliNm));
+    PackI32(cal_ok ? v : 0, &r[kInWrenchInt + 2 * i]);
+    PackFloat32(LsbToSi(d.peaks_lsb[i], i), &r[kInPeaks + 2 * i]);
+  }
+  PackFloat32(s.has_temperature ? static_cast<float>(s.temperature_mdegc * 1e-3) : kNaN,
+              &r[kInTemperature]);
+  // mV/V per count of this ADC; bridges beyond channel_count read 0 counts and NaN mV/V.
+  const double mvv_per_count =
+      adc.max_counts > 0 ? static_cast<double>(adc.full_scale_nvv) * 1e-6 / adc.max_counts : 0.0;
+  for (std::size_t c = 0; c < kMapBridges; ++c) {
+    const bool present = c < s.channel_count;
+    PackI32(present ? s.raw_counts[c] : 0, &r[kInRawCounts + 2 * c]);
+    PackFloat32(present ? static_cast<float>(s.raw_counts[c] * mvv_per_count) : kNaN,
+                &r[kInBridgeMvv + 2 * c]);
+  }
+  r[kInBridgeCount] = s.channel_count;
+  r[kInCalSlot] = d.cal_slot;
+  PackU32(d.overload_events, &r[kInOverloadEvents]);
+  PackU32(d.cal_crc, &r[kInCalCrc]);
+}
+
+RegisterMap::RegisterMap(Device& device) : device_(device), settings_(device.initial_settings()) {}
+
+bool RegisterMap::UnlockedLocked(std::uint64_t now_us) const {
+  return unlock_armed_ && now_us < unlock_until_us_;
+}
+
+bool RegisterMap::Unlocked() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return UnlockedLocked(device_.NowUs());
+}
+
+ModbusException RegisterMap::ReadInput(std::uint16_t addr, std::uint16_t count,
+                                       std::uint16_t* out) {
+  if (count == 0 || static_cast<std::uint32_t>(addr) + count > kInputRegisterCount) {
+    return ModbusException::kIllegalDataAddress;
+  }
+  DeviceSample d{};
+  if (!device_.ReadLatest(&d)) return ModbusException::kDeviceFailure;
+  std::array<std::uint16_t, kInputRegisterCount> image{};
+  BuildInputRegisters(d, device_.adc_info(), device_.NowUs(), &image);
+  for (std::uint16_t i = 0; i < count; ++i) out[i] = image[addr + i];
+  return ModbusException::kNone;
+}
+
+ModbusException RegisterMap::ReadHolding(std::uint16_t addr, std::uint16_t count,
+                                         std::uint16_t* out) {
+  if (count == 0) return ModbusException::kIllegalDataAddress;
+  for (std::uint32_t a = addr; a < static_cast<std::uint32_t>(addr) + count; ++a) {
+    if (!HoldingMapped(a)) return ModbusException::kIllegalDataAddress;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  const bool unlocked = UnlockedLocked(device_.NowUs());
+  for (std::uint16_t i = 0; i < count; ++i) {
+    const std::uint32_t a = static_cast<std::uint32_t>(addr) + i;
+    std::uint16_t v = 0;
+    switch (a) {
+      case kHoldCommand:
+        v = 0;
+        break;
+      case kHoldFilterLength:
+        v = settings_.filter_length;
+        break;
+      case kHoldDecimation:
+        v = settings_.decimation;
+        break;
+      case kHoldCalSlot:
+        v = settings_.cal_slot;
+        break;
+      case kHoldUnlock:
+        v = unlocked ? 1 : 0;
+        break;
+      default:
+        v = transform_regs_[a - kHoldTransform];
+        break;
+    }
+    out[i] = v;
+  }
+  return ModbusException::kNone;
+}
+
+ModbusException RegisterMap::WriteHolding(std::uint16_t addr, const std::uint16_t* values,
+                                          std::uint16_t count) {
+  const std::uint32_t end = static_cast<std::uint32_t>(addr) + count;
+  if (count == 0) return ModbusException::kIllegalDataAddress;
+  for (std::uint32_t a = addr; a < end; ++a) {
+    if (!HoldingMapped(a)) return ModbusException::kIllegalDataAddress;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  const std::uint64_t now_us = device_.NowUs();
+  const bool unlocked = UnlockedLocked(now_us);
+  DeviceSettings next = settings_;
+  std::array<std::uint16_t, 12> next_transform = transform_regs_;
+  bool transform_written = false;
+  bool unlock_written = false;
+  for (std::uint32_t a = addr; a < end; ++a) {
+    const std::uint16_t v = values[a - addr];
+    switch (a) {
+      case kHoldCommand:
+        if (v == kCmdTare || v == kCmdClearTare) {
+          ++next.tare_generation;
+          next.tare_kind = static_cast<std::uint8_t>(v);
+        } else if (v == kCmdClearPeaks) {
+          ++next.clear_generation;
+        } else {
+          return ModbusException::kIllegalDataValue;
+        }
+        break;
+      case kHoldFilterLength:
+        if (v < 1 || v > kMaxFilterLength) return ModbusException::kIllegalDataValue;
+        next.filter_length = v;
+        break;
+      case kHoldDecimation:
+        if (v < 1 || v > kMaxDecimation) return ModbusException::kIllegalDataValue;
+        next.decimation = v;
+        break;
+      case kHoldCalSlot:
+        if (!unlocked || v >= kCalSlots || !device_.slot_present(v)) {
+          return ModbusException::kIllegalDataValue;
+        }
+        next.cal_slot = static_cast<std::uint8_t>(v);
+        break;
+      case kHoldUnlock:
+        if (v != kUnlockKey) return ModbusException::kIllegalDataValue;
+        unlock_written = true;
+        break;
+      default:  // 10 … 21
+        if (!unlocked) return ModbusException::kIllegalDataValue;
+        next_transform[a - kHoldTransform] = v;
+        transform_written = true;
+        break;
+    }
+  }
+  if (transform_written) {
+    // A float is two registers: a write must cover whole floats.
+    constexpr std::uint32_t kFirst = kHoldTransform;
+    constexpr std::uint32_t kEnd = kFirst + 12u;
+    const std::uint32_t first = addr > kFirst ? addr : kFirst;
+    const std::uint32_t last = end < kEnd ? end : kEnd;
+    if ((first - kFirst) % 2 != 0 || (last - kFirst) % 2 != 0) {
+      return ModbusException::kIllegalDataValue;
+    }
+    ToolTransformParams p{};
+    for (std::size_t i = 0; i < 3; ++i) {
+      p.d_m[i] = UnpackFloat32(&next_transform[2 * i]);
+      p.r_deg[i] = UnpackFloat32(&next_transform[6 + 2 * i]);
+    }
+    if (MakeToolTransform(p, &next.transform) != TransformStatus::kOk) {
+      return ModbusException::kIllegalDataValue;
+    }
+  }
+  // Everything validated: commit.
+  settings_ = next;
+  transform_regs_ = next_transform;
+  if (unlock_written) {
+    unlock_armed_ = true;
+    unlock_until_us_ = now_us + kUnlockDurationUs;
+  }
+  device_.WriteSettings(settings_);
+  return ModbusException::kNone;
+}
+
+}  // namespace ftstack::fw

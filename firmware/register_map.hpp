@@ -1,0 +1,108 @@
+// The Modbus register map, version 1 (shared spec modbus-map.md): input image, holding registers.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <mutex>
+
+#include "firmware/device.hpp"
+
+namespace ftstack::fw {
+
+inline constexpr std::uint16_t kMapVersion = 1;
+inline constexpr std::uint16_t kInputRegisterCount = 74;   ///< input registers 0 … 73
+inline constexpr std::uint16_t kHoldingRegisterSpan = 22;  ///< holding 0 … 4 and 10 … 21
+
+/// Input register addresses (0-based protocol addresses).
+enum InputRegister : std::uint16_t {
+  kInMapVersion = 0,
+  kInStatus = 1,
+  kInSequence = 2,      ///< uint32
+  kInTimestampUs = 4,   ///< uint32
+  kInWrenchFloat = 6,   ///< float32 × 6, N and N·m
+  kInWrenchInt = 18,    ///< int32 × 6, mN and mN·m
+  kInTemperature = 30,  ///< float32 °C, NaN where none
+  kInRawCounts = 32,    ///< int32 × 6
+  kInBridgeMvv = 44,    ///< float32 × 6
+  kInBridgeCount = 56,
+  kInCalSlot = 57,
+  kInOverloadEvents = 58,  ///< uint32
+  kInPeaks = 60,           ///< float32 × 6, N and N·m
+  kInCalCrc = 72,          ///< uint32
+};
+
+/// Holding register addresses.
+enum HoldingRegister : std::uint16_t {
+  kHoldCommand = 0,
+  kHoldFilterLength = 1,
+  kHoldDecimation = 2,
+  kHoldCalSlot = 3,  ///< protected
+  kHoldUnlock = 4,
+  kHoldTransform = 10,  ///< float32 × 6 (Dx Dy Dz m, Rx Ry Rz deg), protected, 10 … 21
+};
+
+/// Values of the command register.
+enum Command : std::uint16_t { kCmdTare = 1, kCmdClearTare = 2, kCmdClearPeaks = 3 };
+
+inline constexpr std::uint16_t kUnlockKey = 0xA5C3;
+inline constexpr std::uint64_t kUnlockDurationUs = 10'000'000;
+/// Number of registers of the bridge blocks (raw counts, mV/V): 6 bridges.
+inline constexpr std::size_t kMapBridges = 6;
+
+/// Modbus exception codes the map produces (0: none).
+enum class ModbusException : std::uint8_t {
+  kNone = 0,
+  kIllegalFunction = 1,
+  kIllegalDataAddress = 2,
+  kIllegalDataValue = 3,
+  kDeviceFailure = 4,  ///< the latest sample could not be copied (writer starved the reader)
+};
+
+/// 32-bit values over two registers, high word first (the map's "ABCD" order). Written here
+/// rather than with modbus_set_float_* (which does not round-trip in libmodbus 3.1.6).
+void PackU32(std::uint32_t v, std::uint16_t* regs);
+void PackI32(std::int32_t v, std::uint16_t* regs);
+void PackFloat32(float v, std::uint16_t* regs);
+[[nodiscard]] std::uint32_t UnpackU32(const std::uint16_t* regs);
+[[nodiscard]] std::int32_t UnpackI32(const std::uint16_t* regs);
+[[nodiscard]] float UnpackFloat32(const std::uint16_t* regs);
+
+/// Fills the whole input image from one published sample. `now_us` (device clock) decides the
+/// stale bit: set when the sample is older than two publication periods.
+void BuildInputRegisters(const DeviceSample& d, const hal::AdcInfo& adc, std::uint64_t now_us,
+                         std::array<std::uint16_t, kInputRegisterCount>* regs);
+
+/// The slave's view of one Device: reads build replies from one published sample; writes are
+/// validated completely before anything changes. Thread-safe (TCP and RTU servers share one map).
+class RegisterMap {
+ public:
+  explicit RegisterMap(Device& device);
+
+  /// Function 04. 02 when [addr, addr+count) leaves 0 … 73.
+  [[nodiscard]] ModbusException ReadInput(std::uint16_t addr, std::uint16_t count,
+                                          std::uint16_t* out);
+  /// Function 03. 02 when any address is outside 0 … 4 and 10 … 21.
+  [[nodiscard]] ModbusException ReadHolding(std::uint16_t addr, std::uint16_t count,
+                                            std::uint16_t* out);
+  /// Functions 06 and 16. 02 for an address outside the map; 03 for a value out of range, an
+  /// unknown command, a protected register (3, 10–21) while locked, or a write covering only one
+  /// half of a tool-transform float. On any exception nothing changes.
+  [[nodiscard]] ModbusException WriteHolding(std::uint16_t addr, const std::uint16_t* values,
+                                             std::uint16_t count);
+
+  /// True while protected writes are allowed (within 10 s of writing kUnlockKey).
+  [[nodiscard]] bool Unlocked();
+  [[nodiscard]] Device& device() { return device_; }
+
+ private:
+  [[nodiscard]] bool UnlockedLocked(std::uint64_t now_us) const;
+
+  std::mutex mutex_;
+  Device& device_;
+  DeviceSettings settings_{};
+  std::array<std::uint16_t, 12> transform_regs_{};
+  std::uint64_t unlock_until_us_ = 0;
+  bool unlock_armed_ = false;
+};
+
+}  // namespace ftstack::fw

@@ -1,0 +1,86 @@
+#include "firmware/tool_transform.hpp"
+
+#include <cmath>
+
+#include "firmware/fixed_point.hpp"
+
+namespace ftstack::fw {
+
+TransformStatus MakeToolTransform(const ToolTransformParams& params, FixedToolTransform* out) {
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (!std::isfinite(params.d_m[i]) || !std::isfinite(params.r_deg[i])) {
+      return TransformStatus::kNotFinite;
+    }
+    if (std::fabs(params.d_m[i]) > kMaxToolOffsetM ||
+        std::fabs(params.r_deg[i]) > kMaxToolAngleDeg) {
+      return TransformStatus::kOutOfRange;
+    }
+  }
+  FixedToolTransform t{};
+  bool zero = true;
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (params.d_m[i] != 0.0f || params.r_deg[i] != 0.0f) zero = false;
+  }
+  if (zero) {
+    *out = t;
+    return TransformStatus::kOk;
+  }
+  constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+  const double cx = std::cos(params.r_deg[0] * kDegToRad),
+               sx = std::sin(params.r_deg[0] * kDegToRad);
+  const double cy = std::cos(params.r_deg[1] * kDegToRad),
+               sy = std::sin(params.r_deg[1] * kDegToRad);
+  const double cz = std::cos(params.r_deg[2] * kDegToRad),
+               sz = std::sin(params.r_deg[2] * kDegToRad);
+  // R = Rz·Ry·Rx.
+  const double r[3][3] = {{cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx},
+                          {sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx},
+                          {-sy, cy * sx, cy * cx}};
+  const double d[3] = {params.d_m[0], params.d_m[1], params.d_m[2]};
+  // Skew matrix of D: (D × F)_i = Σ_j dx[i][j] F_j.
+  const double dx[3][3] = {{0, -d[2], d[1]}, {d[2], 0, -d[0]}, {-d[1], d[0], 0}};
+  // Moments in 10 µN·m per (m · mN): 1 m · 1 mN = 1e-3 N·m = 100 LSB.
+  const double lever_lsb = 1e-3 / kMomentLsbNm;
+  double m[kAxes][kAxes] = {};
+  for (std::size_t i = 0; i < 3; ++i) {
+    for (std::size_t j = 0; j < 3; ++j) {
+      m[i][j] = r[j][i];          // Rᵀ on forces
+      m[i + 3][j + 3] = r[j][i];  // Rᵀ on moments
+      double rdx = 0.0;           // (Rᵀ·[D]×)_ij
+      for (std::size_t k = 0; k < 3; ++k) rdx += r[k][i] * dx[k][j];
+      m[i + 3][j] = -lever_lsb * rdx;
+    }
+  }
+  for (std::size_t row = 0; row < kAxes; ++row) {
+    double sum_abs = 0.0;
+    for (std::size_t j = 0; j < kAxes; ++j) sum_abs += std::fabs(m[row][j]);
+    // |w_j| ≤ 2^31: the worst partial sum is (sum_abs + 6 · ½) · 2^s · 2^31 (coefficients
+    // rounded by at most half a unit each); keep it ≤ 2^62 so RoundShift cannot overflow.
+    int s = 62 - 31 - static_cast<int>(std::ceil(std::log2(sum_abs + 6.0)));
+    if (s > 62) s = 62;
+    if (s < 0) s = 0;
+    const double scale = std::ldexp(1.0, s);
+    for (std::size_t j = 0; j < kAxes; ++j) t.coef[row][j] = std::llround(m[row][j] * scale);
+    t.shift[row] = static_cast<std::uint8_t>(s);
+  }
+  t.identity = false;
+  *out = t;
+  return TransformStatus::kOk;
+}
+
+void ApplyToolTransform(const FixedToolTransform& t, const WrenchLsb& in, WrenchLsb* out,
+                        bool* saturated) {
+  if (t.identity) {
+    *out = in;
+    return;
+  }
+  WrenchLsb y{};
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    std::int64_t acc = 0;
+    for (std::size_t j = 0; j < kAxes; ++j) acc += t.coef[r][j] * in[j];
+    y[r] = SatToI32(RoundShift(acc, t.shift[r]), saturated);
+  }
+  *out = y;
+}
+
+}  // namespace ftstack::fw

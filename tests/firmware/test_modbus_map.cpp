@@ -1,0 +1,576 @@
+// Register map, overload rule, tool transform and seqlock, against double-precision references.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include "firmware/register_map.hpp"
+#include "tests/firmware/fake_adc.hpp"
+
+namespace ftstack::fw {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Packing: published IEEE-754 and two's-complement bit patterns, high word first.
+
+TEST(ModbusPacking, Float32HighWordFirstMatchesIeeeBitPattern) {
+  std::uint16_t r[2];
+  PackFloat32(3.5f, r);  // 3.5 = 0x40600000
+  EXPECT_EQ(r[0], 0x4060);
+  EXPECT_EQ(r[1], 0x0000);
+  PackFloat32(-0.1f, r);  // -0.1f = 0xBDCCCCCD
+  EXPECT_EQ(r[0], 0xBDCC);
+  EXPECT_EQ(r[1], 0xCCCD);
+  PackI32(-2, r);
+  EXPECT_EQ(r[0], 0xFFFF);
+  EXPECT_EQ(r[1], 0xFFFE);
+  PackU32(0x12345678u, r);
+  EXPECT_EQ(r[0], 0x1234);
+  EXPECT_EQ(r[1], 0x5678);
+}
+
+TEST(ModbusPacking, RoundTripsEveryBitPattern) {
+  std::mt19937 rng(7);
+  for (int i = 0; i < 100000; ++i) {
+    const std::uint32_t u = rng();
+    std::uint16_t r[2];
+    PackU32(u, r);
+    EXPECT_EQ(UnpackU32(r), u);
+    float f;
+    std::memcpy(&f, &u, 4);
+    PackFloat32(f, r);
+    const float g = UnpackFloat32(r);
+    EXPECT_EQ(std::memcmp(&f, &g, 4), 0);
+    PackI32(static_cast<std::int32_t>(u), r);
+    EXPECT_EQ(UnpackI32(r), static_cast<std::int32_t>(u));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Overload rule.
+
+TEST(Overload, IntegerSquareRootIsExactFloor) {
+  std::mt19937_64 rng(3);
+  for (int i = 0; i < 100000; ++i) {
+    const std::uint64_t n = rng() >> (rng() % 64);
+    const std::uint64_t r = ISqrt64(n);
+    EXPECT_LE(r * r, n);
+    EXPECT_GT((r + 1) * (r + 1), n);  // r + 1 ≤ 2^32: the square fits unless r = 2^32 - 1
+  }
+  EXPECT_EQ(ISqrt64(std::numeric_limits<std::uint64_t>::max()), 0xFFFFFFFFu);
+  EXPECT_EQ(ISqrt64(0), 0u);
+}
+
+constexpr WrenchLsb kRatedLsb = {200000, 200000, 400000, 1000000, 1000000, 800000};
+
+struct RefShares {
+  double fxy_mz, fz_mxy;
+};
+RefShares ReferenceShares(const WrenchLsb& w) {
+  auto s = [&](std::size_t i) { return std::fabs(static_cast<double>(w[i])) / kRatedLsb[i]; };
+  return {std::hypot(s(0), s(1)) + s(5), s(2) + std::hypot(s(3), s(4))};
+}
+
+TEST(Overload, SharesMatchDoubleReferenceAndDecideAt105Percent) {
+  OverloadMonitor m;
+  ASSERT_TRUE(m.Configure(kRatedLsb));
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.3, 1.3);
+  int over = 0;
+  for (int i = 0; i < 50000; ++i) {
+    WrenchLsb w{};
+    for (std::size_t a = 0; a < kAxes; ++a) {
+      w[a] = static_cast<std::int32_t>(std::lround(u(rng) * 0.7 * kRatedLsb[a]));
+    }
+    const RefShares ref = ReferenceShares(w);
+    const LoadShares got = m.Shares(w);
+    // Q24 with floor(2^48/R) reciprocals: each share is low by less than 3 units of 2^-24.
+    EXPECT_NEAR(got.fxy_mz / 16777216.0, ref.fxy_mz, 4.0 / 16777216.0);
+    EXPECT_NEAR(got.fz_mxy / 16777216.0, ref.fz_mxy, 4.0 / 16777216.0);
+    const double worst = std::max(ref.fxy_mz, ref.fz_mxy);
+    if (std::fabs(worst - 1.05) < 1e-6) continue;  // inside the rounding band
+    OverloadMonitor fresh;
+    ASSERT_TRUE(fresh.Configure(kRatedLsb));
+    EXPECT_EQ(fresh.Update(w), worst > 1.05) << "shares " << ref.fxy_mz << " " << ref.fz_mxy;
+    over += worst > 1.05 ? 1 : 0;
+  }
+  EXPECT_GT(over, 1000);  // both outcomes were exercised
+  EXPECT_LT(over, 49000);
+}
+
+TEST(Overload, PureAxisLoadsTripJustAbove105Percent) {
+  OverloadMonitor m;
+  ASSERT_TRUE(m.Configure(kRatedLsb));
+  for (std::size_t a = 0; a < kAxes; ++a) {
+    WrenchLsb w{};
+    w[a] = static_cast<std::int32_t>(kRatedLsb[a] * 1.049);
+    EXPECT_FALSE(m.Update(w)) << "axis " << a;
+    w[a] = -static_cast<std::int32_t>(kRatedLsb[a] * 1.051);
+    EXPECT_TRUE(m.Update(w)) << "axis " << a;
+    m.Update(WrenchLsb{});
+  }
+  // 60 % Fx + 50 % Mz = 110 % of the shear capacity; 60 % + 40 % = 100 % is fine.
+  WrenchLsb w{};
+  w[0] = 120000;
+  w[5] = 320000;
+  EXPECT_FALSE(m.Update(w));
+  w[5] = 400000;
+  EXPECT_TRUE(m.Update(w));
+}
+
+TEST(Overload, CountsEventsOnEntryAndTracksPeaksUntilCleared) {
+  OverloadMonitor m;
+  ASSERT_TRUE(m.Configure(kRatedLsb));
+  const WrenchLsb calm = {1000, -2000, 3000, -4000, 5000, -6000};
+  const WrenchLsb over = {0, 0, -500000, 0, 0, 0};
+  const WrenchLsb spike = {-150000, 0, 0, 0, 0, 0};
+  for (const WrenchLsb& w : {calm, over, over, calm, over, spike, calm}) (void)m.Update(w);
+  EXPECT_EQ(m.events(), 2u);
+  const WrenchLsb expected_peaks = {150000, 2000, 500000, 4000, 5000, 6000};
+  EXPECT_EQ(m.peaks(), expected_peaks);
+  m.Clear();
+  EXPECT_EQ(m.events(), 0u);
+  EXPECT_EQ(m.peaks(), WrenchLsb{});
+  EXPECT_FALSE(m.Configure(WrenchLsb{1, 1, 1, 1, 1, 0}));
+  EXPECT_FALSE(m.Configure(WrenchLsb{1, 1, 1, 1, 1, kMaxRatedLsb + 1}));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tool transform.
+
+Eigen::Matrix<double, 6, 1> ReferenceTransform(const ToolTransformParams& p,
+                                               const Eigen::Matrix<double, 6, 1>& w_si) {
+  constexpr double kDeg = 3.14159265358979323846 / 180.0;
+  const Eigen::Matrix3d r = (Eigen::AngleAxisd(p.r_deg[2] * kDeg, Eigen::Vector3d::UnitZ()) *
+                             Eigen::AngleAxisd(p.r_deg[1] * kDeg, Eigen::Vector3d::UnitY()) *
+                             Eigen::AngleAxisd(p.r_deg[0] * kDeg, Eigen::Vector3d::UnitX()))
+                                .toRotationMatrix();
+  const Eigen::Vector3d d(p.d_m[0], p.d_m[1], p.d_m[2]);
+  const Eigen::Vector3d f = w_si.head<3>();
+  const Eigen::Vector3d m = w_si.tail<3>();
+  Eigen::Matrix<double, 6, 1> out;
+  out.head<3>() = r.transpose() * f;
+  out.tail<3>() = r.transpose() * (m - d.cross(f));
+  return out;
+}
+
+TEST(ToolTransform, MatchesDoubleReferenceWithinOneLsb) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> ud(-0.5, 0.5), ua(-180, 180), uf(-400, 400), um(-10, 10);
+  for (int i = 0; i < 2000; ++i) {
+    ToolTransformParams p;
+    for (std::size_t k = 0; k < 3; ++k) {
+      p.d_m[k] = static_cast<float>(ud(rng));
+      p.r_deg[k] = static_cast<float>(ua(rng));
+    }
+    FixedToolTransform t;
+    ASSERT_EQ(MakeToolTransform(p, &t), TransformStatus::kOk);
+    WrenchLsb w{};
+    Eigen::Matrix<double, 6, 1> w_si;
+    for (std::size_t a = 0; a < kAxes; ++a) {
+      const double v = a < 3 ? uf(rng) : um(rng);
+      w[a] = static_cast<std::int32_t>(std::lround(v / AxisLsb(a)));
+      w_si(static_cast<int>(a)) = w[a] * AxisLsb(a);  // the exact input the firmware sees
+    }
+    WrenchLsb y{};
+    bool sat = false;
+    ApplyToolTransform(t, w, &y, &sat);
+    EXPECT_FALSE(sat);
+    const Eigen::Matrix<double, 6, 1> ref = ReferenceTransform(p, w_si);
+    for (std::size_t a = 0; a < kAxes; ++a) {
+      // Final rounding (0.5 LSB) plus each coefficient's rounding (half a unit of 2^-shift)
+      // times its input.
+      double bound = 0.5;
+      for (std::size_t j = 0; j < kAxes; ++j)
+        bound += 0.5 * std::ldexp(std::fabs(w[j]), -t.shift[a]);
+      EXPECT_NEAR(y[a], ref(static_cast<int>(a)) / AxisLsb(a), bound + 1e-9) << "axis " << a;
+      EXPECT_LT(bound, 0.75);  // and the bound itself is tight: well under one LSB extra
+    }
+  }
+}
+
+TEST(ToolTransform, ForceAtTheToolPointHasNoMomentThere) {
+  // 10 N along x applied at D = (0, 0, 0.1) m: the sensor sees My = +1 N·m; at the tool point
+  // the moment vanishes.
+  ToolTransformParams p;
+  p.d_m = {0.0f, 0.0f, 0.1f};
+  FixedToolTransform t;
+  ASSERT_EQ(MakeToolTransform(p, &t), TransformStatus::kOk);
+  const WrenchLsb w = {10000, 0, 0, 0, 100000, 0};
+  WrenchLsb y{};
+  bool sat = false;
+  ApplyToolTransform(t, w, &y, &sat);
+  EXPECT_EQ(y, (WrenchLsb{10000, 0, 0, 0, 0, 0}));
+  // Rz = 90°: the tool x axis is the sensor y axis, so a sensor +Fx is a tool −Fy.
+  p = {};
+  p.r_deg = {0.0f, 0.0f, 90.0f};
+  ASSERT_EQ(MakeToolTransform(p, &t), TransformStatus::kOk);
+  ApplyToolTransform(t, WrenchLsb{1000, 0, 0, 0, 0, 0}, &y, &sat);
+  EXPECT_EQ(y, (WrenchLsb{0, -1000, 0, 0, 0, 0}));
+}
+
+TEST(ToolTransform, RefusesNonFiniteAndOutOfRangeAndLeavesOutputAlone) {
+  FixedToolTransform t;
+  t.identity = false;
+  t.shift[0] = 7;
+  ToolTransformParams p;
+  p.d_m[1] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(MakeToolTransform(p, &t), TransformStatus::kNotFinite);
+  p = {};
+  p.r_deg[2] = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(MakeToolTransform(p, &t), TransformStatus::kNotFinite);
+  p = {};
+  p.d_m[0] = 10.5f;
+  EXPECT_EQ(MakeToolTransform(p, &t), TransformStatus::kOutOfRange);
+  p = {};
+  p.r_deg[0] = -361.0f;
+  EXPECT_EQ(MakeToolTransform(p, &t), TransformStatus::kOutOfRange);
+  EXPECT_FALSE(t.identity);
+  EXPECT_EQ(t.shift[0], 7);
+  // The largest transform accepted cannot overflow the accumulator for any int32 input.
+  p.d_m = {10.0f, -10.0f, 10.0f};
+  p.r_deg = {33.0f, -71.0f, 150.0f};
+  ASSERT_EQ(MakeToolTransform(p, &t), TransformStatus::kOk);
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    double bound = 0;
+    for (std::size_t j = 0; j < kAxes; ++j) bound += std::fabs(static_cast<double>(t.coef[r][j]));
+    EXPECT_LE(bound * 2147483648.0, std::ldexp(1.0, 62)) << "row " << r;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Seqlock: concurrent readers never see a mix of two writes.
+
+struct Stamped {
+  std::uint32_t seq;
+  std::array<std::int64_t, 24> payload;
+};
+
+TEST(Seqlock, ReadersNeverSeeTornValues) {
+  Seqlock<Stamped> lock;
+  std::atomic<bool> done{false};
+  std::thread writer([&] {
+    Stamped s{};
+    for (std::uint32_t i = 1; i <= 100000; ++i) {
+      s.seq = i;
+      for (std::size_t k = 0; k < s.payload.size(); ++k)
+        s.payload[k] = std::int64_t{i} * 1000003 + k;
+      lock.Write(s);
+      if (i % 4 == 0) std::this_thread::yield();  // a sampling thread also pauses between samples
+    }
+    done = true;
+  });
+  std::atomic<int> torn{0}, backwards{0}, reads{0};
+  auto reader = [&] {
+    std::uint32_t last = 0;
+    while (!done) {
+      Stamped s{};
+      if (!lock.Read(&s)) continue;
+      ++reads;
+      for (std::size_t k = 0; k < s.payload.size(); ++k) {
+        if (s.payload[k] != std::int64_t{s.seq} * 1000003 + static_cast<std::int64_t>(k) &&
+            s.seq != 0) {
+          ++torn;
+          break;
+        }
+      }
+      if (s.seq < last) ++backwards;
+      last = s.seq;
+    }
+  };
+  std::thread r1(reader), r2(reader);
+  writer.join();
+  r1.join();
+  r2.join();
+  EXPECT_EQ(torn.load(), 0);
+  EXPECT_EQ(backwards.load(), 0);
+  EXPECT_GT(reads.load(), 100);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Register map over a Device driven by a scripted ADC.
+
+std::uint64_t g_now_us = 1000000;
+std::uint64_t FakeClock() { return g_now_us; }
+
+constexpr std::array<double, 6> kGain = {100.0, 100.0, 200.0, 5.0, 5.0, 4.0};  // per mV/V
+constexpr double kMvvPerCount = 3.90625 / 8388607.0;
+
+class RegisterMapTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    g_now_us = 1000000;
+    adc_.counts = {};
+    FloatCalibration fc;
+    fc.channel_count = 6;
+    for (std::size_t i = 0; i < 6; ++i) fc.matrix[i][i] = kGain[i];
+    hal::AdcInfo info{6, -(1 << 23), (1 << 23) - 1, 3906250, 1000, false};
+    ASSERT_EQ(LoadCalibration(fc, info, &cfg_.slots[0].fixed, &report_), LoadStatus::kOk);
+    cfg_.slots[0].crc32 = 0xCAFEF00Du;
+    cfg_.slots[0].present = true;
+    cfg_.adc.channel_count = 6;
+    cfg_.adc.rate_hz = 1000;
+    cfg_.rated_lsb = kRatedLsb;
+    cfg_.tare_samples = 4;
+    cfg_.clock_us = &FakeClock;
+  }
+  void StartDevice() {
+    ASSERT_EQ(device_.Start(cfg_), DeviceStatus::kOk);
+    map_ = std::make_unique<RegisterMap>(device_);
+  }
+  void Step(int n = 1) {
+    for (int i = 0; i < n; ++i) {
+      bool published = false;
+      ASSERT_EQ(device_.Step(&published), hal::Status::kOk);
+      g_now_us += 1000;
+    }
+  }
+  std::array<std::uint16_t, kInputRegisterCount> Input() {
+    std::array<std::uint16_t, kInputRegisterCount> r{};
+    EXPECT_EQ(map_->ReadInput(0, kInputRegisterCount, r.data()), ModbusException::kNone);
+    return r;
+  }
+  std::uint16_t Holding(std::uint16_t addr) {
+    std::uint16_t v = 0xDEAD;
+    EXPECT_EQ(map_->ReadHolding(addr, 1, &v), ModbusException::kNone);
+    return v;
+  }
+  ModbusException Write(std::uint16_t addr, std::initializer_list<std::uint16_t> values) {
+    std::vector<std::uint16_t> v(values);
+    return map_->WriteHolding(addr, v.data(), static_cast<std::uint16_t>(v.size()));
+  }
+  ModbusException WriteFloats(std::uint16_t addr, std::initializer_list<float> values) {
+    std::vector<std::uint16_t> v(values.size() * 2);
+    std::size_t i = 0;
+    for (float f : values) PackFloat32(f, &v[2 * i++]);
+    return map_->WriteHolding(addr, v.data(), static_cast<std::uint16_t>(v.size()));
+  }
+  /// The wrench in SI a count vector produces through the diagonal test calibration.
+  static double ExpectedSi(std::size_t axis, std::int32_t counts) {
+    return kGain[axis] * counts * kMvvPerCount;
+  }
+
+  test::FakeAdc adc_;
+  WrenchCore core_;
+  Device device_{adc_, core_};
+  DeviceConfig cfg_;
+  LoadReport report_;
+  std::unique_ptr<RegisterMap> map_;
+};
+
+TEST_F(RegisterMapTest, InputImageCarriesOneSampleInTheSpecifiedLayout) {
+  StartDevice();
+  adc_.counts = {400000, -300000, 1000000, 50000, -60000, 70000};
+  Step(3);
+  const auto r = Input();
+  EXPECT_EQ(r[kInMapVersion], 1);
+  EXPECT_EQ(r[kInStatus], 0);  // real (fake) hardware, calibrated, no faults
+  EXPECT_EQ(UnpackU32(&r[kInSequence]), 3u);
+  EXPECT_EQ(UnpackU32(&r[kInTimestampUs]), 2000u);
+  for (std::size_t a = 0; a < kAxes; ++a) {
+    const double si = ExpectedSi(a, adc_.counts[a]);
+    const double tol = report_.worst_case_error_si[a] + std::fabs(si) * 6e-8;
+    EXPECT_NEAR(UnpackFloat32(&r[kInWrenchFloat + 2 * a]), si, tol) << "axis " << a;
+    // int32 registers: mN and mN·m, rounded: within 0.5 unit + the fixed-point error.
+    EXPECT_NEAR(UnpackI32(&r[kInWrenchInt + 2 * a]), si * 1e3,
+                0.5 + report_.worst_case_error_si[a] * 1e3)
+        << "axis " << a;
+    EXPECT_EQ(UnpackI32(&r[kInRawCounts + 2 * a]), adc_.counts[a]);
+    EXPECT_NEAR(UnpackFloat32(&r[kInBridgeMvv + 2 * a]), adc_.counts[a] * kMvvPerCount,
+                std::fabs(adc_.counts[a] * kMvvPerCount) * 6e-8);
+    // Peaks: the largest |unfiltered| value seen, sensor frame.
+    EXPECT_NEAR(UnpackFloat32(&r[kInPeaks + 2 * a]), std::fabs(si), tol);
+  }
+  EXPECT_FLOAT_EQ(UnpackFloat32(&r[kInTemperature]), 20.0f);
+  EXPECT_EQ(r[kInBridgeCount], 6);
+  EXPECT_EQ(r[kInCalSlot], 0);
+  EXPECT_EQ(UnpackU32(&r[kInOverloadEvents]), 0u);
+  EXPECT_EQ(UnpackU32(&r[kInCalCrc]), 0xCAFEF00Du);
+}
+
+TEST_F(RegisterMapTest, StaleBitAfterTwoPeriodsWithoutSample) {
+  StartDevice();
+  Step(2);
+  g_now_us += 1000;  // 2 periods since the last publication (Step advanced 1000 already)
+  EXPECT_EQ(Input()[kInStatus] & kStatusStale, 0);
+  g_now_us += 1;
+  EXPECT_NE(Input()[kInStatus] & kStatusStale, 0);
+  Step();
+  EXPECT_EQ(Input()[kInStatus] & kStatusStale, 0);
+}
+
+TEST_F(RegisterMapTest, AddressesOutsideTheMapGiveException02) {
+  StartDevice();
+  std::array<std::uint16_t, 125> buf{};
+  EXPECT_EQ(map_->ReadInput(73, 1, buf.data()), ModbusException::kNone);
+  EXPECT_EQ(map_->ReadInput(73, 2, buf.data()), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(map_->ReadInput(74, 1, buf.data()), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(map_->ReadHolding(0, 5, buf.data()), ModbusException::kNone);
+  EXPECT_EQ(map_->ReadHolding(10, 12, buf.data()), ModbusException::kNone);
+  EXPECT_EQ(map_->ReadHolding(0, 6, buf.data()), ModbusException::kIllegalDataAddress);
+  for (std::uint16_t a = 5; a < 10; ++a) {
+    EXPECT_EQ(map_->ReadHolding(a, 1, buf.data()), ModbusException::kIllegalDataAddress);
+    EXPECT_EQ(Write(a, {1}), ModbusException::kIllegalDataAddress);
+  }
+  EXPECT_EQ(map_->ReadHolding(21, 2, buf.data()), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(Write(22, {0}), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(Write(65535, {0}), ModbusException::kIllegalDataAddress);
+}
+
+TEST_F(RegisterMapTest, ValuesOutOfRangeGive03AndChangeNothing) {
+  StartDevice();
+  EXPECT_EQ(Holding(kHoldFilterLength), 1);
+  EXPECT_EQ(Write(kHoldFilterLength, {0}), ModbusException::kIllegalDataValue);
+  EXPECT_EQ(Write(kHoldFilterLength, {257}), ModbusException::kIllegalDataValue);
+  EXPECT_EQ(Write(kHoldFilterLength, {256}), ModbusException::kNone);
+  EXPECT_EQ(Holding(kHoldFilterLength), 256);
+  EXPECT_EQ(Write(kHoldDecimation, {0}), ModbusException::kIllegalDataValue);
+  EXPECT_EQ(Write(kHoldDecimation, {1001}), ModbusException::kIllegalDataValue);
+  EXPECT_EQ(Write(kHoldCommand, {4}), ModbusException::kIllegalDataValue);
+  EXPECT_EQ(Write(kHoldCommand, {0}), ModbusException::kIllegalDataValue);
+  EXPECT_EQ(Write(kHoldUnlock, {0x1234}), ModbusException::kIllegalDataValue);
+  EXPECT_EQ(Holding(kHoldUnlock), 0);
+  // A multi-register write with one bad value changes nothing, not even the good ones before it.
+  EXPECT_EQ(Write(kHoldCommand, {kCmdTare, 10, 0}), ModbusException::kIllegalDataValue);
+  EXPECT_EQ(Holding(kHoldFilterLength), 256);
+  EXPECT_EQ(Holding(kHoldDecimation), 1);
+  Step(10);
+  EXPECT_EQ(Input()[kInStatus] & kStatusTareActive, 0);  // the tare never started
+  EXPECT_EQ(Holding(kHoldCommand), 0);
+}
+
+TEST_F(RegisterMapTest, ProtectedWritesNeedUnlockAndExpireAfterTenSeconds) {
+  cfg_.slots[1] = cfg_.slots[0];
+  cfg_.slots[1].crc32 = 0x0BADBEEFu;
+  StartDevice();
+  EXPECT_EQ(Write(kHoldCalSlot, {1}), ModbusException::kIllegalDataValue);  // locked
+  EXPECT_EQ(WriteFloats(kHoldTransform, {0.1f}), ModbusException::kIllegalDataValue);
+  EXPECT_EQ(Holding(kHoldCalSlot), 0);
+  EXPECT_EQ(Holding(kHoldTransform), 0);
+  EXPECT_EQ(Write(kHoldUnlock, {kUnlockKey}), ModbusException::kNone);
+  EXPECT_EQ(Holding(kHoldUnlock), 1);
+  EXPECT_EQ(Write(kHoldCalSlot, {2}), ModbusException::kIllegalDataValue);
+  EXPECT_EQ(Write(kHoldCalSlot, {1}), ModbusException::kNone);
+  Step();
+  auto r = Input();
+  EXPECT_EQ(r[kInCalSlot], 1);
+  EXPECT_EQ(UnpackU32(&r[kInCalCrc]), 0x0BADBEEFu);
+  // Half a float is refused; so is a NaN; the registers keep their previous content.
+  EXPECT_EQ(Write(kHoldTransform + 1, {0x3F80}), ModbusException::kIllegalDataValue);
+  EXPECT_EQ(Write(kHoldTransform, {0x3F80}), ModbusException::kIllegalDataValue);
+  EXPECT_EQ(WriteFloats(kHoldTransform, {std::numeric_limits<float>::quiet_NaN()}),
+            ModbusException::kIllegalDataValue);
+  EXPECT_EQ(WriteFloats(kHoldTransform + 6, {0.0f, 0.0f, 400.0f}),
+            ModbusException::kIllegalDataValue);
+  EXPECT_EQ(Holding(kHoldTransform), 0);
+  EXPECT_EQ(WriteFloats(kHoldTransform, {0.0f, 0.0f, 0.1f}), ModbusException::kNone);
+  EXPECT_FLOAT_EQ(UnpackFloat32(std::array<std::uint16_t, 2>{Holding(14), Holding(15)}.data()),
+                  0.1f);
+  g_now_us += kUnlockDurationUs;
+  EXPECT_EQ(Holding(kHoldUnlock), 0);
+  EXPECT_EQ(Write(kHoldCalSlot, {0}), ModbusException::kIllegalDataValue);
+  EXPECT_EQ(Holding(kHoldCalSlot), 1);
+}
+
+TEST_F(RegisterMapTest, MissingCalibrationSlotCannotBeSelected) {
+  StartDevice();
+  EXPECT_EQ(Write(kHoldUnlock, {kUnlockKey}), ModbusException::kNone);
+  EXPECT_EQ(Write(kHoldCalSlot, {1}), ModbusException::kIllegalDataValue);
+  EXPECT_EQ(Write(kHoldCalSlot, {0}), ModbusException::kNone);
+}
+
+TEST_F(RegisterMapTest, ToolTransformWrittenOverModbusMovesTheWrench) {
+  StartDevice();
+  adc_.counts = {300000, 0, 0, 0, 0, 0};  // Fx only
+  ASSERT_EQ(Write(kHoldUnlock, {kUnlockKey}), ModbusException::kNone);
+  ASSERT_EQ(WriteFloats(kHoldTransform, {0.0f, 0.0f, 0.2f, 0.0f, 0.0f, 0.0f}),
+            ModbusException::kNone);
+  Step();
+  const auto r = Input();
+  const double fx = ExpectedSi(0, 300000);
+  // At a tool point 0.2 m along z the force Fx has moment M = −D × F: My = −0.2·Fx.
+  // Fx carries the core's fixed-point error (report_); My = −0.2·Fx inherits 0.2 of it, plus half
+  // an output LSB and float32 rounding.
+  const double fx_tol = report_.worst_case_error_si[0] + std::fabs(fx) * 6e-8;
+  EXPECT_NEAR(UnpackFloat32(&r[kInWrenchFloat]), fx, fx_tol);
+  EXPECT_NEAR(UnpackFloat32(&r[kInWrenchFloat + 8]), -0.2 * fx,
+              0.2 * fx_tol + 0.5 * kMomentLsbNm + 0.2 * std::fabs(fx) * 6e-8);
+  // Peaks stay in the sensor frame (what the rating refers to): My peak 0.
+  EXPECT_FLOAT_EQ(UnpackFloat32(&r[kInPeaks + 8]), 0.0f);
+}
+
+TEST_F(RegisterMapTest, CommandsTareClearTareAndClearPeaks) {
+  StartDevice();
+  adc_.counts = {200000, 0, 500000, 0, 0, 0};
+  Step(2);
+  ASSERT_EQ(Write(kHoldCommand, {kCmdTare}), ModbusException::kNone);
+  Step(cfg_.tare_samples + 1);
+  auto r = Input();
+  EXPECT_NE(r[kInStatus] & kStatusTareActive, 0);
+  for (std::size_t a = 0; a < kAxes; ++a) EXPECT_EQ(UnpackI32(&r[kInWrenchInt + 2 * a]), 0);
+  ASSERT_EQ(Write(kHoldCommand, {kCmdClearTare}), ModbusException::kNone);
+  Step();
+  r = Input();
+  EXPECT_EQ(r[kInStatus] & kStatusTareActive, 0);
+  EXPECT_NEAR(UnpackFloat32(&r[kInWrenchFloat + 4]), ExpectedSi(2, 500000), 2e-3);
+  // Overload: Fz at 1.1 × rated (440 N) is one event and sets bit 1 while it lasts.
+  adc_.counts[2] = static_cast<std::int32_t>(440.0 / kGain[2] / kMvvPerCount);
+  Step(3);
+  r = Input();
+  EXPECT_NE(r[kInStatus] & kStatusOverload, 0);
+  EXPECT_EQ(UnpackU32(&r[kInOverloadEvents]), 1u);
+  EXPECT_NEAR(UnpackFloat32(&r[kInPeaks + 4]), 440.0, 0.01);
+  adc_.counts[2] = 0;
+  Step();
+  r = Input();
+  EXPECT_EQ(r[kInStatus] & kStatusOverload, 0);
+  EXPECT_EQ(UnpackU32(&r[kInOverloadEvents]), 1u);
+  ASSERT_EQ(Write(kHoldCommand, {kCmdClearPeaks}), ModbusException::kNone);
+  Step();
+  r = Input();
+  EXPECT_EQ(UnpackU32(&r[kInOverloadEvents]), 0u);
+  EXPECT_NEAR(UnpackFloat32(&r[kInPeaks]), ExpectedSi(0, 200000), 2e-3);  // this sample's Fx
+  EXPECT_FLOAT_EQ(UnpackFloat32(&r[kInPeaks + 4]), 0.0f);
+}
+
+TEST_F(RegisterMapTest, DecimationPublishesEveryNthSample) {
+  StartDevice();
+  ASSERT_EQ(Write(kHoldDecimation, {4}), ModbusException::kNone);
+  Step(12);
+  auto r = Input();
+  EXPECT_EQ(UnpackU32(&r[kInSequence]), 3u);
+  EXPECT_EQ(UnpackU32(&r[kInTimestampUs]), 11000u);
+  // The stale limit follows the publication period: 2 × 4 ms.
+  g_now_us += 6000;
+  EXPECT_EQ(Input()[kInStatus] & kStatusStale, 0);
+}
+
+TEST_F(RegisterMapTest, FaultsSaturationHoldsAndAdcTimeoutFlags) {
+  StartDevice();
+  adc_.counts = {100000, 0, 0, 0, 0, 0};
+  Step();
+  const float fx = UnpackFloat32(&Input()[kInWrenchFloat]);
+  adc_.counts[3] = (1 << 23) - 1;  // at the rail
+  Step();
+  auto r = Input();
+  EXPECT_NE(r[kInStatus] & kStatusSaturated, 0);
+  EXPECT_EQ(UnpackFloat32(&r[kInWrenchFloat]), fx);
+  adc_.counts[3] = 0;
+  adc_.next_status = hal::Status::kTimeout;
+  bool published = false;
+  EXPECT_EQ(device_.Step(&published), hal::Status::kTimeout);
+  r = Input();
+  EXPECT_NE(r[kInStatus] & kStatusAdcFault, 0);
+  EXPECT_NE(r[kInStatus] & kStatusStale, 0);
+  EXPECT_EQ(UnpackU32(&r[kInSequence]), 2u);  // no new sample
+}
+
+}  // namespace
+}  // namespace ftstack::fw

@@ -1,0 +1,414 @@
+// End to end: simulated wrench → ftd (real binary) → Modbus TCP → libmodbus client in this process.
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <modbus/modbus.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+
+#include <atomic>
+#include <cmath>
+#include <random>
+#include <thread>
+
+#include "calibration/cal_file.hpp"
+#include "calibration/ideal.hpp"
+#include "firmware/modbus_server.hpp"
+#include "firmware/register_map.hpp"
+#include "sim/default_sensor.hpp"
+#include "sim/recording.hpp"
+#include "tests/system/ftd_process.hpp"
+
+namespace ftstack {
+namespace {
+
+using fw::UnpackFloat32;
+using fw::UnpackI32;
+using fw::UnpackU32;
+
+/// Per-axis noise of one sample of the built-in simulated sensor, derived by propagating the
+/// simulated ADC's input noise and its quantisation (uniform, q²/12) through the calibration
+/// matrix; and the fixed-point core's worst-case error bound.
+struct Expected {
+  std::array<double, 6> sigma_si{};
+  std::array<double, 6> fixed_error_si{};
+};
+Expected DeriveExpected() {
+  const auto model = sim::MakeDefaultSensor();
+  const hal::AdcInfo adc = cal::DefaultAdc(6);
+  const cal::CalFile c = cal::IdealCalibration(*model, adc);
+  const double q_mvv = adc.full_scale_nvv * 1e-6 / adc.max_counts;
+  const double var = sim::kDefaultNoiseMvv * sim::kDefaultNoiseMvv + q_mvv * q_mvv / 12.0;
+  Expected e;
+  for (std::size_t i = 0; i < 6; ++i) {
+    double s2 = 0;
+    for (std::size_t ch = 0; ch < 6; ++ch) s2 += c.cal.matrix[i][ch] * c.cal.matrix[i][ch] * var;
+    e.sigma_si[i] = std::sqrt(s2);
+  }
+  fw::LoadReport rep;
+  (void)cal::ToFixed(c, adc, &rep);
+  e.fixed_error_si = rep.worst_case_error_si;
+  return e;
+}
+
+/// A libmodbus TCP client connected to the daemon.
+class Client {
+ public:
+  explicit Client(int port, int unit = 1, double timeout_s = 1.0) {
+    ctx_ = modbus_new_tcp("127.0.0.1", port);
+    modbus_set_slave(ctx_, unit);
+    const auto us = static_cast<std::uint32_t>(timeout_s * 1e6);
+    modbus_set_response_timeout(ctx_, us / 1000000, us % 1000000);
+    connected_ = modbus_connect(ctx_) == 0;
+  }
+  ~Client() {
+    modbus_close(ctx_);
+    modbus_free(ctx_);
+  }
+  [[nodiscard]] bool connected() const { return connected_; }
+  modbus_t* ctx() { return ctx_; }
+  /// Reads input registers; returns the libmodbus result (count or -1) and errno in *err.
+  int Input(int addr, int count, std::uint16_t* out, int* err = nullptr) {
+    const int rc = modbus_read_input_registers(ctx_, addr, count, out);
+    if (err != nullptr) *err = rc < 0 ? errno : 0;
+    return rc;
+  }
+  int Holding(int addr, int count, std::uint16_t* out, int* err = nullptr) {
+    const int rc = modbus_read_registers(ctx_, addr, count, out);
+    if (err != nullptr) *err = rc < 0 ? errno : 0;
+    return rc;
+  }
+  int Write(int addr, std::uint16_t v, int* err = nullptr) {
+    const int rc = modbus_write_register(ctx_, addr, v);
+    if (err != nullptr) *err = rc < 0 ? errno : 0;
+    return rc;
+  }
+  int WriteMany(int addr, const std::vector<std::uint16_t>& v, int* err = nullptr) {
+    const int rc = modbus_write_registers(ctx_, addr, static_cast<int>(v.size()), v.data());
+    if (err != nullptr) *err = rc < 0 ? errno : 0;
+    return rc;
+  }
+  std::uint32_t Sequence() {
+    std::uint16_t r[2] = {0, 0};
+    if (Input(fw::kInSequence, 2, r) != 2) return 0;
+    return UnpackU32(r);
+  }
+  /// Waits until `n` more samples have been published (up to 10 s).
+  bool WaitSamples(std::uint32_t n) {
+    const std::uint32_t start = Sequence();
+    for (int i = 0; i < 1000; ++i) {
+      if (Sequence() - start >= n) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return false;
+  }
+
+ private:
+  modbus_t* ctx_ = nullptr;
+  bool connected_ = false;
+};
+
+constexpr double kSigmas = 5.0;  // 5σ: a false failure once in ~1.7 million axis checks
+
+TEST(FtdModbus, SimulatedWrenchArrivesWithinDerivedToleranceAndTareZeroes) {
+  const std::array<double, 6> applied = {20.0, -10.0, -150.0, 0.5, -0.3, 0.2};
+  test::FtdProcess ftd({"--adc", "sim", "--sim-wrench", "20,-10,-150,0.5,-0.3,0.2", "--rate-hz",
+                        "1000", "--modbus-tcp", "127.0.0.1:0"});
+  ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
+  Client c(ftd.port());
+  ASSERT_TRUE(c.connected());
+  const Expected e = DeriveExpected();
+  constexpr int kFilter = 256;
+  ASSERT_EQ(c.Write(fw::kHoldFilterLength, kFilter), 1);
+  std::uint16_t h = 0;
+  ASSERT_EQ(c.Holding(fw::kHoldFilterLength, 1, &h), 1);
+  EXPECT_EQ(h, kFilter);
+  ASSERT_TRUE(c.WaitSamples(kFilter + 20));
+
+  std::array<std::uint16_t, 30> r{};
+  ASSERT_EQ(c.Input(0, 30, r.data()), 30);
+  EXPECT_EQ(r[fw::kInMapVersion], 1);
+  EXPECT_EQ(r[fw::kInStatus] & ~fw::kStatusStale, fw::kStatusSimulated);
+  for (std::size_t a = 0; a < 6; ++a) {
+    const double tol = kSigmas * e.sigma_si[a] / std::sqrt(kFilter) + e.fixed_error_si[a] +
+                       std::fabs(applied[a]) * 6e-8;
+    const double got = UnpackFloat32(&r[fw::kInWrenchFloat + 2 * a]);
+    EXPECT_NEAR(got, applied[a], tol) << "axis " << a;
+    // int32 registers: mN and mN·m of the same sample.
+    EXPECT_NEAR(UnpackI32(&r[fw::kInWrenchInt + 2 * a]), got * 1e3,
+                0.5 + std::fabs(got) * 1e3 * 6e-8)
+        << "axis " << a;
+  }
+  // Unit 255 is answered over TCP as well.
+  Client wildcard(ftd.port(), 255);
+  ASSERT_TRUE(wildcard.connected());
+  EXPECT_EQ(wildcard.Input(0, 1, r.data()), 1);
+
+  // Tare: the tare averages rate/10 = 100 samples; afterwards the filtered reading is the
+  // difference of two independent averages.
+  ASSERT_EQ(c.Write(fw::kHoldCommand, fw::kCmdTare), 1);
+  ASSERT_EQ(c.Holding(fw::kHoldCommand, 1, &h), 1);
+  EXPECT_EQ(h, 0);  // the command register reads 0
+  bool tared = false;
+  for (int i = 0; i < 500 && !tared; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    ASSERT_EQ(c.Input(fw::kInStatus, 1, &h), 1);
+    tared = (h & fw::kStatusTareActive) != 0;
+  }
+  ASSERT_TRUE(tared);
+  ASSERT_TRUE(c.WaitSamples(kFilter + 20));
+  ASSERT_EQ(c.Input(0, 30, r.data()), 30);
+  for (std::size_t a = 0; a < 6; ++a) {
+    const double tol =
+        kSigmas * e.sigma_si[a] * std::sqrt(1.0 / kFilter + 1.0 / 100.0) + 2.0 * fw::AxisLsb(a);
+    EXPECT_NEAR(UnpackFloat32(&r[fw::kInWrenchFloat + 2 * a]), 0.0, tol) << "axis " << a;
+  }
+  EXPECT_EQ(ftd.Stop(SIGTERM), 0);
+}
+
+TEST(FtdModbus, ExceptionsAndProtectedWritesOverTheWire) {
+  test::FtdProcess ftd({"--modbus-tcp", "127.0.0.1:0", "--unit-id", "7"});
+  ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
+  Client c(ftd.port(), 7);
+  ASSERT_TRUE(c.connected());
+  std::array<std::uint16_t, 130> r{};
+  int err = 0;
+  EXPECT_EQ(c.Input(74, 1, r.data(), &err), -1);
+  EXPECT_EQ(err, EMBXILADD);
+  EXPECT_EQ(c.Input(70, 5, r.data(), &err), -1);
+  EXPECT_EQ(err, EMBXILADD);
+  EXPECT_EQ(c.Holding(5, 1, r.data(), &err), -1);
+  EXPECT_EQ(err, EMBXILADD);
+  EXPECT_EQ(c.Write(9, 1, &err), -1);
+  EXPECT_EQ(err, EMBXILADD);
+  // Unknown function (read coils) → 01.
+  std::uint8_t bits[8];
+  EXPECT_EQ(modbus_read_bits(c.ctx(), 0, 1, bits), -1);
+  EXPECT_EQ(errno, EMBXILFUN);
+  // Protected writes while locked → 03 and nothing changes.
+  EXPECT_EQ(c.Write(fw::kHoldCalSlot, 1, &err), -1);
+  EXPECT_EQ(err, EMBXILVAL);
+  std::vector<std::uint16_t> d(4);
+  fw::PackFloat32(0.05f, &d[0]);
+  fw::PackFloat32(0.10f, &d[2]);
+  EXPECT_EQ(c.WriteMany(fw::kHoldTransform, d, &err), -1);
+  EXPECT_EQ(err, EMBXILVAL);
+  ASSERT_EQ(c.Holding(0, 5, r.data()), 5);
+  EXPECT_EQ(r[fw::kHoldCalSlot], 0);
+  EXPECT_EQ(r[fw::kHoldUnlock], 0);
+  ASSERT_EQ(c.Holding(fw::kHoldTransform, 12, r.data()), 12);
+  for (int i = 0; i < 12; ++i) EXPECT_EQ(r[i], 0) << i;
+  // Out-of-range values → 03.
+  EXPECT_EQ(c.Write(fw::kHoldFilterLength, 0, &err), -1);
+  EXPECT_EQ(err, EMBXILVAL);
+  EXPECT_EQ(c.Write(fw::kHoldCommand, 9, &err), -1);
+  EXPECT_EQ(err, EMBXILVAL);
+  // Unlock, then the transform is accepted and reads back.
+  ASSERT_EQ(c.Write(fw::kHoldUnlock, fw::kUnlockKey), 1);
+  ASSERT_EQ(c.Holding(fw::kHoldUnlock, 1, r.data()), 1);
+  EXPECT_EQ(r[0], 1);
+  ASSERT_EQ(c.WriteMany(fw::kHoldTransform, d), 4);
+  ASSERT_EQ(c.Holding(fw::kHoldTransform, 4, r.data()), 4);
+  EXPECT_FLOAT_EQ(UnpackFloat32(&r[0]), 0.05f);
+  EXPECT_FLOAT_EQ(UnpackFloat32(&r[2]), 0.10f);
+  // The slot register: only slot 0 exists without --cal-b.
+  EXPECT_EQ(c.Write(fw::kHoldCalSlot, 1, &err), -1);
+  EXPECT_EQ(err, EMBXILVAL);
+  // A unit id that is neither ours nor 255 gets no answer.
+  Client other(ftd.port(), 1, 0.3);
+  ASSERT_TRUE(other.connected());
+  EXPECT_EQ(other.Input(0, 1, r.data(), &err), -1);
+  EXPECT_EQ(err, ETIMEDOUT);
+  EXPECT_EQ(ftd.Stop(SIGINT), 0);
+}
+
+int RawConnect(int port) {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0) {
+    close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+TEST(FtdModbus, GarbageAndHalfFramesDoNotDisturbOtherClients) {
+  test::FtdProcess ftd({"--modbus-tcp", "127.0.0.1:0", "--rate-hz", "2000"});
+  ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
+  std::atomic<bool> stop{false};
+  std::atomic<int> ok{0}, failed{0};
+  // A well-behaved client polling the wrench all along (1 s timeout per request).
+  std::thread good([&] {
+    Client c(ftd.port());
+    std::array<std::uint16_t, 74> r{};
+    while (!stop) {
+      if (c.Input(0, 74, r.data()) == 74 && r[0] == 1) {
+        ++ok;
+      } else {
+        if (failed++ == 0)
+          std::fprintf(stderr, "first failure: %s after %d ok\n", modbus_strerror(errno),
+                       ok.load());
+      }
+    }
+  });
+  for (int i = 0; i < 500 && ok == 0; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  if (ok == 0) {
+    stop = true;
+    good.join();
+    FAIL() << "the polling client never got an answer";
+  }
+  std::mt19937 rng(42);
+  // 1: clients that send half an MBAP header and then go silent (keeping their sockets open),
+  // more of them than the server has connection slots.
+  std::vector<int> stalled;
+  for (std::size_t i = 0; i < fw::kMaxTcpClients + 8; ++i) {
+    stalled.push_back(RawConnect(ftd.port()));
+    const std::uint8_t half[] = {0x00, 0x01, 0x00};
+    (void)send(stalled.back(), half, sizeof(half), MSG_NOSIGNAL);
+  }
+  // 2: a client that sends half a request and disconnects mid-frame.
+  for (int i = 0; i < 20; ++i) {
+    const int fd = RawConnect(ftd.port());
+    const std::uint8_t part[] = {0x00, 0x02, 0x00, 0x00, 0x00, 0x06, 0x01, 0x04, 0x00};
+    EXPECT_EQ(send(fd, part, sizeof(part), MSG_NOSIGNAL), static_cast<ssize_t>(sizeof(part)));
+    close(fd);
+  }
+  // 3: pure garbage streams.
+  for (int i = 0; i < 20; ++i) {
+    const int fd = RawConnect(ftd.port());
+    std::vector<std::uint8_t> junk(1 + rng() % 600);
+    for (auto& b : junk) b = static_cast<std::uint8_t>(rng());
+    (void)send(fd, junk.data(), junk.size(), MSG_NOSIGNAL);
+    close(fd);
+  }
+  // 4: well-framed MBAP with random PDUs (fuzz-like): each gets a reply or is ignored, and the
+  // connection stays usable as long as the header is valid.
+  const int fuzz = RawConnect(ftd.port());
+  EXPECT_GE(fuzz, 0);
+  int replies = 0;
+  for (int i = 0; i < 300; ++i) {
+    const std::size_t pdu = 1 + rng() % 20;
+    std::vector<std::uint8_t> f = {0x12, 0x34, 0x00, 0x00, 0x00, static_cast<std::uint8_t>(pdu + 1),
+                                   0x01};
+    for (std::size_t k = 0; k < pdu; ++k) f.push_back(static_cast<std::uint8_t>(rng()));
+    if (i % 3 == 0) f[7] = static_cast<std::uint8_t>(1 + rng() % 24);  // often a known-ish code
+    if (send(fuzz, f.data(), f.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(f.size())) break;
+    std::uint8_t rsp[300];
+    timeval tv{1, 0};
+    setsockopt(fuzz, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+    const ssize_t n = recv(fuzz, rsp, sizeof(rsp), 0);
+    EXPECT_GT(n, 8) << "frame " << i << ": no reply";
+    if (n <= 8) break;
+    EXPECT_EQ(rsp[0], 0x12);  // transaction id echoed
+    EXPECT_EQ(rsp[1], 0x34);
+    ++replies;
+  }
+  EXPECT_EQ(replies, 300);
+  close(fuzz);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  stop = true;
+  good.join();
+  for (const int fd : stalled) close(fd);
+  EXPECT_EQ(failed.load(), 0);
+  EXPECT_GT(ok.load(), 50);
+  EXPECT_TRUE(ftd.alive());
+  EXPECT_EQ(ftd.Stop(SIGTERM), 0);
+}
+
+/// Triangle wave of Fz through keyframes every 0.5 s: ±300 N, 600 N/s.
+double TriangleFz(double t) {
+  const double phase = std::fmod(t, 2.0);
+  return phase < 1.0 ? -300.0 + 600.0 * phase : 300.0 - 600.0 * (phase - 1.0);
+}
+
+TEST(FtdModbus, EveryReplyComesFromOneSample) {
+  // Replay a fast ramp: one sample step is 0.6 N of Fz, far above the noise, so a reply mixing
+  // the sequence/timestamp of one sample with the wrench of another cannot pass.
+  char path[] = "/tmp/ftd_ramp_XXXXXX.csv";
+  close(mkstemps(path, 4));
+  sim::Recording rec;
+  std::vector<double> t, fz, zero;
+  for (int i = 0; i <= 40; ++i) {
+    t.push_back(i * 0.5);
+    fz.push_back(TriangleFz(i * 0.5));
+    zero.push_back(0.0);
+  }
+  rec.SetColumn("t", t);
+  for (const std::string& n : sim::WrenchColumns()) rec.SetColumn(n, n == "Fz" ? fz : zero);
+  sim::WriteRecording(path, rec);
+  test::FtdProcess ftd({"--replay", path, "--rate-hz", "1000", "--modbus-tcp", "127.0.0.1:0"});
+  ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
+  const Expected e = DeriveExpected();
+  const double tol = kSigmas * e.sigma_si[2] + e.fixed_error_si[2] + 300 * 6e-8;
+  ASSERT_LT(tol, 0.3);  // half a sample step: the test can tell neighbouring samples apart
+  std::atomic<int> bad{0}, checked{0};
+  {
+    Client c(ftd.port());
+    ASSERT_TRUE(c.WaitSamples(200));  // past start-up, when the sampler may catch up in a burst
+  }
+  auto reader = [&] {
+    Client c(ftd.port());
+    std::array<std::uint16_t, 18> r{};
+    std::uint32_t first = 0;
+    // One second of samples (1000 sequence numbers), read as fast as the server answers.
+    for (std::uint32_t seq = 0; first == 0 || seq - first < 1000;) {
+      if (c.Input(0, 18, r.data()) != 18) {
+        ++bad;
+        continue;
+      }
+      seq = UnpackU32(&r[fw::kInSequence]);
+      const std::uint32_t ts = UnpackU32(&r[fw::kInTimestampUs]);
+      if (first == 0) first = seq;
+      const double t_s = ts * 1e-6;
+      const bool same =
+          ts == (seq - 1) * 1000u &&
+          std::fabs(UnpackFloat32(&r[fw::kInWrenchFloat + 4]) - TriangleFz(t_s)) <= tol;
+      if (!same) ++bad;
+      ++checked;
+    }
+  };
+  std::thread r1(reader), r2(reader);
+  r1.join();
+  r2.join();
+  EXPECT_EQ(bad.load(), 0);
+  EXPECT_GT(checked.load(), 2000);  // several reads per sample period
+  EXPECT_EQ(ftd.Stop(), 0);
+  std::remove(path);
+}
+
+TEST(FtdModbus, LogWritesTheRecordingFormatAndDurationEndsCleanly) {
+  char path[] = "/tmp/ftd_log_XXXXXX.csv";
+  close(mkstemps(path, 4));
+  test::FtdProcess ftd(
+      {"--sim-wrench", "0,0,-100,0,0,0", "--rate-hz", "1000", "--duration-s", "1", "--log", path},
+      false);
+  ASSERT_EQ(ftd.Wait(20.0), 0) << ftd.Stderr();
+  sim::ReadOptions ro;
+  ro.required = {"t", "status", "temp_C", "raw0", "raw5"};
+  ro.require_bridges = true;
+  ro.require_wrench = true;
+  const sim::Recording rec = sim::ReadRecording(path, ro);
+  EXPECT_GE(rec.rows(), 900u);
+  EXPECT_LE(rec.rows(), 1100u);
+  EXPECT_EQ(rec.BridgeCount(), 6u);
+  const Expected e = DeriveExpected();
+  double sum = 0;
+  for (double v : rec.Column("Fz")) sum += v;
+  const double n = static_cast<double>(rec.rows());
+  EXPECT_NEAR(sum / n, -100.0, kSigmas * e.sigma_si[2] / std::sqrt(n) + e.fixed_error_si[2]);
+  const hal::AdcInfo adc = cal::DefaultAdc(6);
+  const double mvv_per_count = adc.full_scale_nvv * 1e-6 / adc.max_counts;
+  for (std::size_t i = 0; i < rec.rows(); i += 97) {
+    EXPECT_NEAR(rec.Column("b2")[i], rec.Column("raw2")[i] * mvv_per_count, 1e-9);
+    EXPECT_EQ(static_cast<int>(rec.Column("status")[i]) & fw::kStatusSimulated,
+              fw::kStatusSimulated);
+    EXPECT_DOUBLE_EQ(rec.Column("temp_C")[i], 20.0);
+  }
+  std::remove(path);
+}
+
+}  // namespace
+}  // namespace ftstack

@@ -1,0 +1,312 @@
+#include "tools/ftd/daemon.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "calibration/cal_file.hpp"
+#include "calibration/ideal.hpp"
+#include "hal/sim/sim_adc.hpp"
+#include "sim/default_sensor.hpp"
+#include "sim/recording.hpp"
+#include "sim/simulated_sensor.hpp"
+#include "sim/wrench_source.hpp"
+#include "tools/ftd/hardware_adc.hpp"
+
+namespace ftstack::tools {
+namespace {
+
+constexpr std::size_t kLogRingCapacity = std::size_t{1} << 15;
+
+void AppendLe(std::string* out, std::uint64_t v, int bytes) {
+  for (int i = 0; i < bytes; ++i) out->push_back(static_cast<char>((v >> (8 * i)) & 0xFFu));
+}
+
+/// One calibration slot from a file: fixed-point form for `adc`, CRC of the file's content.
+fw::CalSlot SlotFromFile(const std::string& path, const hal::AdcInfo& adc,
+                         std::array<double, 6>* rated) {
+  const cal::CalFile file = cal::LoadCalFile(path);  // verifies schema and CRC; throws
+  std::ifstream in(path);
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  fw::CalSlot slot;
+  slot.fixed = cal::ToFixed(file, adc);
+  slot.crc32 = j.is_discarded() ? FixedFormCrc(slot.fixed) : cal::ContentCrc(j);
+  slot.present = true;
+  if (rated != nullptr) *rated = file.rated;
+  return slot;
+}
+
+}  // namespace
+
+void ParseHostPort(const std::string& text, std::string* host, std::uint16_t* port) {
+  const std::size_t colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0) {
+    throw FtdError("--modbus-tcp '" + text + "': expected HOST:PORT");
+  }
+  const std::string p = text.substr(colon + 1);
+  std::size_t used = 0;
+  long v = -1;
+  try {
+    v = std::stol(p, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != p.size() || v < 0 || v > 65535) {
+    throw FtdError("--modbus-tcp '" + text + "': port '" + p + "' is not 0 … 65535");
+  }
+  *host = text.substr(0, colon);
+  *port = static_cast<std::uint16_t>(v);
+}
+
+std::uint32_t FixedFormCrc(const fw::FixedCalibration& cal) {
+  std::string bytes;
+  AppendLe(&bytes, cal.channel_count, 1);
+  for (std::size_t r = 0; r < fw::kAxes; ++r) {
+    for (std::size_t c = 0; c < cal.channel_count; ++c) {
+      AppendLe(&bytes, static_cast<std::uint64_t>(cal.coef[r][c]), 8);
+    }
+    AppendLe(&bytes, static_cast<std::uint64_t>(cal.bias[r]), 8);
+    AppendLe(&bytes, cal.shift[r], 1);
+  }
+  AppendLe(&bytes, static_cast<std::uint32_t>(cal.min_counts), 4);
+  AppendLe(&bytes, static_cast<std::uint32_t>(cal.max_counts), 4);
+  return cal::Crc32(bytes);
+}
+
+Ftd::Ftd(FtdOptions options) : opt_(std::move(options)) {}
+
+Ftd::~Ftd() { Stop(); }
+
+void Ftd::Start() {
+  if (running_) return;
+  std::uint8_t channels = 6;
+  try {
+    if (opt_.adc == "sim") {
+      model_ = sim::MakeDefaultSensor();
+      channels = static_cast<std::uint8_t>(model_->channel_count());
+      if (!opt_.replay.empty()) {
+        sim::ReadOptions ro;
+        ro.required = {"t"};
+        ro.require_wrench = true;
+        source_ = sim::ReplayWrench(sim::ReadRecording(opt_.replay, ro));
+      } else {
+        sim::Wrench w = sim::Wrench::Zero();
+        if (opt_.sim_wrench) {
+          for (int i = 0; i < 6; ++i) w(i) = (*opt_.sim_wrench)[static_cast<std::size_t>(i)];
+        }
+        source_ = std::make_unique<sim::ConstantWrench>(w);
+      }
+      sensor_ = std::make_unique<sim::SimulatedSensor>(*model_, *source_);
+      hal::sim::SimAdcParams params;
+      params.seed = opt_.seed;
+      params.realtime = opt_.paced;
+      params.noise_rms_mvv = sim::kDefaultNoiseMvv;
+      adc_ = std::make_unique<hal::sim::SimAdc>(*sensor_, params);
+    } else {
+      std::string error;
+      HardwareAdcOptions hw{opt_.adc, opt_.gpiochip, opt_.spidev, channels};
+      adc_ = MakeHardwareAdc(hw, &error);
+      if (adc_ == nullptr) throw FtdError(error);
+      if (opt_.cal.empty()) throw FtdError("--adc " + opt_.adc + " needs --cal CAL.json");
+    }
+  } catch (const FtdError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw FtdError(e.what());
+  }
+
+  fw::DeviceConfig cfg;
+  cfg.adc.channel_count = channels;
+  cfg.adc.rate_hz = opt_.rate_hz;
+  // Configure once to learn the ADC's scaling, which the fixed-point calibration is made for.
+  if (const hal::Status s = adc_->Configure(cfg.adc); s != hal::Status::kOk) {
+    throw FtdError(std::string("ADC configuration failed: ") + hal::ToString(s));
+  }
+  const hal::AdcInfo info = adc_->Info();
+  std::array<double, 6> rated{};
+  try {
+    if (opt_.cal.empty()) {
+      const cal::CalFile ideal = cal::IdealCalibration(*model_, info);
+      cfg.slots[0].fixed = cal::ToFixed(ideal, info);
+      cfg.slots[0].crc32 = FixedFormCrc(cfg.slots[0].fixed);
+      cfg.slots[0].present = true;
+      rated = ideal.rated;
+    } else {
+      cfg.slots[0] = SlotFromFile(opt_.cal, info, &rated);
+    }
+    if (!opt_.cal_b.empty()) cfg.slots[1] = SlotFromFile(opt_.cal_b, info, nullptr);
+  } catch (const std::exception& e) {
+    throw FtdError(e.what());
+  }
+  for (std::size_t i = 0; i < fw::kAxes; ++i) {
+    const double lsb = rated[i] / fw::AxisLsb(i);
+    if (!std::isfinite(lsb) || lsb < 0 || lsb > fw::kMaxRatedLsb) {
+      throw FtdError("calibration's rated range of axis " + std::to_string(i) + " is unusable");
+    }
+    cfg.rated_lsb[i] = static_cast<std::int32_t>(std::llround(lsb));
+  }
+  bool any_zero = false;
+  for (const std::int32_t r : cfg.rated_lsb) any_zero = any_zero || r == 0;
+  if (any_zero) cfg.rated_lsb = {};  // no complete rating: overload rule off
+
+  core_ = std::make_unique<fw::WrenchCore>();
+  device_ = std::make_unique<fw::Device>(*adc_, *core_);
+  switch (device_->Start(cfg)) {
+    case fw::DeviceStatus::kOk:
+      break;
+    case fw::DeviceStatus::kAdcConfig:
+      throw FtdError("ADC configuration failed");
+    case fw::DeviceStatus::kNoCalibration:
+      throw FtdError("no calibration in the initial slot");
+    case fw::DeviceStatus::kBadRated:
+      throw FtdError("rated range outside what the overload rule accepts");
+  }
+  map_ = std::make_unique<fw::RegisterMap>(*device_);
+
+  if (!opt_.modbus_tcp.empty()) {
+    std::string host;
+    std::uint16_t port = 0;
+    ParseHostPort(opt_.modbus_tcp, &host, &port);
+    tcp_ = std::make_unique<fw::ModbusTcpServer>(*map_);
+    const fw::ServerStatus s =
+        tcp_->Open(host.c_str(), port, static_cast<std::uint8_t>(opt_.unit_id));
+    if (s != fw::ServerStatus::kOk) {
+      throw FtdError("Modbus TCP on " + opt_.modbus_tcp + ": " + fw::ToString(s));
+    }
+  }
+  if (!opt_.modbus_rtu.empty()) {
+    rtu_ = std::make_unique<fw::ModbusRtuServer>(*map_);
+    const fw::ServerStatus s = rtu_->Open(opt_.modbus_rtu.c_str(), static_cast<int>(opt_.baud),
+                                          opt_.parity, static_cast<std::uint8_t>(opt_.unit_id));
+    if (s != fw::ServerStatus::kOk) {
+      throw FtdError("Modbus RTU on " + opt_.modbus_rtu + ": " + fw::ToString(s) + " (" +
+                     std::strerror(errno) + ")");
+    }
+  }
+  if (!opt_.log.empty()) {
+    std::FILE* f = std::fopen(opt_.log.c_str(), "w");
+    if (f == nullptr) throw FtdError(opt_.log + ": cannot write: " + std::strerror(errno));
+    std::fclose(f);
+    ring_.resize(kLogRingCapacity);
+  }
+
+  stop_ = false;
+  start_us_ = fw::MonotonicUs();
+  running_ = true;
+  threads_.emplace_back([this] { SamplingLoop(); });
+  if (tcp_) threads_.emplace_back([this] { tcp_->Run(stop_); });
+  if (rtu_) threads_.emplace_back([this] { rtu_->Run(stop_); });
+}
+
+void Ftd::SamplingLoop() {
+  bool published = false;
+  while (!stop_.load(std::memory_order_relaxed)) {
+    const hal::Status s = device_->Step(&published);
+    if (s == hal::Status::kEndOfData || s == hal::Status::kNotConfigured ||
+        s == hal::Status::kUnavailable) {
+      ended_ = true;
+      return;
+    }
+    if (s != hal::Status::kOk) continue;
+    samples_.fetch_add(1, std::memory_order_relaxed);
+    if (!published || ring_.empty()) continue;
+    const std::uint64_t head = ring_head_.load(std::memory_order_relaxed);
+    if (head - ring_tail_.load(std::memory_order_acquire) >= ring_.size()) {
+      log_dropped_.fetch_add(1, std::memory_order_relaxed);
+      continue;
+    }
+    ring_[head % ring_.size()] = device_->last_published();
+    ring_head_.store(head + 1, std::memory_order_release);
+  }
+}
+
+void Ftd::DrainLog() {
+  if (ring_.empty()) return;
+  const std::uint64_t head = ring_head_.load(std::memory_order_acquire);
+  std::uint64_t tail = ring_tail_.load(std::memory_order_relaxed);
+  if (tail == head) return;
+  const hal::AdcInfo& adc = device_->adc_info();
+  const double mvv_per_count =
+      adc.max_counts > 0 ? static_cast<double>(adc.full_scale_nvv) * 1e-6 / adc.max_counts : 0.0;
+  std::vector<double> row;
+  for (; tail != head; ++tail) {
+    const fw::DeviceSample& d = ring_[tail % ring_.size()];
+    const fw::PublishedSample& s = d.sample;
+    if (!writer_) {
+      std::vector<std::string> names{"t"};
+      for (std::size_t c = 0; c < s.channel_count; ++c) names.push_back("b" + std::to_string(c));
+      for (std::size_t c = 0; c < s.channel_count; ++c) names.push_back("raw" + std::to_string(c));
+      for (const std::string& n : sim::WrenchColumns()) names.push_back(n);
+      if (s.has_temperature) names.push_back("temp_C");
+      names.push_back("status");
+      std::vector<std::string> meta{"source: ftd", "adc: " + opt_.adc,
+                                    "rate_hz: " + std::to_string(opt_.rate_hz),
+                                    "wrench: measured (tool frame), N and N·m"};
+      writer_ = std::make_unique<sim::RecordingWriter>(opt_.log, meta, names);
+      log_started_ = true;
+    }
+    if (log_started_ && logged_rows_ > 0 && s.timestamp_us < last_log_timestamp_us_) {
+      log_time_base_us_ += std::uint64_t{1} << 32;  // the 32-bit µs timestamp wrapped
+    }
+    last_log_timestamp_us_ = s.timestamp_us;
+    row.clear();
+    row.push_back(static_cast<double>(log_time_base_us_ + s.timestamp_us) * 1e-6);
+    for (std::size_t c = 0; c < s.channel_count; ++c)
+      row.push_back(s.raw_counts[c] * mvv_per_count);
+    for (std::size_t c = 0; c < s.channel_count; ++c) row.push_back(s.raw_counts[c]);
+    for (std::size_t i = 0; i < fw::kAxes; ++i) row.push_back(s.wrench[i] * fw::AxisLsb(i));
+    if (s.has_temperature) row.push_back(s.temperature_mdegc * 1e-3);
+    row.push_back(s.status);
+    writer_->WriteRow(row);
+    ++logged_rows_;
+    last_logged_sequence_ = s.sequence;
+  }
+  ring_tail_.store(tail, std::memory_order_release);
+}
+
+void Ftd::Stop() {
+  if (!running_) return;
+  stop_ = true;
+  for (std::thread& t : threads_) t.join();
+  threads_.clear();
+  running_ = false;
+  DrainLog();
+  if (writer_) writer_->Flush();
+}
+
+std::uint16_t Ftd::tcp_port() const { return tcp_ ? tcp_->port() : 0; }
+
+const fw::ServerCounters* Ftd::tcp_counters() const { return tcp_ ? &tcp_->counters() : nullptr; }
+
+FtdStats Ftd::stats() const {
+  FtdStats s;
+  s.samples = samples_.load(std::memory_order_relaxed);
+  s.elapsed_s = static_cast<double>(fw::MonotonicUs() - start_us_) * 1e-6;
+  s.logged_rows = logged_rows_;
+  s.log_dropped = log_dropped_.load(std::memory_order_relaxed);
+  s.sampling_ended = ended_.load(std::memory_order_relaxed);
+  return s;
+}
+
+std::string Ftd::StatusLine() const {
+  fw::DeviceSample d{};
+  if (!device_ || !device_->ReadLatest(&d)) return "no sample";
+  const FtdStats st = stats();
+  char buf[256];
+  const auto& w = d.sample.wrench;
+  std::snprintf(buf, sizeof(buf),
+                "seq=%-9u F=[%9.3f %9.3f %9.3f] N  M=[%8.4f %8.4f %8.4f] N·m  status=0x%04x  "
+                "%.0f Hz",
+                d.sample.sequence, w[0] * fw::kForceLsbN, w[1] * fw::kForceLsbN,
+                w[2] * fw::kForceLsbN, w[3] * fw::kMomentLsbNm, w[4] * fw::kMomentLsbNm,
+                w[5] * fw::kMomentLsbNm, d.sample.status,
+                st.elapsed_s > 0 ? static_cast<double>(st.samples) / st.elapsed_s : 0.0);
+  std::string line = buf;
+  if (tcp_) {
+    line += "  tcp " + std::to_string(tcp_->counters().requests.load()) + " req";
+  }
+  return line;
+}
+
+}  // namespace ftstack::tools
