@@ -70,6 +70,34 @@ class Clock {
   virtual void SleepNs(std::int64_t ns) = 0;
 };
 
+/// Waits until `line` reads low or the clock passes deadline_ns: drops queued edges, checks the
+/// level, then sleeps on falling edges (or polls every 100 µs on a line without edge events).
+/// `low` says which happened. kOk, or kReadError when a GPIO call failed.
+[[nodiscard]] inline Status WaitForLow(InputLine& line, Clock& clock, std::int64_t deadline_ns,
+                                       bool& low) {
+  if (line.DiscardEdges() != Status::kOk) return Status::kReadError;
+  bool high = true;
+  if (line.Get(high) != Status::kOk) return Status::kReadError;
+  while (high) {
+    const std::int64_t left_ns = deadline_ns - clock.NowNs();
+    if (left_ns <= 0) {
+      low = false;
+      return Status::kOk;
+    }
+    bool rising = false;
+    const auto left_us = static_cast<std::uint32_t>((left_ns + 999) / 1000);
+    const Status s = line.WaitForEdge(left_us, rising);
+    if (s == Status::kNotConfigured) {
+      clock.SleepNs(left_ns < 100000 ? left_ns : 100000);
+    } else if (s != Status::kOk && s != Status::kTimeout) {
+      return Status::kReadError;
+    }
+    if (line.Get(high) != Status::kOk) return Status::kReadError;
+  }
+  low = true;
+  return Status::kOk;
+}
+
 /// Capacity of an error message buffer of a GPIO/SPI backend (one line, NUL-terminated).
 inline constexpr std::uint32_t kErrorTextSize = 160;
 

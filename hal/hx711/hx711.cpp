@@ -130,32 +130,6 @@ Status Hx711Adc::DoConfigure(const AdcConfig& config) {
   return Status::kOk;
 }
 
-Status Hx711Adc::WaitLow(std::size_t chip, std::int64_t deadline_ns, bool& low) {
-  gpio::InputLine& line = *params_.wiring[chip].data;
-  // Drop the edges of earlier reads first: an edge after the level check is then never missed.
-  if (line.DiscardEdges() != Status::kOk) return Status::kReadError;
-  bool high = true;
-  if (line.Get(high) != Status::kOk) return Status::kReadError;
-  while (high) {
-    const std::int64_t left_ns = deadline_ns - clock_.NowNs();
-    if (left_ns <= 0) {
-      low = false;
-      return Status::kOk;
-    }
-    bool rising = false;
-    const auto left_us = static_cast<std::uint32_t>((left_ns + 999) / 1000);
-    const Status s = line.WaitForEdge(left_us, rising);
-    if (s == Status::kNotConfigured) {
-      clock_.SleepNs(left_ns < 100000 ? left_ns : 100000);  // no edge events: poll every 100 µs
-    } else if (s != Status::kOk && s != Status::kTimeout) {
-      return Status::kReadError;
-    }
-    if (line.Get(high) != Status::kOk) return Status::kReadError;
-  }
-  low = true;
-  return Status::kOk;
-}
-
 Status Hx711Adc::DoWaitDataReady(std::uint32_t timeout_us) {
   if (!configured_) return Status::kNotConfigured;
   ready_ = false;
@@ -163,7 +137,7 @@ Status Hx711Adc::DoWaitDataReady(std::uint32_t timeout_us) {
   std::uint8_t missing = 0;
   for (std::size_t c = 0; c < info_.channel_count; ++c) {
     bool low = false;
-    if (WaitLow(c, deadline_ns, low) != Status::kOk) {
+    if (gpio::WaitForLow(*params_.wiring[c].data, clock_, deadline_ns, low) != Status::kOk) {
       ++counters_.line_errors;
       return Status::kReadError;
     }

@@ -110,7 +110,6 @@ class Hx711Adc final : public Adc {
   ReadResult ReadGroup(std::size_t g, std::uint8_t& stuck_mask);
   /// One PD_SCK pulse with its width bound measured; false when the GPIO call failed.
   bool Pulse(gpio::OutputLine& clock, std::int64_t& width_ns);
-  Status WaitLow(std::size_t chip, std::int64_t deadline_ns, bool& low);
   void ResetGroups();
 
   Hx711Params params_;
