@@ -52,7 +52,7 @@ case "$cmd" in
   run)
     build
     log "starting the simulated sensor daemon; poll it with:"
-    log "  mbpoll -m tcp -p 1502 -a 1 -t 3:float -B -r 7 -c 6 127.0.0.1"
+    log "  mbpoll -m tcp -p 1502 -a 1 -t 3:float -B -r 7 -c 6 -1 127.0.0.1   (README: more examples)"
     exec "$BUILD_DIR/bin/ftd" --adc sim --modbus-tcp 127.0.0.1:1502 "$@"
     ;;
   test)
