@@ -19,3 +19,26 @@ if [ -x "$B/bench_core" ]; then
         }
       }'
 fi
+
+# --- Modbus TCP (issue 5): ftd vs a plain libmodbus server, same 74 registers, same run -------
+if [ -x "$B/bench_modbus" ]; then
+  section "Modbus TCP, read 74 input registers: ftd (sampling at 8 kHz) vs plain libmodbus server"
+  FTSTACK_BENCH_SECONDS=${BENCH_MODBUS_SECONDS:-1} "$B/bench_modbus" --benchmark_format=csv 2>/dev/null |
+    awk -F, 'NR==1 { for (i = 1; i <= NF; ++i) { h=$i; gsub(/"/,"",h); col[h]=i }; next }
+      { n=$1; gsub(/"/,"",n); split(n, p, "/"); k=p[1] "/" p[2];
+        tx[k]=$col["tx_per_s"]; p50[k]=$col["p50_us"]; p99[k]=$col["p99_us"];
+        hz[k]=$col["sample_hz"]; err[k]=$col["errors"] }
+      END {
+        printf "  %-8s %12s %8s %8s   %12s %8s %8s   %6s %10s\n", "clients", "ftd tx/s", "p50 us",
+               "p99 us", "plain tx/s", "p50 us", "p99 us", "ratio", "ftd Hz";
+        for (c = 1; c <= 16; c *= 4) {
+          f="BM_FtdTcp/" c; q="BM_PlainTcp/" c;
+          if (tx[q] > 0) printf "  %-8d %12.0f %8.1f %8.1f   %12.0f %8.1f %8.1f   %6.2f %10.0f%s\n", c,
+            tx[f], p50[f], p99[f], tx[q], p50[q], p99[q], tx[f] / tx[q], hz[f],
+            (err[f] + err[q] > 0) ? "  (errors!)" : ""
+        }
+        u="BM_FtdUnpacedSampleRate/4";
+        printf "  ratio = ftd tx/s / plain tx/s; ftd Hz = sample rate the sampling thread sustained\n";
+        printf "  host sample rate, simulated ADC unpaced, 4 clients polling: %.0f Hz (%.0f tx/s)\n", hz[u], tx[u]
+      }'
+fi

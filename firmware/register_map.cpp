@@ -1,5 +1,7 @@
 #include "firmware/register_map.hpp"
 
+#include <sched.h>
+
 #include <bit>
 #include <limits>
 
@@ -92,7 +94,14 @@ ModbusException RegisterMap::ReadInput(std::uint16_t addr, std::uint16_t count,
     return ModbusException::kIllegalDataAddress;
   }
   DeviceSample d{};
-  if (!device_.ReadLatest(&d)) return ModbusException::kDeviceFailure;
+  // The writer may be preempted in the middle of a publication (odd sequence): let it run
+  // rather than spinning. Only a writer stuck for 1000 scheduler rounds gives exception 04.
+  bool got = device_.ReadLatest(&d);
+  for (int round = 0; !got && round < 1000; ++round) {
+    sched_yield();
+    got = device_.ReadLatest(&d);
+  }
+  if (!got) return ModbusException::kDeviceFailure;
   std::array<std::uint16_t, kInputRegisterCount> image{};
   BuildInputRegisters(d, device_.adc_info(), device_.NowUs(), &image);
   for (std::uint16_t i = 0; i < count; ++i) out[i] = image[addr + i];
