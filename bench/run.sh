@@ -42,3 +42,19 @@ if [ -x "$B/bench_modbus" ]; then
         printf "  host sample rate, simulated ADC unpaced, 4 clients polling: %.0f Hz (%.0f tx/s)\n", hz[u], tx[u]
       }'
 fi
+
+# --- crossed-strip pivot (issue 3): one solve, exact elastica vs Wittrick, same run ------------
+if [ -x "$B/bench_pivot" ]; then
+  section "crossed-strip pivot: one solve (CPU us) and Newton iterations, exact vs Wittrick (one run)"
+  "$B/bench_pivot" --benchmark_min_time="$MIN_TIME" --benchmark_format=csv 2>/dev/null |
+    awk -F, 'NR==1 { for (i = 1; i <= NF; ++i) { h = $i; gsub(/"/, "", h); col[h] = i }; next }
+      $1 ~ /BM_/ { gsub(/"/,"",$1); split($1, p, "/"); m = p[1]; sub("BM_Pivot", "", m)
+        key = p[2] "/" p[3] "/" p[4]; t[m, key] = $4; it[m, key] = $col["newton_iterations"]
+        v[key] = $col["valid"]; if (!(key in seen)) { seen[key] = 1; order[++n] = key } }
+      END {
+        printf "  %-22s %12s %12s %8s %8s %6s\n", "theta°/V N/H N", "exact us", "wittrick us", "it ex", "it wi", "valid"
+        for (k = 1; k <= n; ++k) { c = order[k]
+          printf "  %-22s %12.1f %12.1f %8d %8d %6d   exact/wittrick time = %.1f\n", c, t["Exact", c],
+            t["Wittrick", c], it["Exact", c], it["Wittrick", c], v[c], t["Exact", c] / t["Wittrick", c] }
+      }'
+fi

@@ -40,8 +40,9 @@ struct StressWeights {
 };
 StressWeights MakeStressWeights(const PivotGeometry& g);
 
-/// Fills valid/reason from converged, dc_dtheta, max_compression_n and max_stress_pa.
-void Judge(const PivotGeometry& g, PivotResult& r);
+/// Fills valid/reason from converged, dc_dtheta, max_compression_n and max_stress_pa. Without
+/// convergence the numbers become NaN and the reason adds a buckling diagnosis from statics.
+void Judge(const PivotGeometry& g, const PivotLoad& load, PivotResult& r);
 
 PivotResult SolveExact(const PivotGeometry& g, const PivotLoad& load, const PivotOptions& options);
 PivotResult SolveWittrick(const PivotGeometry& g, const PivotLoad& load,

@@ -32,18 +32,22 @@ NewtonOutcome NewtonSolve(const SystemFn& f, Eigen::VectorXd& u, double tau, int
     // Armijo: the directional derivative of ½|r|² along a Newton step is −|r|².
     double lambda = 1.0;
     bool accepted = false;
+    // Trial points are evaluated with their Jacobian: the accepted one (usually the full step)
+    // is then the next iterate without another evaluation.
     Eigen::VectorXd u_try(n), r_try(n);
+    Eigen::MatrixXd j_try(n, n);
     for (int halvings = 0; halvings < 30; ++halvings, lambda *= 0.5) {
       u_try = u + lambda * step;
-      if (!f(u_try, tau, r_try, nullptr) || !AllFinite(r_try)) continue;
+      if (!f(u_try, tau, r_try, &j_try) || !AllFinite(r_try)) continue;
       if (0.5 * r_try.squaredNorm() <= merit0 * (1.0 - 2e-4 * lambda)) {
         accepted = true;
         break;
       }
     }
     if (!accepted) return out;
-    u = u_try;
-    if (!f(u, tau, r, &j) || !AllFinite(r)) return out;
+    u.swap(u_try);
+    r.swap(r_try);
+    j.swap(j_try);
   }
 }
 

@@ -1,8 +1,10 @@
 // Crossed-strip flexure pivot: input checks, validity rules and the choice of formulation.
 #include "sim/pivot/pivot.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -64,7 +66,7 @@ PivotResult SolvePivot(const PivotGeometry& g, const PivotLoad& load, PivotMetho
   PivotResult r = method == PivotMethod::kExact ? detail::SolveExact(g, load, options)
                                                 : detail::SolveWittrick(g, load, options);
   r.method = method;
-  detail::Judge(g, r);
+  detail::Judge(g, load, r);
   return r;
 }
 
@@ -114,13 +116,29 @@ StressWeights MakeStressWeights(const PivotGeometry& g) {
   return {ei / l * 6.0 / (b * t * t), ei / (l * l) / (b * t)};
 }
 
-void Judge(const PivotGeometry& g, PivotResult& r) {
+void Judge(const PivotGeometry& g, const PivotLoad& load, PivotResult& r) {
   std::string reason;
   auto add = [&reason](const std::string& s) { reason += (reason.empty() ? "" : "; ") + s; };
   char buf[256];
   if (!r.converged) {
     std::snprintf(buf, sizeof buf, "no convergence after %d Newton iterations", r.iterations);
     add(buf);
+    // Say why where statics of the straight strips already does: N1·e1 + N2·e2 = (H, V).
+    const double sa = std::sin(g.alpha_rad), ca = std::cos(g.alpha_rad);
+    const double n1 = 0.5 * (load.v_n / ca + load.h_n / sa);
+    const double n2 = 0.5 * (load.v_n / ca - load.h_n / sa);
+    const double compression = std::max(-n1, -n2);
+    if (compression > g.EulerLoad()) {
+      std::snprintf(buf, sizeof buf,
+                    "buckled: the loads put %.4g N of compression in a straight strip, beyond "
+                    "the clamped-clamped Euler load 4*pi^2*EI/L^2 = %.4g N",
+                    compression, g.EulerLoad());
+      add(buf);
+    }
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    r.c_nm = r.dx_m = r.dy_m = r.dc_dtheta_nm_per_rad = r.max_stress_pa = nan;
+    r.max_compression_n = nan;
+    r.f = r.mb = r.axial_n = r.moment_b_nm = {nan, nan};
   } else {
     if (!(r.dc_dtheta_nm_per_rad > 0.0)) {
       std::snprintf(buf, sizeof buf,

@@ -94,7 +94,7 @@ struct PivotResult {
 void ValidateInputs(const PivotGeometry& g, const PivotLoad& load);
 
 /// Solves the pivot with the chosen formulation; never throws for valid inputs (non-convergence
-/// gives valid = false). Throws std::invalid_argument for invalid inputs (ValidateInputs).
+/// gives valid = false and NaN numbers). Throws std::invalid_argument for invalid inputs.
 [[nodiscard]] PivotResult SolvePivot(const PivotGeometry& g, const PivotLoad& load,
                                      PivotMethod method, const PivotOptions& options = {});
 
@@ -132,9 +132,10 @@ struct BeamColumnEnd {
   double m_b = 0.0;         ///< Moment at the body end, w''(1).
   double q = 0.0;           ///< Transverse end force (along the strip's normal n_i) on the strip.
   double shortening = 0.0;  ///< ½∫ w'² ds: axial approach of the ends due to bending.
-  double max_abs_m = 0.0;   ///< max |w''(s)|.
+  double max_abs_m = 0.0;   ///< max |w''(s)| (0 unless asked for).
   bool singular = false;    ///< True at a clamped–clamped buckling load (system singular).
 };
-[[nodiscard]] BeamColumnEnd SolveBeamColumn(double p, double w1, double theta);
+[[nodiscard]] BeamColumnEnd SolveBeamColumn(double p, double w1, double theta,
+                                            bool with_max_moment = true);
 
 }  // namespace ftstack::sim::pivot

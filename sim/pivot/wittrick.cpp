@@ -86,7 +86,7 @@ const GaussLegendre& Quadrature() {
 
 }  // namespace
 
-BeamColumnEnd SolveBeamColumn(double p, double w1, double theta) {
+BeamColumnEnd SolveBeamColumn(double p, double w1, double theta, bool with_max_moment) {
   BeamColumnEnd out;
   const Basis e = EvalBasis(p, 1.0);
   const double det = e.c * e.ds - e.s * e.dc;
@@ -108,7 +108,7 @@ BeamColumnEnd SolveBeamColumn(double p, double w1, double theta) {
   }
   out.shortening = 0.5 * integral;
   constexpr int kSamples = 64;
-  for (int i = 0; i <= kSamples; ++i) {
+  for (int i = 0; with_max_moment && i <= kSamples; ++i) {
     const Basis bi = EvalBasis(p, static_cast<double>(i) / kSamples);
     out.max_abs_m = std::max(out.max_abs_m, std::abs(a * bi.ddc + b * bi.dds));
   }
@@ -124,10 +124,11 @@ namespace {
 // conditions: w and θ drive the beam-column, and inextensibility asks u = −½∫w'². Equilibrium of
 // the body: Σ (p_i e_i + q_i n_i) = (h, v), forces written along the undeformed strip axes.
 struct WittrickSystem : DimensionlessPivot {
-  bool Strip(const Eigen::VectorXd& z, double th, int i, BeamColumnEnd& bc) const {
+  bool Strip(const Eigen::VectorXd& z, double th, int i, BeamColumnEnd& bc,
+             bool with_max_moment = false) const {
     const Eigen::Vector2d d(z[0], z[1]);
     const Eigen::Vector2d delta = d + (Rot(th) - Eigen::Matrix2d::Identity()) * strips[i].rho;
-    bc = SolveBeamColumn(z[2 + i], delta.dot(strips[i].n), th);
+    bc = SolveBeamColumn(z[2 + i], delta.dot(strips[i].n), th, with_max_moment);
     return !bc.singular;
   }
 
@@ -197,7 +198,7 @@ PivotResult SolveWittrick(const PivotGeometry& g, const PivotLoad& load,
   const StressWeights w = MakeStressWeights(g);
   for (int i = 0; i < 2; ++i) {
     BeamColumnEnd bc;
-    sys.Strip(z, sys.theta, i, bc);
+    sys.Strip(z, sys.theta, i, bc, true);
     res.f[i] = z[2 + i];
     res.mb[i] = bc.m_b;
     res.axial_n[i] = z[2 + i] * ei / (l * l);

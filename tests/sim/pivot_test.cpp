@@ -307,6 +307,12 @@ TEST(PivotValidity, BucklingYieldAndNonConvergenceAreReported) {
   weak.yield_pa = 1.3 * sigma_bending;
   EXPECT_TRUE(SolvePivot(weak, {theta, 0.0, 0.0}, PivotMethod::kExact).valid);
 
+  // Far beyond buckling the solver finds no equilibrium; the reason still names the buckling.
+  const PivotResult crushed = Exact(g, -45.0, -1000.0, 0.0);
+  EXPECT_FALSE(crushed.valid);
+  EXPECT_NE(crushed.reason.find("buckled"), std::string::npos) << crushed.reason;
+  EXPECT_TRUE(std::isnan(crushed.c_nm));
+
   PivotOptions starved;
   starved.max_iterations = 1;
   const PivotResult r = SolvePivot(g, {20 * kDeg, 10.0, 5.0}, PivotMethod::kExact, starved);
