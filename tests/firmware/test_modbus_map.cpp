@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "firmware/register_map.hpp"
+#include "hal/sim/sim_adc.hpp"
 #include "tests/firmware/fake_adc.hpp"
 
 namespace ftstack::fw {
@@ -570,6 +571,69 @@ TEST_F(RegisterMapTest, FaultsSaturationHoldsAndAdcTimeoutFlags) {
   EXPECT_NE(r[kInStatus] & kStatusAdcFault, 0);
   EXPECT_NE(r[kInStatus] & kStatusStale, 0);
   EXPECT_EQ(UnpackU32(&r[kInSequence]), 2u);  // no new sample
+}
+
+/// Constant bridge outputs for the simulated ADC.
+class ConstantBridges final : public hal::sim::BridgeSignalSource {
+ public:
+  [[nodiscard]] std::uint8_t channel_count() const override { return 6; }
+  [[nodiscard]] bool Sample(double, double* mvv, double* temperature_c) override {
+    for (int c = 0; c < 6; ++c) mvv[c] = 0.1 * (c + 1);
+    *temperature_c = 21.0;
+    return true;
+  }
+};
+
+TEST_F(RegisterMapTest, SimulatedAdcFaultsReachTheStatusRegister) {
+  ConstantBridges bridges;
+  hal::sim::SimAdcParams params;
+  params.realtime = false;
+  hal::sim::SimAdc sim_adc(bridges, params);
+  WrenchCore core;
+  Device device(sim_adc, core);
+  ASSERT_EQ(device.Start(cfg_), DeviceStatus::kOk);
+  RegisterMap map(device);
+  auto status = [&] {
+    std::uint16_t v = 0;
+    EXPECT_EQ(map.ReadInput(kInStatus, 1, &v), ModbusException::kNone);
+    return v;
+  };
+  auto step = [&](int n) {
+    hal::Status last = hal::Status::kOk;
+    for (int i = 0; i < n; ++i) {
+      bool published = false;
+      last = device.Step(&published);
+      g_now_us += 1000;
+    }
+    return last;
+  };
+  ASSERT_EQ(step(5), hal::Status::kOk);
+  EXPECT_EQ(status(), kStatusSimulated);
+  // No data-ready: ADC fault and stale, the wrench and sequence stay.
+  std::uint16_t seq_before[2];
+  ASSERT_EQ(map.ReadInput(kInSequence, 2, seq_before), ModbusException::kNone);
+  sim_adc.SetFault(hal::sim::SimFault::kNoDataReady);
+  EXPECT_EQ(step(3), hal::Status::kTimeout);
+  EXPECT_EQ(status() & (kStatusAdcFault | kStatusStale), kStatusAdcFault | kStatusStale);
+  std::uint16_t seq_after[2];
+  ASSERT_EQ(map.ReadInput(kInSequence, 2, seq_after), ModbusException::kNone);
+  EXPECT_EQ(UnpackU32(seq_after), UnpackU32(seq_before));
+  sim_adc.SetFault(hal::sim::SimFault::kNone);
+  ASSERT_EQ(step(1), hal::Status::kOk);
+  EXPECT_EQ(status(), kStatusSimulated);
+  // Open bridge: channel at the rail → saturated at once, bridge fault after 8 samples.
+  sim_adc.SetFault(hal::sim::SimFault::kOpenBridge, 2);
+  ASSERT_EQ(step(1), hal::Status::kOk);
+  EXPECT_NE(status() & kStatusSaturated, 0);
+  ASSERT_EQ(step(8), hal::Status::kOk);
+  EXPECT_NE(status() & kStatusBridgeFault, 0);
+  sim_adc.SetFault(hal::sim::SimFault::kNone);
+  ASSERT_EQ(step(1), hal::Status::kOk);
+  EXPECT_EQ(status(), kStatusSimulated);
+  // Stuck converter: identical counts for 64 samples → ADC fault.
+  sim_adc.SetFault(hal::sim::SimFault::kStuck);
+  ASSERT_EQ(step(70), hal::Status::kOk);
+  EXPECT_NE(status() & kStatusAdcFault, 0);
 }
 
 }  // namespace

@@ -221,6 +221,56 @@ TEST(FtdModbus, ExceptionsAndProtectedWritesOverTheWire) {
   EXPECT_EQ(ftd.Stop(SIGINT), 0);
 }
 
+TEST(FtdModbus, OverloadPeaksAndToolTransformEndToEnd) {
+  // Fz = 450 N on a 400 N axis (112 %): overloaded. 10 N along x acting 0.1 m above the sensor
+  // origin shows as My = +1 N·m at the sensor and as no moment at that tool point.
+  test::FtdProcess ftd(
+      {"--sim-wrench", "10,0,450,0,1,0", "--rate-hz", "1000", "--modbus-tcp", "127.0.0.1:0"});
+  ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
+  Client c(ftd.port());
+  ASSERT_TRUE(c.connected());
+  const Expected e = DeriveExpected();
+  ASSERT_TRUE(c.WaitSamples(200));
+  std::array<std::uint16_t, 74> r{};
+  ASSERT_EQ(c.Input(0, 74, r.data()), 74);
+  EXPECT_NE(r[fw::kInStatus] & fw::kStatusOverload, 0);
+  // One continuing overload is one event, not one per sample.
+  EXPECT_EQ(UnpackU32(&r[fw::kInOverloadEvents]), 1u);
+  // The peak is the largest |Fz| of ~200+ unfiltered samples: above the load, and not by more
+  // than the extreme of that many normal draws (≤ 5σ).
+  const double peak = UnpackFloat32(&r[fw::kInPeaks + 4]);
+  EXPECT_GT(peak, 450.0 - e.fixed_error_si[2]);
+  EXPECT_LT(peak, 450.0 + kSigmas * e.sigma_si[2] + e.fixed_error_si[2]);
+  // Clearing while the overload continues: the counter restarts at the ongoing event.
+  ASSERT_EQ(c.Write(fw::kHoldCommand, fw::kCmdClearPeaks), 1);
+  ASSERT_TRUE(c.WaitSamples(5));
+  ASSERT_EQ(c.Input(0, 74, r.data()), 74);
+  EXPECT_EQ(UnpackU32(&r[fw::kInOverloadEvents]), 1u);
+  EXPECT_LT(UnpackFloat32(&r[fw::kInPeaks + 4]),
+            450.0 + kSigmas * e.sigma_si[2] + e.fixed_error_si[2]);
+
+  // Tool transform: unlock, D = (0, 0, 0.1) m.
+  ASSERT_EQ(c.Write(fw::kHoldFilterLength, 256), 1);
+  ASSERT_EQ(c.Write(fw::kHoldUnlock, fw::kUnlockKey), 1);
+  std::vector<std::uint16_t> d(6);
+  fw::PackFloat32(0.0f, &d[0]);
+  fw::PackFloat32(0.0f, &d[2]);
+  fw::PackFloat32(0.1f, &d[4]);
+  ASSERT_EQ(c.WriteMany(fw::kHoldTransform, d), 6);
+  ASSERT_TRUE(c.WaitSamples(300));
+  ASSERT_EQ(c.Input(0, 30, r.data()), 30);
+  // My_tool = My − (D × F)_y = My − Dz·Fx: its noise is that of My and 0.1 × that of Fx.
+  const double sigma_my = std::hypot(e.sigma_si[4], 0.1 * e.sigma_si[0]) / std::sqrt(256.0);
+  EXPECT_NEAR(UnpackFloat32(&r[fw::kInWrenchFloat + 8]), 0.0,
+              kSigmas * sigma_my + e.fixed_error_si[4] + 0.1 * e.fixed_error_si[0] + 1e-5);
+  EXPECT_NEAR(UnpackFloat32(&r[fw::kInWrenchFloat]), 10.0,
+              kSigmas * e.sigma_si[0] / 16.0 + e.fixed_error_si[0] + 1e-5);
+  // Peaks stay in the sensor frame: the peak My is the sensor's 1 N·m.
+  EXPECT_NEAR(UnpackFloat32(&r[fw::kInPeaks + 8]), 1.0,
+              kSigmas * e.sigma_si[4] + e.fixed_error_si[4]);
+  EXPECT_EQ(ftd.Stop(), 0);
+}
+
 int RawConnect(int port) {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
   sockaddr_in a{};
