@@ -193,6 +193,7 @@ void Ftd::Start() {
 
   stop_ = false;
   start_us_ = fw::MonotonicUs();
+  stop_us_ = 0;
   running_ = true;
   threads_.emplace_back([this] { SamplingLoop(); });
   if (tcp_) threads_.emplace_back([this] { tcp_->Run(stop_); });
@@ -268,6 +269,7 @@ void Ftd::DrainLog() {
 void Ftd::Stop() {
   if (!running_) return;
   stop_ = true;
+  stop_us_ = fw::MonotonicUs();
   for (std::thread& t : threads_) t.join();
   threads_.clear();
   running_ = false;
@@ -282,7 +284,8 @@ const fw::ServerCounters* Ftd::tcp_counters() const { return tcp_ ? &tcp_->count
 FtdStats Ftd::stats() const {
   FtdStats s;
   s.samples = samples_.load(std::memory_order_relaxed);
-  s.elapsed_s = static_cast<double>(fw::MonotonicUs() - start_us_) * 1e-6;
+  const std::uint64_t end_us = stop_us_ != 0 ? stop_us_ : fw::MonotonicUs();
+  s.elapsed_s = static_cast<double>(end_us - start_us_) * 1e-6;
   s.logged_rows = logged_rows_;
   s.log_dropped = log_dropped_.load(std::memory_order_relaxed);
   s.sampling_ended = ended_.load(std::memory_order_relaxed);

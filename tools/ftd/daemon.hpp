@@ -124,6 +124,7 @@ class Ftd {
   std::atomic<bool> ended_{false};
   std::atomic<std::uint64_t> samples_{0};
   std::uint64_t start_us_ = 0;
+  std::uint64_t stop_us_ = 0;  ///< when Stop was called (0 while running)
   std::vector<std::thread> threads_;
   bool running_ = false;
 };
