@@ -7,6 +7,8 @@
 
 #include <atomic>
 #include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <thread>
 
@@ -269,6 +271,89 @@ TEST(FtdModbus, OverloadPeaksAndToolTransformEndToEnd) {
   EXPECT_NEAR(UnpackFloat32(&r[fw::kInPeaks + 8]), 1.0,
               kSigmas * e.sigma_si[4] + e.fixed_error_si[4]);
   EXPECT_EQ(ftd.Stop(), 0);
+}
+
+/// Bitwise CRC-32 (IEEE 802.3, reflected), written here independently of cal::Crc32.
+std::uint32_t BitwiseCrc32(const std::vector<std::uint8_t>& bytes) {
+  std::uint32_t c = 0xFFFFFFFFu;
+  for (const std::uint8_t b : bytes) {
+    c ^= b;
+    for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
+  }
+  return ~c;
+}
+
+std::uint32_t FileCrcField(const std::string& path) {
+  std::ifstream in(path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  return static_cast<std::uint32_t>(std::stoul(j.at("crc32").get<std::string>(), nullptr, 16));
+}
+
+TEST(FtdModbus, CalibrationSlotsAndTheirCrc) {
+  const auto model = sim::MakeDefaultSensor();
+  const hal::AdcInfo adc = cal::DefaultAdc(6);
+  // Built-in calibration: registers 72–73 hold the CRC-32 of the documented fixed-point layout.
+  {
+    const fw::FixedCalibration fixed = cal::ToFixed(cal::IdealCalibration(*model, adc), adc);
+    std::vector<std::uint8_t> bytes;
+    auto le = [&](std::uint64_t v, int n) {
+      for (int i = 0; i < n; ++i) bytes.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+    };
+    le(fixed.channel_count, 1);
+    for (std::size_t r = 0; r < 6; ++r) {
+      for (std::size_t ch = 0; ch < fixed.channel_count; ++ch) {
+        le(static_cast<std::uint64_t>(fixed.coef[r][ch]), 8);
+      }
+      le(static_cast<std::uint64_t>(fixed.bias[r]), 8);
+      le(fixed.shift[r], 1);
+    }
+    le(static_cast<std::uint32_t>(fixed.min_counts), 4);
+    le(static_cast<std::uint32_t>(fixed.max_counts), 4);
+    test::FtdProcess ftd({"--modbus-tcp", "127.0.0.1:0"});
+    ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
+    Client c(ftd.port());
+    std::uint16_t r[2];
+    ASSERT_EQ(c.Input(fw::kInCalCrc, 2, r), 2);
+    EXPECT_EQ(UnpackU32(r), BitwiseCrc32(bytes));
+    EXPECT_EQ(ftd.Stop(), 0);
+  }
+  // Two files: slot 0 the ideal calibration, slot 1 the same with a doubled matrix.
+  char dir[] = "/tmp/ftd_cal_XXXXXX";
+  const std::string base = mkdtemp(dir);
+  const std::string a = base + "/a.json", b = base + "/b.json";
+  cal::CalFile fa = cal::IdealCalibration(*model, adc);
+  cal::SaveCalFile(a, fa);
+  cal::CalFile fb = fa;
+  for (auto& row : fb.cal.matrix) {
+    for (double& m : row) m *= 2.0;
+  }
+  fb.serial = "slot-b";
+  cal::SaveCalFile(b, fb);
+  test::FtdProcess ftd(
+      {"--sim-wrench", "0,0,100,0,0,0", "--cal", a, "--cal-b", b, "--modbus-tcp", "127.0.0.1:0"});
+  ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
+  Client c(ftd.port());
+  const Expected e = DeriveExpected();
+  ASSERT_EQ(c.Write(fw::kHoldFilterLength, 256), 1);
+  ASSERT_TRUE(c.WaitSamples(300));
+  std::array<std::uint16_t, 74> r{};
+  ASSERT_EQ(c.Input(0, 74, r.data()), 74);
+  EXPECT_EQ(r[fw::kInCalSlot], 0);
+  EXPECT_EQ(UnpackU32(&r[fw::kInCalCrc]), FileCrcField(a));
+  const double tol = kSigmas * e.sigma_si[2] / 16.0 + e.fixed_error_si[2];
+  EXPECT_NEAR(UnpackFloat32(&r[fw::kInWrenchFloat + 4]), 100.0, tol);
+  ASSERT_EQ(c.Write(fw::kHoldUnlock, fw::kUnlockKey), 1);
+  ASSERT_EQ(c.Write(fw::kHoldCalSlot, 1), 1);
+  ASSERT_TRUE(c.WaitSamples(300));  // the switch restarts the filter
+  ASSERT_EQ(c.Input(0, 74, r.data()), 74);
+  EXPECT_EQ(r[fw::kInCalSlot], 1);
+  EXPECT_EQ(UnpackU32(&r[fw::kInCalCrc]), FileCrcField(b));
+  EXPECT_NE(FileCrcField(a), FileCrcField(b));
+  EXPECT_NEAR(UnpackFloat32(&r[fw::kInWrenchFloat + 4]), 200.0, 2 * tol + e.fixed_error_si[2]);
+  EXPECT_EQ(ftd.Stop(), 0);
+  std::remove(a.c_str());
+  std::remove(b.c_str());
+  rmdir(base.c_str());
 }
 
 int RawConnect(int port) {
