@@ -60,6 +60,11 @@ bool HandleRequest(RegisterMap& map, modbus_t* ctx, modbus_mapping_t* mapping,
   if (pdu_length < 1) return true;  // nothing to answer
   const std::uint8_t* pdu = req + header_length;
   const std::uint8_t function = pdu[0];
+  if ((function & 0x80u) != 0) {
+    // Codes 128–255 are exception responses, not requests; no exception code can answer them.
+    if (counters != nullptr) counters->dropped.fetch_add(1, std::memory_order_relaxed);
+    return true;
+  }
   ModbusException ex = ModbusException::kNone;
   std::array<std::uint16_t, MODBUS_MAX_READ_REGISTERS> values{};
   switch (function) {

@@ -45,8 +45,9 @@ struct ServerCounters {
 /// Decodes one request PDU (function code first) addressed to this slave, runs it on `map` and
 /// sends the reply through libmodbus (`req` is the whole ADU, `header_length` bytes before the
 /// function code). Quantities outside the Modbus limits or a PDU of the wrong length give 03,
-/// functions other than 03, 04, 06, 16 give 01. `reply` false (RTU broadcast) executes writes
-/// silently. Returns false when sending failed.
+/// functions other than 03, 04, 06, 16 give 01; a function code of 128 or more (the exception
+/// range) is dropped without reply. `reply` false (RTU broadcast) executes writes silently.
+/// Returns false when sending failed.
 [[nodiscard]] bool HandleRequest(RegisterMap& map, _modbus* ctx, _modbus_mapping_t* mapping,
                                  const std::uint8_t* req, int length, int header_length, bool reply,
                                  ServerCounters* counters);
