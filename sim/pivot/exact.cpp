@@ -11,8 +11,9 @@ namespace ftstack::sim::pivot {
 
 namespace {
 
-// State: phi, m, x, y, then the 4×3 sensitivity d(phi, m, x, y)/d(m0, fx, fy), row-major.
-using State = std::array<double, 16>;
+// State: phi, m, x, y, then the 4×3 sensitivity d(phi, m, x, y)/d(m0, fx, fy), row-major, then
+// the bending energy ½∫m² ds.
+using State = std::array<double, 17>;
 
 void Derivative(const State& y, double fx, double fy, State& dy) {
   const double c = std::cos(y[0]), s = std::sin(y[0]);
@@ -29,6 +30,7 @@ void Derivative(const State& y, double fx, double fy, State& dy) {
     dy[10 + k] = -s * s_phi;
     dy[13 + k] = c * s_phi;
   }
+  dy[16] = 0.5 * y[1] * y[1];
 }
 
 }  // namespace
@@ -61,19 +63,21 @@ ElasticaEnd IntegrateElastica(double phi0, double m0, double x0, double y0, doub
   State k1, k2, k3, k4, tmp;
   for (int i = 0; i < steps; ++i) {
     Derivative(y, fx, fy, k1);
-    for (int j = 0; j < 16; ++j) tmp[j] = y[j] + 0.5 * h * k1[j];
+    for (size_t j = 0; j < y.size(); ++j) tmp[j] = y[j] + 0.5 * h * k1[j];
     Derivative(tmp, fx, fy, k2);
-    for (int j = 0; j < 16; ++j) tmp[j] = y[j] + 0.5 * h * k2[j];
+    for (size_t j = 0; j < y.size(); ++j) tmp[j] = y[j] + 0.5 * h * k2[j];
     Derivative(tmp, fx, fy, k3);
-    for (int j = 0; j < 16; ++j) tmp[j] = y[j] + h * k3[j];
+    for (size_t j = 0; j < y.size(); ++j) tmp[j] = y[j] + h * k3[j];
     Derivative(tmp, fx, fy, k4);
-    for (int j = 0; j < 16; ++j) y[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+    for (size_t j = 0; j < y.size(); ++j)
+      y[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
     track(y);
   }
   end.phi = y[0];
   end.m = y[1];
   end.x = y[2];
   end.y = y[3];
+  end.energy = y[16];
   for (int r = 0; r < 4; ++r) {
     for (int k = 0; k < 3; ++k) end.sensitivity(r, k) = y[4 + 3 * r + k];
   }
@@ -187,6 +191,7 @@ PivotResult SolveExact(const PivotGeometry& g, const PivotLoad& load, const Pivo
     res.moment_b_nm[i] = ends[i].m * ei / l;
     res.max_stress_pa = std::max(res.max_stress_pa, ends[i].max_stress_index);
     res.max_compression_n = std::max(res.max_compression_n, ends[i].max_compression * ei / (l * l));
+    res.strain_energy_j += ends[i].energy * ei / l;
     if (options.want_shape) {
       for (auto& p : shapes[i]) p *= l;
       res.shape_m[i] = std::move(shapes[i]);

@@ -81,6 +81,7 @@ struct PivotResult {
   double dc_dtheta_nm_per_rad = 0.0;    ///< Rotational stiffness at the solution (N·m/rad).
   double max_stress_pa = 0.0;           ///< max over both strips of 6|M|/(b t²) + |N|/(b t).
   double max_compression_n = 0.0;       ///< Largest compressive axial force in either strip (N).
+  double strain_energy_j = 0.0;         ///< Bending energy of both strips (J); exact solver only.
   int iterations = 0;                   ///< Newton iterations used (all continuation steps).
   bool converged = false;
   bool valid = false;
@@ -114,6 +115,7 @@ struct ElasticaEnd {
   double max_abs_n = 0.0;                       ///< max |n(s)| (axial force, tension positive).
   double max_stress_index = 0.0;  ///< max over s of |m|·mw + |n|·nw (weights set by the caller).
   double max_compression = 0.0;   ///< max over s of -n(s) (0 if always in tension).
+  double energy = 0.0;            ///< Bending energy ½∫m² ds (units of EI/L).
 };
 
 /// Integrates phi' = m, m' = fx·sin(phi) − fy·cos(phi), x' = cos(phi), y' = sin(phi) from s = 0

@@ -1,6 +1,8 @@
 // The logic behind `ftsim pivot`: strict number parsing, solving, and text/JSON presentation.
 #include "sim/pivot/pivot_report.hpp"
 
+#include "sim/pivot/shape_registration.hpp"
+
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -73,6 +75,8 @@ int RunPivotCommand(const PivotCommandArgs& args, std::ostream& out, std::ostrea
   PivotGeometry g;
   PivotLoad load;
   PivotMethod method = kDefaultPivotMethod;
+  std::vector<Eigen::Vector2d> measured;
+  int strip = 1;
   try {
     constexpr double kDeg = std::numbers::pi / 180.0;
     g.e_pa = ParseFiniteNumber(args.e_pa, "--E");
@@ -87,13 +91,37 @@ int RunPivotCommand(const PivotCommandArgs& args, std::ostream& out, std::ostrea
     load.h_n = ParseFiniteNumber(args.h_n, "--H");
     method = ParsePivotMethod(args.method);
     ValidateInputs(g, load);
+    strip = args.strip == "1" ? 1 : args.strip == "2" ? 2 : 0;
+    if (strip == 0) throw std::invalid_argument("--strip: '" + args.strip + "' is not 1 or 2");
+    if (!args.shape_csv.empty()) measured = ReadPointsCsv(args.shape_csv);
   } catch (const std::invalid_argument& e) {
     err << "ftsim pivot: " << e.what() << '\n';
     return 2;
   }
-  const PivotResult r = SolvePivot(g, load, method);
+  PivotOptions options;
+  options.want_shape = !measured.empty();
+  const PivotResult r = SolvePivot(g, load, method, options);
+  nlohmann::json shape;  // null unless a shape was registered
+  if (!measured.empty() && r.converged) {
+    try {
+      const ShapeRegistration reg = RegisterShape(r.shape_m[strip - 1], measured);
+      shape = {{"strip", strip},
+               {"points", measured.size()},
+               {"scale_m_per_px", reg.measured_to_model.scale},
+               {"rotation_deg", reg.measured_to_model.AngleRad() * 180.0 / std::numbers::pi},
+               {"reflected", reg.measured_to_model.reflected},
+               {"rms_residual_m", reg.rms_residual_m},
+               {"max_residual_m", reg.max_residual_m},
+               {"rms_residual_px", reg.rms_residual_m / reg.measured_to_model.scale}};
+    } catch (const std::invalid_argument& e) {
+      err << "ftsim pivot: " << args.shape_csv << ":1:1: " << e.what() << '\n';
+      return 2;
+    }
+  }
   if (args.json) {
-    out << PivotResultToJson(g, load, r).dump() << '\n';
+    nlohmann::json j = PivotResultToJson(g, load, r);
+    if (!measured.empty()) j["shape"] = shape;
+    out << j.dump() << '\n';
     return 0;
   }
   out << "method            " << ToString(r.method) << '\n'
@@ -108,6 +136,11 @@ int RunPivotCommand(const PivotCommandArgs& args, std::ostream& out, std::ostrea
       << "iterations        " << r.iterations << '\n'
       << "valid             " << (r.valid ? "yes" : "no") << '\n';
   if (!r.valid) out << "reason            " << r.reason << '\n';
+  if (!shape.is_null()) {
+    out << "shape (strip " << strip << ")     registered RMS residual "
+        << shape["rms_residual_m"].get<double>() << " m (" << shape["rms_residual_px"].get<double>()
+        << " px), scale " << shape["scale_m_per_px"].get<double>() << " m/px\n";
+  }
   return 0;
 }
 

@@ -16,6 +16,10 @@ struct PivotCommandArgs {
   std::string lambda = "0.5";
   std::string method = "exact";
   bool json = false;
+  /// Optional: measured edge points of one strip (pixels, any frame; see ReadPointsCsv) to register
+  /// onto the model's deformed strip `strip` (1 or 2); adds a "shape" object to the output.
+  std::string shape_csv;
+  std::string strip = "1";
 };
 
 /// Parses a whole string as a finite double; throws std::invalid_argument naming `option`.
@@ -30,8 +34,9 @@ struct PivotCommandArgs {
 [[nodiscard]] nlohmann::json PivotResultToJson(const PivotGeometry& g, const PivotLoad& load,
                                                const PivotResult& r);
 
-/// Runs the command: prints the result to `out` (JSON or text) and returns 0; on bad input prints
-/// one line "ftsim pivot: <reason>" to `err` and returns 2.
+/// Runs the command: prints the result to `out` (JSON or text) and returns 0; on bad input
+/// (numbers, method, strip, shape file) prints one line "ftsim pivot: <reason>" to `err` and
+/// returns 2.
 int RunPivotCommand(const PivotCommandArgs& args, std::ostream& out, std::ostream& err);
 
 }  // namespace ftstack::sim::pivot

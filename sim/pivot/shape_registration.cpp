@@ -3,9 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 namespace ftstack::sim::pivot {
 
@@ -201,6 +204,62 @@ ShapeRegistration RegisterShape(const std::vector<Eigen::Vector2d>& model_m,
     best.max_residual_m = std::max(best.max_residual_m, best.residuals_m[k]);
   }
   return best;
+}
+
+std::vector<Eigen::Vector2d> ReadPointsCsv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument(path + ":1:1: cannot open the file");
+  std::vector<Eigen::Vector2d> points;
+  std::string line;
+  int line_no = 0;
+  bool first_data_line = true;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const size_t start = line.find_first_not_of(" \t");
+    if (start == std::string::npos || line[start] == '#') continue;
+    // Fields: maximal runs of characters other than separators.
+    std::vector<std::pair<size_t, std::string>> fields;
+    size_t k = 0;
+    while (k < line.size()) {
+      const size_t b = line.find_first_not_of(" \t,;", k);
+      if (b == std::string::npos) break;
+      const size_t e = line.find_first_of(" \t,;", b);
+      fields.emplace_back(b, line.substr(b, e == std::string::npos ? std::string::npos : e - b));
+      k = e == std::string::npos ? line.size() : e;
+    }
+    auto where = [&](size_t col) {
+      return path + ":" + std::to_string(line_no) + ":" + std::to_string(col + 1) + ": ";
+    };
+    double v[2] = {0.0, 0.0};
+    bool numeric = true;
+    for (size_t f = 0; f < fields.size() && f < 2; ++f) {
+      const char* b = fields[f].second.c_str();
+      char* e = nullptr;
+      v[f] = std::strtod(b, &e);
+      if (e == b || *e != '\0' || !std::isfinite(v[f])) {
+        if (first_data_line) {
+          numeric = false;
+          break;
+        }
+        throw std::invalid_argument(where(fields[f].first) + "'" + fields[f].second +
+                                    "' is not a finite number");
+      }
+    }
+    const bool header = first_data_line && !numeric;
+    first_data_line = false;
+    if (header) continue;
+    if (fields.size() != 2) {
+      throw std::invalid_argument(where(fields.size() > 2 ? fields[2].first : line.size()) +
+                                  "expected two numbers x,y");
+    }
+    points.emplace_back(v[0], v[1]);
+  }
+  if (points.size() < 3) {
+    throw std::invalid_argument(path + ":" + std::to_string(line_no + 1) +
+                                ":1: need at least 3 points, got " + std::to_string(points.size()));
+  }
+  return points;
 }
 
 }  // namespace ftstack::sim::pivot

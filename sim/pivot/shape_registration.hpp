@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <string>
 #include <vector>
 
 namespace ftstack::sim::pivot {
@@ -47,5 +48,10 @@ struct ShapeRegistration {
 [[nodiscard]] ShapeRegistration RegisterShape(const std::vector<Eigen::Vector2d>& model_m,
                                               const std::vector<Eigen::Vector2d>& measured_px,
                                               bool allow_reflection = true);
+
+/// Reads measured points, one "x,y" per line (comma, semicolon, tab or spaces between; '#' starts a
+/// comment line; an optional non-numeric header on the first line). Throws std::invalid_argument
+/// "FILE:LINE:COLUMN: reason" for anything else, non-finite numbers, or fewer than 3 points.
+[[nodiscard]] std::vector<Eigen::Vector2d> ReadPointsCsv(const std::string& path);
 
 }  // namespace ftstack::sim::pivot

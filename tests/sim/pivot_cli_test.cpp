@@ -6,8 +6,10 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <random>
 #include <string>
 #include <tuple>
 
@@ -86,6 +88,55 @@ TEST(PivotCli, BadNumbersGiveOneLineErrorAndNonZeroExit) {
   EXPECT_NE(method.exit_code, 0);
   const CliRun missing = Ftsim("--E 200e9 --theta-deg 5 2>&1");
   EXPECT_NE(missing.exit_code, 0);
+}
+
+// The camera experiment through the command line: points of the model's strip 2, "photographed"
+// at 3000 px/m (rotated 40°, mirrored, shifted, 0.3 px noise), written to a CSV file.
+TEST(PivotCli, ShapeCsvIsRegisteredOntoTheModelStrip) {
+  PivotOptions o;
+  o.want_shape = true;
+  const PivotResult model =
+      SolvePivot(PivotGeometry{}, {15 * std::numbers::pi / 180, 5.0, -3.0}, PivotMethod::kExact, o);
+  ASSERT_TRUE(model.valid);
+  const std::string path = ::testing::TempDir() + "pivot_shape_points.csv";
+  {
+    std::mt19937_64 rng(3);
+    std::normal_distribution<double> noise(0.0, 0.3);
+    const double a = 40 * std::numbers::pi / 180;
+    std::ofstream f(path);
+    f << "x_px,y_px\n";
+    for (const auto& p : model.shape_m[1]) {
+      const double x = 3000 * (std::cos(a) * p.x() - std::sin(a) * p.y()) + 800;
+      const double y = -3000 * (std::sin(a) * p.x() + std::cos(a) * p.y()) + 600;
+      f << x + noise(rng) << "," << y + noise(rng) << "\n";
+    }
+  }
+  const CliRun run =
+      Ftsim(kStrip + "--theta-deg 15 --V 5 --H -3 --json --strip 2 --shape-csv " + path);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const auto j = nlohmann::json::parse(run.out);
+  ASSERT_TRUE(j["shape"].is_object()) << run.out;
+  EXPECT_NEAR(j["shape"]["scale_m_per_px"].get<double>() * 3000, 1.0, 5e-3);
+  EXPECT_TRUE(j["shape"]["reflected"].get<bool>());
+  // 201 points: the normal noise component 0.3 px, RMS scatter ≈ 1/√402 = 5 %.
+  EXPECT_NEAR(j["shape"]["rms_residual_px"].get<double>() / 0.3, 1.0, 0.2);
+  // The same points against the model under 80 N of compression (an S-bent strip) fit far worse.
+  const auto other = nlohmann::json::parse(
+      Ftsim(kStrip + "--theta-deg 15 --V -80 --H -3 --json --strip 2 --shape-csv " + path).out);
+  EXPECT_GT(other["shape"]["rms_residual_px"].get<double>(), 5 * 0.3);
+
+  // A bad file: one line naming file, line and column.
+  const std::string bad = ::testing::TempDir() + "pivot_shape_bad.csv";
+  {
+    std::ofstream f(bad);
+    f << "x,y\n1,2\n3,4\n5,zz\n";
+  }
+  const CliRun broken =
+      Ftsim(kStrip + "--theta-deg 15 --V 5 --H -3 --json --shape-csv " + bad + " 2>&1");
+  EXPECT_EQ(broken.exit_code, 2);
+  EXPECT_NE(broken.out.find(bad + ":4:3: 'zz' is not a finite number"), std::string::npos)
+      << broken.out;
+  EXPECT_EQ(std::count(broken.out.begin(), broken.out.end(), '\n'), 1) << broken.out;
 }
 
 TEST(PivotCli, WittrickMethodIsSelectable) {

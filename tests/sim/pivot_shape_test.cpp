@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <numbers>
 #include <random>
+#include <string>
 
 #include "sim/pivot/pivot.hpp"
 #include "sim/pivot/shape_registration.hpp"
@@ -128,6 +130,37 @@ TEST(PivotShape, BadInputIsRejected) {
   EXPECT_THROW((void)RegisterShape(model, {{0, 0}, {1, 1}}), std::invalid_argument);
   EXPECT_THROW((void)RegisterShape(model, {{0, 0}, {1, 1}, {NAN, 2}}), std::invalid_argument);
   EXPECT_THROW((void)RegisterShape(model, {{1, 1}, {1, 1}, {1, 1}}), std::invalid_argument);
+}
+
+TEST(PivotShape, ReadPointsCsvAcceptsCommonLayoutsAndNamesTheFaultyPlace) {
+  const std::string path = ::testing::TempDir() + "pivot_points.csv";
+  {
+    std::ofstream f(path);
+    f << "# edge points\nx y\n1.5, 2\n3;4\r\n  5\t6\n\n";
+  }
+  const auto pts = ReadPointsCsv(path);
+  ASSERT_EQ(pts.size(), 3u);
+  EXPECT_EQ(pts[0], Eigen::Vector2d(1.5, 2));
+  EXPECT_EQ(pts[2], Eigen::Vector2d(5, 6));
+  auto error_of = [&](const std::string& text) {
+    {
+      std::ofstream f(path);
+      f << text;
+    }
+    try {
+      (void)ReadPointsCsv(path);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error_of("1,2\n3,nan\n5,6\n"), path + ":2:3: 'nan' is not a finite number");
+  EXPECT_EQ(error_of("1,2\n3,4,9\n5,6\n"), path + ":2:5: expected two numbers x,y");
+  EXPECT_EQ(error_of("1,2\n3\n5,6\n"), path + ":2:2: expected two numbers x,y");
+  EXPECT_EQ(error_of("1,2\n3,4\n"), path + ":3:1: need at least 3 points, got 2");
+  EXPECT_NE(error_of("").find(":1:1: need at least 3 points"), std::string::npos);
+  EXPECT_EQ(error_of("1,2\n"), path + ":2:1: need at least 3 points, got 1");
+  EXPECT_THROW((void)ReadPointsCsv(path + ".missing"), std::invalid_argument);
 }
 
 }  // namespace

@@ -28,6 +28,10 @@ void AddPivotCommand(CLI::App& app) {
                   "crossing point as a fraction of the strip length from the base, default 0.5");
   cmd->add_option("--method", args->method, "exact (default, elastica) or wittrick");
   cmd->add_flag("--json", args->json, "print one JSON object");
+  cmd->add_option("--shape-csv", args->shape_csv,
+                  "measured edge points x,y (pixels, any frame) of one strip: register them onto "
+                  "the model's deformed strip and report the shape residual");
+  cmd->add_option("--strip", args->strip, "strip the --shape-csv points belong to (1 or 2)");
   cmd->callback([args] {
     const int rc = sim::pivot::RunPivotCommand(*args, std::cout, std::cerr);
     std::cout.flush();
