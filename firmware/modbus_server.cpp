@@ -255,22 +255,29 @@ bool ModbusTcpServer::Service(Connection& c) {
   }
 }
 
+bool ModbusTcpServer::FramePending(const Connection& c) {
+  // A complete frame (or a header to refuse) already buffered: no new data will announce it.
+  return c.fd >= 0 && c.fill >= kMbapLength && c.fill >= 6u + Be16(&c.buf[4]);
+}
+
 void ModbusTcpServer::Run(const std::atomic<bool>& stop) {
   std::array<pollfd, kMaxTcpClients + 1> fds{};
   std::array<Connection*, kMaxTcpClients + 1> owner{};
   while (!stop.load(std::memory_order_relaxed)) {
     std::size_t n = 0;
+    bool pending = false;
     fds[n] = pollfd{listen_fd_, POLLIN, 0};
     owner[n++] = nullptr;
     for (Connection& c : conns_) {
       if (c.fd < 0) continue;
       fds[n] = pollfd{c.fd, POLLIN, 0};
       owner[n++] = &c;
+      pending = pending || FramePending(c);
     }
-    const int rc = ::poll(fds.data(), n, kPollMs);
-    if (rc <= 0) continue;
+    const int rc = ::poll(fds.data(), n, pending ? 0 : kPollMs);
+    if (rc < 0) continue;
     for (std::size_t i = 1; i < n; ++i) {
-      if (fds[i].revents == 0) continue;
+      if (fds[i].revents == 0 && !FramePending(*owner[i])) continue;
       if (!Service(*owner[i])) Close(*owner[i]);
     }
     if ((fds[0].revents & POLLIN) != 0) Accept();

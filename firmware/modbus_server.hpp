@@ -82,6 +82,7 @@ class ModbusTcpServer {
   /// Reads what is available and serves every complete frame; false when the connection must go.
   [[nodiscard]] bool Service(Connection& c);
   void Close(Connection& c);
+  [[nodiscard]] static bool FramePending(const Connection& c);
 
   RegisterMap& map_;
   int listen_fd_ = -1;
