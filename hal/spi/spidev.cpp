@@ -3,6 +3,8 @@
 #include <fcntl.h>
 #include <linux/spi/spidev.h>
 #include <sys/ioctl.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -29,6 +31,12 @@ Status Spidev::Open(const char* path, std::uint8_t mode, std::uint32_t speed_hz)
   if (mode > 3 || speed_hz == 0) return Fail("bad mode or clock rate", EINVAL);
   fd_ = open(path_.data(), O_RDWR | O_CLOEXEC);
   if (fd_ < 0) return Fail("cannot open", errno);
+  // spidev nodes are character devices of the fixed major 153 (SPIDEV_MAJOR); checking that
+  // first gives the same answer under qemu-user, which does not emulate unknown ioctls.
+  struct stat st {};
+  constexpr unsigned kSpidevMajor = 153;
+  if (fstat(fd_, &st) != 0) return Fail("cannot stat", errno);
+  if (!S_ISCHR(st.st_mode) || major(st.st_rdev) != kSpidevMajor) return Fail("open", ENOTTY);
   const std::uint8_t m = mode;
   const std::uint8_t bits = 8;
   if (ioctl(fd_, SPI_IOC_WR_MODE, &m) != 0) return Fail("cannot set the SPI mode", errno);
