@@ -58,3 +58,14 @@ if [ -x "$B/bench_pivot" ]; then
             t["Wittrick", c], it["Exact", c], it["Wittrick", c], v[c], t["Exact", c] / t["Wittrick", c] }
       }'
 fi
+
+# --- simulated recordings (issue 3): ms per in-process recording, rig at 200 Hz, same run -------
+if [ -x "$B/bench_record" ]; then
+  section "ftsim record in-process (sim::MakeRecording), builtin sensor, rig 200 Hz, CPU time (one run)"
+  "$B/bench_record" --benchmark_min_time="$MIN_TIME" --benchmark_format=csv 2>/dev/null |
+    awk -F, 'NR==1 { for (i = 1; i <= NF; ++i) { h = $i; gsub(/"/, "", h); col[h] = i }; next }
+      $1 ~ /BM_/ { gsub(/"/,"",$1); t[$1] = $4
+        printf "  %-22s %8.0f rows %8.1f ms CPU\n", $1, $col["rows"], $4 }
+      END { if (t["BM_RecordNone/300"] > 0) printf "  300 s: creep / none = %.2f, three effects / none = %.2f\n",
+            t["BM_RecordCreep/300"] / t["BM_RecordNone/300"], t["BM_RecordThree/300"] / t["BM_RecordNone/300"] }'
+fi

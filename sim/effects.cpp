@@ -70,7 +70,10 @@ const std::vector<EffectDef>& Defs() {
         {"channels", V::kChannels}}},
       {"resonance",
        EffectKind::kResonance,
-       {{"freq_hz", V::kNumber}, {"damping_ratio", V::kNumber}, {"channels", V::kChannels}}},
+       {{"freq_hz", V::kNumber},
+        {"damping_ratio", V::kNumber},
+        {"participation", V::kNumber},
+        {"channels", V::kChannels}}},
   };
   return defs;
 }
@@ -455,6 +458,10 @@ Effect ResolveEffect(const EffectSpec& s, const EffectContext& ctx, int index) {
       e.num["freq_hz"] = positive("freq_hz", NumOr(s, "freq_hz", 25.0));
       e.num["damping_ratio"] = positive("damping_ratio", NumOr(s, "damping_ratio", 0.04));
       if (e.num["damping_ratio"] >= 1.0) Range(s, "damping_ratio must be in (0, 1) (ringing)");
+      e.num["participation"] = NumOr(s, "participation", 0.01);
+      if (!(e.num["participation"] > 0.0) || e.num["participation"] > 1.0) {
+        Range(s, "participation must be in (0, 1]");
+      }
       break;
   }
   return e;
@@ -508,6 +515,21 @@ Eigen::MatrixXd Compose(const std::vector<Effect>& effects, const ComposeInput& 
   // 1. The load the sensor actually sees.
   constexpr int kPlays = 8;
   std::vector<std::array<double, 6 * kPlays>> play(effects.size());
+  std::vector<std::array<double, 6 * kPlays>> thresholds(effects.size());
+  std::vector<Eigen::Matrix3d> rot_t(effects.size(), Eigen::Matrix3d::Identity());
+  for (std::size_t ei = 0; ei < effects.size(); ++ei) {
+    const Effect& e = effects[ei];
+    if (e.kind == EffectKind::kHysteresis) {
+      for (int k = 0; k < 6; ++k) {
+        for (int j = 0; j < kPlays; ++j) {
+          thresholds[ei][static_cast<std::size_t>(k * kPlays + j)] =
+              e.num.at("width") * r(k) * (j + 1) / kPlays;
+        }
+      }
+    } else if (e.kind == EffectKind::kMisalignment) {
+      rot_t[ei] = Rotation(e.axis, e.num.at("angle_deg")).transpose();
+    }
+  }
   std::vector<Wrench> seen(ns);
   for (std::size_t i = 0; i < ns; ++i) {
     Wrench w = in.profile->LoadAt(in.t_s[i] - delay);
@@ -516,7 +538,7 @@ Eigen::MatrixXd Compose(const std::vector<Effect>& effects, const ComposeInput& 
       switch (e.kind) {
         case EffectKind::kMisalignment: {
           // Sensor frame rotated by angle about the axis: it sees the load's components Rᵀ·F, Rᵀ·M.
-          const Eigen::Matrix3d rt = Rotation(e.axis, e.num.at("angle_deg")).transpose();
+          const Eigen::Matrix3d& rt = rot_t[ei];
           const Eigen::Vector3d f = rt * w.head<3>();
           const Eigen::Vector3d m = rt * w.tail<3>();
           w.head<3>() = f;
@@ -539,7 +561,7 @@ Eigen::MatrixXd Compose(const std::vector<Effect>& effects, const ComposeInput& 
           Wrench d = Wrench::Zero();
           for (int k = 0; k < 6; ++k) {
             for (int j = 0; j < kPlays; ++j) {
-              const double thr = e.num.at("width") * r(k) * (j + 1) / kPlays;
+              const double thr = thresholds[ei][static_cast<std::size_t>(k * kPlays + j)];
               double& pj = p[static_cast<std::size_t>(k * kPlays + j)];
               pj = i == 0 ? w(k) : std::clamp(pj, w(k) - thr, w(k) + thr);
               d(k) += (pj - w(k)) / thr;
@@ -602,7 +624,11 @@ Eigen::MatrixXd Compose(const std::vector<Effect>& effects, const ComposeInput& 
         std::vector<double> u(ns);
         for (std::size_t i = 0; i < ns; ++i) u[i] = load(ch, static_cast<Eigen::Index>(i));
         const auto y = Filter(sys, c, Eigen::Vector2d(u[0], 0.0), u);
-        for (std::size_t i = 0; i < ns; ++i) load(ch, static_cast<Eigen::Index>(i)) = y[i];
+        // Only the mode's share of the output rings: L + p·(y − L).
+        const double p = e.num.at("participation");
+        for (std::size_t i = 0; i < ns; ++i) {
+          load(ch, static_cast<Eigen::Index>(i)) = u[i] + p * (y[i] - u[i]);
+        }
       }
     }
   }
