@@ -25,7 +25,7 @@ using Clock = std::chrono::steady_clock;
 
 double RunSeconds() {
   const char* s = std::getenv("FTSTACK_BENCH_SECONDS");
-  const double v = s != nullptr ? std::atof(s) : 1.0;
+  const double v = s != nullptr ? std::strtod(s, nullptr) : 1.0;
   return v > 0 ? v : 1.0;
 }
 
@@ -137,6 +137,7 @@ LoadResult Hammer(int port, int clients, double seconds) {
   std::atomic<std::uint64_t> errors{0};
   std::atomic<bool> go{false}, stop{false};
   std::vector<std::thread> threads;
+  threads.reserve(static_cast<std::size_t>(clients));
   for (int i = 0; i < clients; ++i) {
     threads.emplace_back([&, i] {
       modbus_t* c = modbus_new_tcp("127.0.0.1", port);

@@ -111,7 +111,9 @@ bool HandleRequest(RegisterMap& map, modbus_t* ctx, modbus_mapping_t* mapping,
         ex = ModbusException::kIllegalDataValue;
         break;
       }
-      for (std::uint16_t i = 0; i < count; ++i) values[i] = Be16(pdu + 6 + 2 * i);
+      for (std::uint16_t i = 0; i < count; ++i) {
+        values[i] = Be16(pdu + 6 + 2 * static_cast<std::size_t>(i));
+      }
       ex = map.WriteHolding(Be16(pdu + 1), values.data(), count);
       break;
     }

@@ -6,10 +6,9 @@
 #include <atomic>
 #include <cstdint>
 
-#include "firmware/register_map.hpp"
+#include <modbus/modbus.h>
 
-struct _modbus;
-struct _modbus_mapping_t;
+#include "firmware/register_map.hpp"
 
 namespace ftstack::fw {
 
@@ -48,7 +47,7 @@ struct ServerCounters {
 /// functions other than 03, 04, 06, 16 give 01; a function code of 128 or more (the exception
 /// range) is dropped without reply. `reply` false (RTU broadcast) executes writes silently.
 /// Returns false when sending failed.
-[[nodiscard]] bool HandleRequest(RegisterMap& map, _modbus* ctx, _modbus_mapping_t* mapping,
+[[nodiscard]] bool HandleRequest(RegisterMap& map, modbus_t* ctx, modbus_mapping_t* mapping,
                                  const std::uint8_t* req, int length, int header_length, bool reply,
                                  ServerCounters* counters);
 
@@ -88,8 +87,8 @@ class ModbusTcpServer {
   int listen_fd_ = -1;
   std::uint16_t port_ = 0;
   std::uint8_t unit_id_ = 1;
-  _modbus* ctx_ = nullptr;
-  _modbus_mapping_t* mapping_ = nullptr;
+  modbus_t* ctx_ = nullptr;
+  modbus_mapping_t* mapping_ = nullptr;
   std::array<Connection, kMaxTcpClients> conns_{};
   ServerCounters counters_{};
 };
@@ -110,8 +109,8 @@ class ModbusRtuServer {
 
  private:
   RegisterMap& map_;
-  _modbus* ctx_ = nullptr;
-  _modbus_mapping_t* mapping_ = nullptr;
+  modbus_t* ctx_ = nullptr;
+  modbus_mapping_t* mapping_ = nullptr;
   ServerCounters counters_{};
 };
 

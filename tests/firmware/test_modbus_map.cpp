@@ -3,6 +3,7 @@
 
 #include <Eigen/Dense>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -48,7 +49,7 @@ TEST(ModbusPacking, RoundTripsEveryBitPattern) {
     std::memcpy(&f, &u, 4);
     PackFloat32(f, r);
     const float g = UnpackFloat32(r);
-    EXPECT_EQ(std::memcmp(&f, &g, 4), 0);
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(g), u);  // bit for bit, NaN payloads included
     PackI32(static_cast<std::int32_t>(u), r);
     EXPECT_EQ(UnpackI32(r), static_cast<std::int32_t>(u));
   }
@@ -189,8 +190,9 @@ TEST(ToolTransform, MatchesDoubleReferenceWithinOneLsb) {
       // Final rounding (0.5 LSB) plus each coefficient's rounding (half a unit of 2^-shift)
       // times its input.
       double bound = 0.5;
-      for (std::size_t j = 0; j < kAxes; ++j)
+      for (std::size_t j = 0; j < kAxes; ++j) {
         bound += 0.5 * std::ldexp(std::fabs(w[j]), -t.shift[a]);
+      }
       EXPECT_NEAR(y[a], ref(static_cast<int>(a)) / AxisLsb(a), bound + 1e-9) << "axis " << a;
       EXPECT_LT(bound, 0.75);  // and the bound itself is tight: well under one LSB extra
     }
@@ -261,8 +263,9 @@ TEST(Seqlock, ReadersNeverSeeTornValues) {
     Stamped s{};
     for (std::uint32_t i = 1; i <= 100000; ++i) {
       s.seq = i;
-      for (std::size_t k = 0; k < s.payload.size(); ++k)
-        s.payload[k] = std::int64_t{i} * 1000003 + k;
+      for (std::size_t k = 0; k < s.payload.size(); ++k) {
+        s.payload[k] = std::int64_t{i} * 1000003 + static_cast<std::int64_t>(k);
+      }
       lock.Write(s);
       if (i % 4 == 0) std::this_thread::yield();  // a sampling thread also pauses between samples
     }

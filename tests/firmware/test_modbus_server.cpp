@@ -63,8 +63,9 @@ TEST(ModbusServerFuzz, RandomTcpRequestsGetWellFormedRepliesAndKeepRegistersVali
       }
       if (code == 0x10) {
         f.push_back(static_cast<std::uint8_t>(2 * count));
-        for (int k = 0; k < count; ++k)
+        for (int k = 0; k < count; ++k) {
           f.insert(f.end(), {0, static_cast<std::uint8_t>(rng() % 300)});
+        }
       }
       f[4] = 0;
       f[5] = static_cast<std::uint8_t>(f.size() - 6);
@@ -84,7 +85,7 @@ TEST(ModbusServerFuzz, RandomTcpRequestsGetWellFormedRepliesAndKeepRegistersVali
     EXPECT_EQ(rsp[1], 0x34);
     EXPECT_EQ((rsp[4] << 8) | rsp[5], n - 6);  // MBAP length matches what was sent
     if (rsp[7] == (function | 0x80)) {
-      EXPECT_TRUE(rsp[8] >= 1 && rsp[8] <= 3) << "exception " << int(rsp[8]);
+      EXPECT_TRUE(rsp[8] >= 1 && rsp[8] <= 3) << "exception " << static_cast<int>(rsp[8]);
       ++exceptions;
     } else {
       EXPECT_EQ(rsp[7], function);

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <system_error>
 #include <thread>
 
 #include "calibration/cal_file.hpp"
@@ -384,14 +385,16 @@ TEST(FtdModbus, GarbageAndHalfFramesDoNotDisturbOtherClients) {
       if (c.Input(0, 74, r.data()) == 74 && r[0] == 1) {
         ++ok;
       } else {
-        if (failed++ == 0)
+        if (failed++ == 0) {
           std::fprintf(stderr, "first failure: %s after %d ok\n", modbus_strerror(errno),
                        ok.load());
+        }
       }
     }
   });
-  for (int i = 0; i < 500 && ok == 0; ++i)
+  for (int i = 0; i < 500 && ok == 0; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
   if (ok == 0) {
     stop = true;
     good.join();
@@ -445,7 +448,8 @@ TEST(FtdModbus, GarbageAndHalfFramesDoNotDisturbOtherClients) {
     timeval tv{1, 0};
     setsockopt(fuzz, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
     const ssize_t n = recv(fuzz, rsp, sizeof(rsp), 0);
-    EXPECT_GT(n, 8) << "frame " << i << ": no reply (" << (n < 0 ? std::strerror(errno) : "closed")
+    EXPECT_GT(n, 8) << "frame " << i << ": no reply ("
+                    << (n < 0 ? std::system_category().message(errno) : std::string("closed"))
                     << ")";
     if (n <= 8) break;
     EXPECT_EQ(rsp[0], 0x12);  // transaction id echoed

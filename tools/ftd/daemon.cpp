@@ -4,6 +4,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <system_error>
 
 #include "calibration/cal_file.hpp"
 #include "calibration/ideal.hpp"
@@ -181,12 +182,14 @@ void Ftd::Start() {
                                           opt_.parity, static_cast<std::uint8_t>(opt_.unit_id));
     if (s != fw::ServerStatus::kOk) {
       throw FtdError("Modbus RTU on " + opt_.modbus_rtu + ": " + fw::ToString(s) + " (" +
-                     std::strerror(errno) + ")");
+                     std::system_category().message(errno) + ")");
     }
   }
   if (!opt_.log.empty()) {
     std::FILE* f = std::fopen(opt_.log.c_str(), "w");
-    if (f == nullptr) throw FtdError(opt_.log + ": cannot write: " + std::strerror(errno));
+    if (f == nullptr) {
+      throw FtdError(opt_.log + ": cannot write: " + std::system_category().message(errno));
+    }
     std::fclose(f);
     ring_.resize(kLogRingCapacity);
   }
@@ -253,8 +256,9 @@ void Ftd::DrainLog() {
     last_log_timestamp_us_ = s.timestamp_us;
     row.clear();
     row.push_back(static_cast<double>(log_time_base_us_ + s.timestamp_us) * 1e-6);
-    for (std::size_t c = 0; c < s.channel_count; ++c)
+    for (std::size_t c = 0; c < s.channel_count; ++c) {
       row.push_back(s.raw_counts[c] * mvv_per_count);
+    }
     for (std::size_t c = 0; c < s.channel_count; ++c) row.push_back(s.raw_counts[c]);
     for (std::size_t i = 0; i < fw::kAxes; ++i) row.push_back(s.wrench[i] * fw::AxisLsb(i));
     if (s.has_temperature) row.push_back(s.temperature_mdegc * 1e-3);

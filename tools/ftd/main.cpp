@@ -18,7 +18,8 @@ void OnSignal(int) { g_stop = true; }
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+int Run(int argc, char** argv) {
   using namespace ftstack;
   CLI::App app{"ftd — force/torque sensor daemon (firmware main loop on a board or host)"};
   tools::FtdOptions opt;
@@ -122,4 +123,14 @@ int main(int argc, char** argv) {
                st.elapsed_s > 0 ? static_cast<double>(st.samples) / st.elapsed_s : 0.0,
                st.log_dropped > 0 ? " — log dropped samples" : "");
   return 0;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return Run(argc, argv);
+  } catch (const std::exception& e) {  // nothing is expected here; never die with a trace
+    std::fprintf(stderr, "ftd: %s\n", e.what());
+    return 1;
+  }
 }
