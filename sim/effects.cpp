@@ -429,7 +429,10 @@ Effect ResolveEffect(const EffectSpec& s, const EffectContext& ctx, int index) {
       for (int k = 0; a && k < 6; ++k) {
         if (Lower(*a) == Lower(kLoadAxes[k])) e.axis = k;
       }
-      e.num["onset_s"] = NumOr(s, "onset_s", std::round(0.55 * ctx.duration_s * 10.0) / 10.0);
+      // Default: 55 % into the record (to 0.1 s), kept where the overload fits.
+      const double dflt = std::round(0.55 * ctx.duration_s * 10.0) / 10.0;
+      e.num["onset_s"] =
+          NumOr(s, "onset_s", std::clamp(dflt, 0.7, std::max(0.7, ctx.duration_s - 1.4)));
       if (e.num["onset_s"] < 0.7 || e.num["onset_s"] > ctx.duration_s - 1.4) {
         Range(s, "onset_s must leave 0.7 s before and 1.4 s after it inside the recording");
       }
