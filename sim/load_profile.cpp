@@ -247,6 +247,47 @@ std::string LineColumn(const std::string& text, std::size_t byte) {
   return std::to_string(lines + 1) + ":" + std::to_string(col);
 }
 
+// Byte offsets (0-based) where each element of the top-level object's array `key` starts, found
+// by a scan that skips strings; the text has already parsed as JSON. Empty if not found.
+std::vector<std::size_t> ArrayElementOffsets(const std::string& text, const std::string& key) {
+  std::vector<std::size_t> out;
+  int depth = 0;
+  bool in_array = false;  // inside the wanted array (at depth 2)
+  bool expect_element = false;
+  std::string last_string;
+  bool key_seen = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == ' ' || c == '\t' || c == '\n' || c == '\r') continue;
+    if (expect_element && c != ']') {
+      out.push_back(i);
+      expect_element = false;
+    }
+    if (c == '"') {
+      const std::size_t start = i + 1;
+      for (++i; i < text.size() && text[i] != '"'; ++i) {
+        if (text[i] == '\\') ++i;
+      }
+      last_string = text.substr(start, i - start);
+      continue;
+    }
+    if (c == ':' && depth == 1) key_seen = last_string == key;
+    if (c == '{' || c == '[') {
+      ++depth;
+      if (c == '[' && depth == 2 && key_seen) {
+        in_array = true;
+        expect_element = true;
+      }
+    } else if (c == '}' || c == ']') {
+      if (in_array && depth == 2) return out;
+      --depth;
+    } else if (c == ',' && in_array && depth == 2) {
+      expect_element = true;
+    }
+  }
+  return out;
+}
+
 LoadProfile FromJson(const std::string& path, double duration_s) {
   const std::string text = ReadText(path);
   nlohmann::json j;
@@ -261,9 +302,10 @@ LoadProfile FromJson(const std::string& path, double duration_s) {
   if (!j.contains("keyframes") || !j["keyframes"].is_array() || j["keyframes"].empty()) {
     throw ProfileError(path + ": 'keyframes' must be a non-empty array");
   }
+  // `what` starts with ": name" or ":LINE:COLUMN: name".
   auto num = [&](const nlohmann::json& v, const std::string& what) {
     if (!v.is_number() || !std::isfinite(v.get<double>())) {
-      throw ProfileError(path + ": " + what + " is not a finite number");
+      throw ProfileError(path + what + " is not a finite number");
     }
     return v.get<double>();
   };
@@ -271,19 +313,24 @@ LoadProfile FromJson(const std::string& path, double duration_s) {
   std::vector<Wrench> lw;
   std::vector<double> tt;
   std::vector<double> tc;
+  const std::vector<std::size_t> offsets = ArrayElementOffsets(text, "keyframes");
   std::size_t i = 0;
   for (const auto& k : j["keyframes"]) {
-    const std::string where = "keyframes[" + std::to_string(i++) + "]";
+    // "PATH:LINE:COLUMN: keyframes[i]" (the keyframe's opening brace), or without the position.
+    const std::string at = i < offsets.size() && offsets.size() == j["keyframes"].size()
+                               ? ":" + LineColumn(text, offsets[i] + 1)
+                               : "";
+    const std::string where = at + ": keyframes[" + std::to_string(i++) + "]";
     if (!k.is_object() || !k.contains("t_s") || !k.contains("wrench")) {
-      throw ProfileError(path + ": " + where + " needs 't_s' and 'wrench'");
+      throw ProfileError(path + where + " needs 't_s' and 'wrench'");
     }
     const double t = num(k["t_s"], where + ".t_s");
     if (!lt.empty() && !(t > lt.back())) {
-      throw ProfileError(path + ": " + where + ".t_s does not increase");
+      throw ProfileError(path + where + ".t_s does not increase");
     }
     const auto& wj = k["wrench"];
     if (!wj.is_array() || wj.size() != 6) {
-      throw ProfileError(path + ": " + where + ".wrench needs 6 numbers Fx,Fy,Fz,Mx,My,Mz");
+      throw ProfileError(path + where + ".wrench needs 6 numbers Fx,Fy,Fz,Mx,My,Mz");
     }
     Wrench w;
     for (std::size_t c = 0; c < 6; ++c) w(static_cast<int>(c)) = num(wj[c], where + ".wrench");
@@ -303,7 +350,7 @@ LoadProfile FromJson(const std::string& path, double duration_s) {
   }
   double rate = 200.0;
   if (j.contains("rate_hz")) {
-    rate = num(j["rate_hz"], "rate_hz");
+    rate = num(j["rate_hz"], ": rate_hz");
     if (rate <= 0.0) throw ProfileError(path + ": rate_hz must be positive");
   }
   const double dur = duration_s > 0.0 ? duration_s : lt.back();

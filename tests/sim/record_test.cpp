@@ -150,8 +150,19 @@ TEST(RecordProfiles, BadFilesNameTheFaultyPlace) {
     std::ofstream(dir + "/dec.json")
         << R"({"schema": "ftstack-profile/1", "keyframes": [{"t_s": 1, "wrench": [0,0,0,0,0,0]}, {"t_s": 1, "wrench": [0,0,0,0,0,0]}]})";
   }
-  EXPECT_NE(ErrorOf(dir + "/dec.json").find("keyframes[1].t_s does not increase"),
-            std::string::npos);
+  // The second keyframe's brace is at column 84 of line 1.
+  EXPECT_NE(ErrorOf(dir + "/dec.json").find("dec.json:1:84: keyframes[1].t_s does not increase"),
+            std::string::npos)
+      << ErrorOf(dir + "/dec.json");
+  {
+    std::ofstream(dir + "/str.json") << "{\"schema\": \"ftstack-profile/1\", \"keyframes\": [\n"
+                                        "  {\"t_s\": 0, \"wrench\": [0,0,0,0,0,0]},\n"
+                                        "  {\"t_s\": \"1,]\", \"wrench\": [0,0,0,0,0,0]}]}";
+  }
+  EXPECT_NE(
+      ErrorOf(dir + "/str.json").find("str.json:3:3: keyframes[1].t_s is not a finite number"),
+      std::string::npos)
+      << ErrorOf(dir + "/str.json");
   { std::ofstream(dir + "/bad.csv") << "t,Fx,Fy,Fz,Mx,My,Mz\n0,0,0,0,0,0,0\n1,0,nan,0,0,0,0\n"; }
   EXPECT_NE(ErrorOf(dir + "/bad.csv").find("bad.csv:3:"), std::string::npos)
       << ErrorOf(dir + "/bad.csv");
