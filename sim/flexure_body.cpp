@@ -230,7 +230,8 @@ GaugeStrain FlexureBody::StrainAt(const GaugeSite& site, const Wrench& w) const 
   return GaugeStrain{e(0), e(1)};
 }
 
-double FlexureBody::MaxSurfaceStrain(const Wrench& range) const {
+double FlexureBody::MaxSurfaceStrain(
+    const std::function<double(const Eigen::Matrix<double, 1, 6>&)>& worst_of) const {
   double worst = 0;
   const double hb = 0.5 * g_.beam_width_m;
   const double hh = 0.5 * g_.beam_height_m;
@@ -242,8 +243,7 @@ double FlexureBody::MaxSurfaceStrain(const Wrench& range) const {
           const Eigen::Matrix<double, 1, 6> sigma = sec.row(0) / section_.area_m2 +
                                                     sec.row(4) * (z / section_.iy_m4) -
                                                     sec.row(5) * (y / section_.iz_m4);
-          worst =
-              std::max(worst, sigma.cwiseAbs().dot(range.cwiseAbs().transpose()) / section_.e_pa);
+          worst = std::max(worst, worst_of(sigma / section_.e_pa));
         }
       }
     }

@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "sim/beam_element.hpp"
@@ -78,9 +79,11 @@ class FlexureBody {
   [[nodiscard]] Eigen::Matrix<double, 2, 6> StrainMatrix(const GaugeSite& site) const;
   /// Strain of a gauge at `site` under w.
   [[nodiscard]] GaugeStrain StrainAt(const GaugeSite& site, const Wrench& w) const;
-  /// Largest |normal strain| at any section corner of any beam end (where bending peaks) for any
-  /// load inside the box |w_j| ≤ range_j (the worst-case combination).
-  [[nodiscard]] double MaxSurfaceStrain(const Wrench& range) const;
+  /// Largest |normal strain| at any section corner of any beam end (where bending peaks), each
+  /// corner's linear map wrench → strain (1×6) reduced to a number by `worst` (e.g. the maximum
+  /// over a load envelope).
+  [[nodiscard]] double MaxSurfaceStrain(
+      const std::function<double(const Eigen::Matrix<double, 1, 6>&)>& worst) const;
 
  private:
   [[nodiscard]] Eigen::Matrix<double, 6, 6> SectionMatrix(int beam, double position_m) const;

@@ -28,7 +28,9 @@ SimAdc::SimAdc(BridgeSignalSource& source, const SimAdcParams& params)
 Status SimAdc::DoConfigure(const AdcConfig& config) {
   if (params_.resolution_bits < 8 || params_.resolution_bits > 31 || params_.reference_ratio <= 0 ||
       config.gain == 0 || config.channel_count != source_.channel_count() ||
-      config.rate_hz > 1000000) {
+      config.rate_hz > 1000000 ||
+      (params_.required_gain != 0 && config.gain != params_.required_gain) ||
+      (params_.required_rate_hz != 0 && config.rate_hz != params_.required_rate_hz)) {
     return Status::kInvalidArgument;
   }
   const std::int64_t half = std::int64_t{1} << (params_.resolution_bits - 1);

@@ -39,6 +39,11 @@ struct SimAdcParams {
   double noise_rms_mvv = 1.0e-4;  ///< input-referred white noise per channel, mV/V RMS
   std::uint64_t seed = 1;         ///< noise seed: equal seeds give equal sample streams
   bool realtime = false;          ///< pace WaitDataReady to the wall clock (false: virtual time)
+  /// Operating point the noise figure belongs to (a converter model's gain and data rate, see
+  /// sim/adc_models.hpp). 0 accepts any; otherwise Configure rejects another value with
+  /// kInvalidArgument, so the noise of the counts always matches the configuration.
+  std::uint16_t required_gain = 0;
+  std::uint32_t required_rate_hz = 0;
 };
 
 /// Simulated ratiometric delta-sigma ADC. counts = round(mV/V · max_counts / full_scale_mvv +
