@@ -69,3 +69,13 @@ if [ -x "$B/bench_record" ]; then
       END { if (t["BM_RecordNone/300"] > 0) printf "  300 s: creep / none = %.2f, three effects / none = %.2f\n",
             t["BM_RecordCreep/300"] / t["BM_RecordNone/300"], t["BM_RecordThree/300"] / t["BM_RecordNone/300"] }'
 fi
+
+# --- physics (issue 3): full-chain sample wrench → counts, physical vs linear model, same run ---
+if [ -x "$B/bench_physics" ]; then
+  section "physics: one full-chain sample (wrench -> strains -> bridges -> counts) and model build"
+  "$B/bench_physics" --benchmark_min_time="$MIN_TIME" --benchmark_format=csv 2>/dev/null |
+    awk -F, 'NR>1 && $1 ~ /BM_/ { gsub(/"/,"",$1); t[$1]=$3; printf "  %-26s %12.1f ns\n", $1, $3 }
+      END { if (t["BM_FullChainSample/1"] > 0)
+              printf "  full chain, physical/linear model = %.2f; model build %.1f us\n",
+                     t["BM_FullChainSample/0"] / t["BM_FullChainSample/1"], t["BM_BuildModel"] / 1000 }'
+fi
