@@ -394,6 +394,9 @@ SensorDescription ParseSensorDescription(const std::string& text, const std::str
   d.adc_spec = ReadAdc(rd, type == "flexure" ? &flexure : nullptr);
   const AdcOperatingPoint op = MakeAdcOperatingPoint(d.adc_spec);
   d.adc = op.params;
+  // The noise figure is the one at rate_hz, but recordings and ftd run the description's converter
+  // at the rate they need: only AdcParamsAt() pins the rate (and its noise) in the HAL.
+  d.adc.required_rate_hz = 0;
   d.adc_gain = d.adc_spec.gain;
   d.rate_hz = d.adc_spec.rate_hz;
   return d;

@@ -23,8 +23,10 @@ class SensorDescriptionError : public std::runtime_error {
 struct SensorDescription {
   std::string name;
   std::shared_ptr<const SensorModel> model;
-  AdcSpec adc_spec;            ///< the converter model (chip, gain, rate, excitation)
-  hal::sim::SimAdcParams adc;  ///< its operating point: noise (mV/V RMS), span, required gain/rate
+  AdcSpec adc_spec;  ///< the converter model (chip, gain, rate, excitation)
+  /// Its operating point at rate_hz: noise (mV/V RMS), span, required gain. The rate is left free
+  /// (required_rate_hz = 0) so callers may run other rates; AdcParamsAt gives their exact noise.
+  hal::sim::SimAdcParams adc;
   std::uint16_t adc_gain = 128;  ///< PGA gain
   double rate_hz = 1000.0;       ///< sample rate, Hz
 };

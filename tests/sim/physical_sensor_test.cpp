@@ -178,7 +178,12 @@ TEST(DefaultSensor, ShippedFileIsTheCompiledInDescription) {
   const SensorDescription d =
       LoadSensorDescription(std::string(FTSTACK_SOURCE_DIR) + "/sim/sensors/default.json");
   EXPECT_EQ(d.adc_spec.chip, AdcChip::kAds131m0x);
-  EXPECT_EQ(d.adc.required_rate_hz, 1000u);
+  EXPECT_EQ(d.adc.required_gain, 128u);
+  EXPECT_EQ(d.adc.required_rate_hz, 0u);
+  const hal::sim::SimAdcParams at2k = AdcParamsAt(d, 2000);
+  EXPECT_EQ(at2k.required_rate_hz, 2000u);
+  EXPECT_NEAR(at2k.noise_rms_mvv, 1.00e-3 / 3.3, 1e-15);  // datasheet: 1.00 µV at 2 kSPS, gain 128
+  EXPECT_THROW((void)AdcParamsAt(d, 100), std::invalid_argument);
 }
 
 std::string ErrorOf(const std::string& text) {
