@@ -190,6 +190,24 @@ TEST(PivotExact, CoupleIsTheDerivativeOfThePotentialEnergy) {
   }
 }
 
+TEST(PivotExact, MirrorSymmetry) {
+  // Mirroring x → −x maps the pivot onto itself with the strips swapped: θ → −θ, H → −H,
+  // dX → −dX, C → −C, while dY and the strip quantities (swapped) stay.
+  const PivotGeometry g = ReportStrip(50.0);
+  for (const PivotMethod m : {PivotMethod::kExact, PivotMethod::kWittrick}) {
+    const PivotResult a = SolvePivot(g, {17 * kDeg, 7.0, 4.0}, m);
+    const PivotResult b = SolvePivot(g, {-17 * kDeg, 7.0, -4.0}, m);
+    ASSERT_TRUE(a.converged && b.converged);
+    EXPECT_NEAR(a.c_nm, -b.c_nm, 1e-9 * std::abs(a.c_nm));
+    EXPECT_NEAR(a.dx_m, -b.dx_m, 1e-9 * g.length_m);
+    EXPECT_NEAR(a.dy_m, b.dy_m, 1e-9 * g.length_m);
+    EXPECT_NEAR(a.f[0], b.f[1], 1e-7 * (1 + std::abs(a.f[0])));
+    EXPECT_NEAR(a.mb[0], -b.mb[1], 1e-7 * (1 + std::abs(a.mb[0])));
+    EXPECT_NEAR(a.dc_dtheta_nm_per_rad, b.dc_dtheta_nm_per_rad,
+                1e-6 * std::abs(a.dc_dtheta_nm_per_rad));
+  }
+}
+
 TEST(PivotExact, DiscretisationIsConverged) {
   // RK4 error scales as h⁴: 200 steps against 800 steps bounds the error of the default.
   const PivotGeometry g = ReportStrip();
