@@ -1,5 +1,6 @@
 #include "calibration/apply.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "firmware/core.hpp"
@@ -22,12 +23,18 @@ sim::Recording ApplyCalibration(const CalFile& cal, const sim::Recording& in) {
   std::vector<std::vector<double>> out(7, std::vector<double>(rows));
   std::vector<double> status(rows);
   const bool has_t = in.Has("t");
+  const std::vector<double>* temp = in.Has("temp_C") ? &in.Column("temp_C") : nullptr;
   hal::AdcSample sample{};
   sample.channel_count = static_cast<std::uint8_t>(n);
   hal::AdcInfo rails = cal.adc;
   fw::CoreOutput o{};
   for (std::size_t i = 0; i < rows; ++i) {
     sample.flags = {};
+    sample.has_temperature = temp != nullptr;
+    sample.temperature_mdegc =
+        temp != nullptr
+            ? static_cast<std::int32_t>(std::lround(std::clamp((*temp)[i], -1e6, 1e6) * 1000.0))
+            : 0;
     for (std::size_t c = 0; c < n; ++c) {
       double v = std::nearbyint((*b[c])[i] * counts_per_input);
       if (v > rails.max_counts) v = rails.max_counts;

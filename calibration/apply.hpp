@@ -8,7 +8,8 @@ namespace ftstack::cal {
 
 /// Converts each row's b* columns (in the file's input unit) to counts of the calibration's ADC
 /// (rounded, clipped at the rails), runs fw::WrenchCore on them and returns a recording with
-/// columns t,Fx,Fy,Fz,Mx,My,Mz in N and N·m (plus `status`).
+/// columns t,Fx,Fy,Fz,Mx,My,Mz in N and N·m (plus `status`). A `temp_C` column, where present,
+/// feeds the core's temperature compensation (as m°C, like hal::AdcSample).
 [[nodiscard]] sim::Recording ApplyCalibration(const CalFile& cal, const sim::Recording& in);
 
 }  // namespace ftstack::cal

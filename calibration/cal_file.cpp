@@ -98,17 +98,62 @@ nlohmann::json ToJson(const CalFile& f) {
   j["bias"] = f.cal.bias;
   j["rated"] = f.rated;
   j["uncertainty"] = f.uncertainty;
+  if (f.cal.product_count > 0) {
+    json terms = json::array();
+    json pm = json::array();
+    for (std::size_t k = 0; k < f.cal.product_count; ++k) {
+      terms.push_back({f.cal.products[k].a, f.cal.products[k].b});
+    }
+    for (std::size_t r = 0; r < 6; ++r) {
+      pm.push_back(std::vector<double>(f.cal.product_matrix[r].begin(),
+                                       f.cal.product_matrix[r].begin() + f.cal.product_count));
+    }
+    j["model"] = {{"products", terms}, {"product_matrix", pm}};
+  }
+  if (f.cal.temperature_compensated) {
+    j["temperature"] = {
+        {"ref_C", f.cal.temp_ref_c},
+        {"min_C", f.cal.temp_min_c},
+        {"max_C", f.cal.temp_max_c},
+        {"bias_slope_mvv_per_C", std::vector<double>(f.cal.bias_slope_mvv_per_c.begin(),
+                                                     f.cal.bias_slope_mvv_per_c.begin() + n)},
+        {"gain_slope_per_C",
+         std::vector<double>(f.cal.gain_slope_per_c.begin(), f.cal.gain_slope_per_c.begin() + n)}};
+  }
   fw::LoadReport rep{};
   const fw::FixedCalibration fx = ToFixed(f, f.adc, &rep);
   json fp = json::object();
   fp["shift"] = fx.shift;
   json coef = json::array();
+  const std::size_t features = n + fx.extra_count;
   for (std::size_t r = 0; r < 6; ++r) {
-    coef.push_back(std::vector<std::int64_t>(fx.coef[r].begin(), fx.coef[r].begin() + n));
+    coef.push_back(std::vector<std::int64_t>(fx.coef[r].begin(), fx.coef[r].begin() + features));
   }
   fp["coef"] = coef;
   fp["bias"] = fx.bias;
+  json feats = json::array();
+  for (std::size_t c = 0; c < n; ++c) feats.push_back("counts" + std::to_string(c));
+  for (std::size_t k = 0; k < fx.extra_count; ++k) {
+    const fw::FixedFeature& e = fx.extra[k];
+    switch (e.kind) {
+      case fw::FeatureKind::kTemperature:
+        feats.push_back("dT_mdegC");
+        break;
+      case fw::FeatureKind::kProduct:
+        feats.push_back("x" + std::to_string(e.a) + "*x" + std::to_string(e.b) + ">>" +
+                        std::to_string(e.shift));
+        break;
+      case fw::FeatureKind::kTempProduct:
+        feats.push_back("x" + std::to_string(e.a) + "*dT>>" + std::to_string(e.shift));
+        break;
+    }
+  }
+  fp["features"] = feats;
+  if (fx.extra_count > 0) {
+    fp["zero_counts"] = std::vector<std::int32_t>(fx.zero.begin(), fx.zero.begin() + n);
+  }
   fp["worst_case_error"] = rep.worst_case_error_si;
+  fp["worst_case_error_lsb"] = rep.worst_case_error_lsb;
   fp["output_lsb"] = {fw::kForceLsbN,   fw::kForceLsbN,   fw::kForceLsbN,
                       fw::kMomentLsbNm, fw::kMomentLsbNm, fw::kMomentLsbNm};
   j["fixed_point"] = fp;
@@ -118,8 +163,9 @@ nlohmann::json ToJson(const CalFile& f) {
 
 CalFile FromJson(const nlohmann::json& j, const std::string& path) {
   if (!j.is_object()) throw CalFileError(path + ": not a JSON object");
-  if (!j.contains("schema") || j["schema"] != kCalSchema) {
-    throw CalFileError(path + ": schema is not '" + std::string(kCalSchema) + "'");
+  if (!j.contains("schema") || (j["schema"] != kCalSchema && j["schema"] != kCalSchemaV1)) {
+    throw CalFileError(path + ": schema is not '" + std::string(kCalSchema) + "' (or '" +
+                       kCalSchemaV1 + "')");
   }
   if (!j.contains("crc32") || !j["crc32"].is_string()) {
     throw CalFileError(path + ": no crc32 field");
@@ -174,6 +220,66 @@ CalFile FromJson(const nlohmann::json& j, const std::string& path) {
   vec("bias", 6, f.cal.bias.data(), true);
   vec("rated", 6, f.rated.data(), true);
   vec("uncertainty", 6, f.uncertainty.data(), false);
+  if (j.contains("model")) {
+    const auto& model = j["model"];
+    const auto& terms = model.at("products");
+    const auto& pm = model.at("product_matrix");
+    if (!terms.is_array() || terms.size() > fw::kMaxProducts) {
+      throw CalFileError(path + ": model.products must list at most " +
+                         std::to_string(fw::kMaxProducts) + " pairs");
+    }
+    const std::size_t k_count = terms.size();
+    f.cal.product_count = static_cast<std::uint8_t>(k_count);
+    for (std::size_t k = 0; k < k_count; ++k) {
+      const auto& t = terms[k];
+      if (!t.is_array() || t.size() != 2 || !t[0].is_number_integer() ||
+          !t[1].is_number_integer()) {
+        throw CalFileError(path + ": model.products[" + std::to_string(k) + "] must be [a, b]");
+      }
+      const int a = t[0].get<int>();
+      const int b = t[1].get<int>();
+      if (a < 0 || b < a || b >= n) {
+        throw CalFileError(path + ": model.products[" + std::to_string(k) +
+                           "] names a channel outside 0.." + std::to_string(n - 1));
+      }
+      f.cal.products[k] =
+          fw::ProductTerm{static_cast<std::uint8_t>(a), static_cast<std::uint8_t>(b)};
+    }
+    if (!pm.is_array() || pm.size() != 6) {
+      throw CalFileError(path + ": model.product_matrix must have 6 rows");
+    }
+    for (std::size_t r = 0; r < 6; ++r) {
+      if (!pm[r].is_array() || pm[r].size() != k_count) {
+        throw CalFileError(path + ": model.product_matrix row " + std::to_string(r) +
+                           " must have " + std::to_string(k_count) + " entries");
+      }
+      for (std::size_t k = 0; k < k_count; ++k) {
+        f.cal.product_matrix[r][k] =
+            Finite(pm[r][k], path,
+                   "model.product_matrix[" + std::to_string(r) + "][" + std::to_string(k) + "]");
+      }
+    }
+  }
+  if (j.contains("temperature")) {
+    const auto& t = j["temperature"];
+    f.cal.temperature_compensated = true;
+    f.cal.temp_ref_c = Finite(t.at("ref_C"), path, "temperature.ref_C");
+    f.cal.temp_min_c = Finite(t.at("min_C"), path, "temperature.min_C");
+    f.cal.temp_max_c = Finite(t.at("max_C"), path, "temperature.max_C");
+    auto slopes = [&](const char* key, double* out) {
+      const auto& a = t.at(key);
+      if (!a.is_array() || a.size() != static_cast<std::size_t>(n)) {
+        throw CalFileError(path + ": temperature." + key + " must have " + std::to_string(n) +
+                           " entries");
+      }
+      for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) {
+        out[i] =
+            Finite(a[i], path, std::string("temperature.") + key + "[" + std::to_string(i) + "]");
+      }
+    };
+    slopes("bias_slope_mvv_per_C", f.cal.bias_slope_mvv_per_c.data());
+    slopes("gain_slope_per_C", f.cal.gain_slope_per_c.data());
+  }
   const auto& adc = j.at("adc");
   f.adc.channel_count = static_cast<std::uint8_t>(n);
   f.adc.min_counts = adc.at("min_counts").get<std::int32_t>();
@@ -181,8 +287,9 @@ CalFile FromJson(const nlohmann::json& j, const std::string& path) {
   f.adc.full_scale_nvv = adc.at("full_scale_nvv").get<std::int64_t>();
   for (const auto& [key, value] : j.items()) {
     static const char* kKnown[] = {
-        "schema", "serial",     "date", "source", "channels",    "input_unit",  "units", "adc",
-        "matrix", "offset_mvv", "bias", "rated",  "uncertainty", "fixed_point", "crc32"};
+        "schema",      "serial",      "date",   "source",     "channels",   "input_unit",
+        "units",       "adc",         "matrix", "offset_mvv", "bias",       "rated",
+        "uncertainty", "fixed_point", "crc32",  "model",      "temperature"};
     bool known = false;
     for (const char* k : kKnown) known = known || key == k;
     if (!known) f.extra[key] = value;
@@ -191,6 +298,17 @@ CalFile FromJson(const nlohmann::json& j, const std::string& path) {
     (void)ToFixed(f, f.adc);
   } catch (const CalFileError& e) {
     throw CalFileError(path + ": " + e.what());
+  }
+  // The stored fixed-point form must be the one this matrix gives (a file written by another
+  // loader version, or edited with a recomputed CRC, is refused rather than run differently).
+  if (j.contains("fixed_point")) {
+    const nlohmann::json expect = ToJson(f).at("fixed_point");
+    for (const char* key : {"shift", "coef", "bias"}) {
+      if (!j["fixed_point"].contains(key) || j["fixed_point"][key] != expect[key]) {
+        throw CalFileError(path + ": fixed_point." + key +
+                           " does not match the matrix (recompute with this version)");
+      }
+    }
   }
   return f;
 }

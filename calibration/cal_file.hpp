@@ -18,8 +18,12 @@ class CalFileError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// File schema identifier written and accepted by this version.
-inline constexpr const char* kCalSchema = "ftstack-cal/1";
+/// File schema identifier written by this version. Version 2 adds second-order terms
+/// ("model"), temperature compensation ("temperature") and the feature list of the fixed-point
+/// form; version 1 files (affine only) are still read.
+inline constexpr const char* kCalSchema = "ftstack-cal/2";
+/// The older schema still accepted.
+inline constexpr const char* kCalSchemaV1 = "ftstack-cal/1";
 
 /// The contents of a calibration file.
 struct CalFile {
@@ -30,8 +34,10 @@ struct CalFile {
   fw::FloatCalibration cal{};       ///< matrix (N, N·m per input unit), offsets, bias
   /// ADC the fixed-point form is made for: rails and full scale (input unit at max_counts).
   hal::AdcInfo adc{};
-  std::array<double, 6> rated{};        ///< rated range per axis, N and N·m
-  std::array<double, 6> uncertainty{};  ///< per-axis standard uncertainty of the fit, N and N·m
+  std::array<double, 6> rated{};  ///< rated range per axis, N and N·m
+  /// Per-axis standard uncertainty of a calibrated reading (for a fit: the held-out RMS error
+  /// over whole load blocks), N and N·m.
+  std::array<double, 6> uncertainty{};
   nlohmann::json extra = nlohmann::json::object();  ///< fields of later issues, kept verbatim
 };
 

@@ -14,6 +14,7 @@ void WrenchCore::SetCalibration(const FixedCalibration& cal) {
 bool WrenchCore::RequestTare(std::uint16_t samples) {
   if (samples < 1 || samples > kMaxTareSamples) return false;
   tare_sum_ = {};
+  tare_temp_sum_ = 0;
   tare_total_ = samples;
   tare_remaining_ = samples;
   return true;
@@ -23,6 +24,7 @@ void WrenchCore::ClearTare() {
   tare_active_ = false;
   tare_remaining_ = 0;
   tare_counts_ = {};
+  tare_extra_ = {};
 }
 
 bool WrenchCore::SetFilterLength(std::uint16_t length) {
@@ -40,7 +42,55 @@ void WrenchCore::ResetFilter() {
 
 void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts, WrenchLsb& y,
                        bool* saturated) const {
+  bool temp_range = false;
+  Apply(counts, cal_.temp_ref_mdegc, true, y, saturated, &temp_range);
+}
+
+std::int32_t WrenchCore::DeltaT(std::int32_t temperature_mdegc, bool has_temperature,
+                                bool* out_of_range) const {
+  if (!cal_.temperature) return 0;
+  std::int32_t t = has_temperature ? temperature_mdegc : cal_.temp_ref_mdegc;
+  if (!has_temperature) *out_of_range = true;
+  if (t > cal_.temp_max_mdegc) {
+    t = cal_.temp_max_mdegc;
+    *out_of_range = true;
+  } else if (t < cal_.temp_min_mdegc) {
+    t = cal_.temp_min_mdegc;
+    *out_of_range = true;
+  }
+  return t - cal_.temp_ref_mdegc;
+}
+
+void WrenchCore::ExtraFeatures(const std::array<std::int32_t, kMaxChannels>& counts,
+                               std::int32_t dt_mdegc,
+                               std::array<std::int64_t, kMaxFeatures - kMaxChannels>& f) const {
+  for (std::size_t k = 0; k < cal_.extra_count; ++k) {
+    const FixedFeature& e = cal_.extra[k];
+    switch (e.kind) {
+      case FeatureKind::kTemperature:
+        f[k] = dt_mdegc;
+        break;
+      case FeatureKind::kProduct: {
+        // |x̃| < 2^32 each: the product fits int64; the loader sized the shift.
+        const std::int64_t xa = static_cast<std::int64_t>(counts[e.a]) - cal_.zero[e.a];
+        const std::int64_t xb = static_cast<std::int64_t>(counts[e.b]) - cal_.zero[e.b];
+        f[k] = RoundShift(xa * xb, e.shift);
+        break;
+      }
+      case FeatureKind::kTempProduct: {
+        const std::int64_t xa = static_cast<std::int64_t>(counts[e.a]) - cal_.zero[e.a];
+        f[k] = RoundShift(xa * dt_mdegc, e.shift);
+        break;
+      }
+    }
+  }
+}
+
+void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts,
+                       std::int32_t temperature_mdegc, bool has_temperature, WrenchLsb& y,
+                       bool* saturated, bool* temp_range) const {
   std::array<std::int64_t, kMaxChannels> x{};
+  std::array<std::int32_t, kMaxChannels> clamped{};
   for (std::size_t c = 0; c < cal_.channel_count; ++c) {
     std::int32_t v = counts[c];
     if (v > cal_.max_counts) {
@@ -50,12 +100,22 @@ void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts, Wre
       v = cal_.min_counts;
       *saturated = true;
     }
+    clamped[c] = v;
     x[c] = static_cast<std::int64_t>(v) - (tare_active_ ? tare_counts_[c] : 0);
   }
+  std::array<std::int64_t, kMaxFeatures - kMaxChannels> f{};
+  if (cal_.extra_count > 0) {
+    ExtraFeatures(clamped, DeltaT(temperature_mdegc, has_temperature, temp_range), f);
+    if (tare_active_) {
+      for (std::size_t k = 0; k < cal_.extra_count; ++k) f[k] -= tare_extra_[k];
+    }
+  }
+  const std::size_t n = cal_.channel_count;
   for (std::size_t r = 0; r < kAxes; ++r) {
     // The loader guarantees |acc| < 2^62 for every x between the rails.
     std::int64_t acc = tare_active_ ? 0 : cal_.bias[r];
-    for (std::size_t c = 0; c < cal_.channel_count; ++c) acc += cal_.coef[r][c] * x[c];
+    for (std::size_t c = 0; c < n; ++c) acc += cal_.coef[r][c] * x[c];
+    for (std::size_t k = 0; k < cal_.extra_count; ++k) acc += cal_.coef[r][n + k] * f[k];
     y[r] = SatToI32(RoundShift(acc, cal_.shift[r]), saturated);
   }
 }
@@ -100,12 +160,21 @@ void WrenchCore::Process(const hal::AdcSample& in, bool simulated, CoreOutput& o
   }
 
   const bool usable = !any_saturated && !any_error && !bridge_fault;
+  bool temp_range = false;
+  const std::int32_t dt_mdegc = DeltaT(in.temperature_mdegc, in.has_temperature, &temp_range);
+  if (temp_range) out.status |= kStatusTempRange;
   // Tare accumulates only on usable samples.
   if (usable && tare_remaining_ > 0) {
     for (std::size_t c = 0; c < n; ++c) tare_sum_[c] += in.counts[c];
+    tare_temp_sum_ += dt_mdegc;
     if (--tare_remaining_ == 0) {
       for (std::size_t c = 0; c < n; ++c) {
         tare_counts_[c] = static_cast<std::int32_t>(RoundDiv(tare_sum_[c], tare_total_));
+      }
+      if (cal_.extra_count > 0) {
+        ExtraFeatures(tare_counts_,
+                      static_cast<std::int32_t>(RoundDiv(tare_temp_sum_, tare_total_)),
+                      tare_extra_);
       }
       tare_active_ = true;
       ResetFilter();
@@ -119,7 +188,8 @@ void WrenchCore::Process(const hal::AdcSample& in, bool simulated, CoreOutput& o
   }
 
   WrenchLsb y{};
-  Apply(in.counts, y, &out.arithmetic_saturated);
+  Apply(in.counts, in.temperature_mdegc, in.has_temperature, y, &out.arithmetic_saturated,
+        &temp_range);
   out.unfiltered = y;
 
   // Moving average over the last filter_length_ samples (shorter while filling).

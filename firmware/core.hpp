@@ -63,11 +63,23 @@ class WrenchCore {
 
   /// The unfiltered matrix step alone (exposed for tests and `ftcal apply`): y = M·(x − zero) + b.
   /// Counts outside the calibration's rails are clamped and reported through *saturated.
+  /// A temperature-compensated calibration is evaluated at its reference temperature.
   void Apply(const std::array<std::int32_t, kMaxChannels>& counts, WrenchLsb& y,
              bool* saturated) const;
+  /// The same with the body temperature (m°C): second-order and temperature features included.
+  /// A temperature outside the compensated range is clamped and reported through *temp_range
+  /// (as is a missing one, which is taken as the reference temperature).
+  void Apply(const std::array<std::int32_t, kMaxChannels>& counts, std::int32_t temperature_mdegc,
+             bool has_temperature, WrenchLsb& y, bool* saturated, bool* temp_range) const;
 
  private:
   void ResetFilter();
+  /// Fills the derived features (ΔT, products) for clamped counts and a clamped temperature.
+  void ExtraFeatures(const std::array<std::int32_t, kMaxChannels>& counts, std::int32_t dt_mdegc,
+                     std::array<std::int64_t, kMaxFeatures - kMaxChannels>& f) const;
+  /// Clamps a temperature into the compensated range and returns ΔT, m°C.
+  std::int32_t DeltaT(std::int32_t temperature_mdegc, bool has_temperature,
+                      bool* out_of_range) const;
 
   FixedCalibration cal_{};
   CoreLimits limits_{};
@@ -76,6 +88,9 @@ class WrenchCore {
   std::uint16_t tare_remaining_ = 0;
   std::uint16_t tare_total_ = 0;
   std::array<std::int64_t, kMaxChannels> tare_sum_{};
+  std::int64_t tare_temp_sum_ = 0;  ///< Σ clamped ΔT over the tare, m°C
+  std::array<std::int64_t, kMaxFeatures - kMaxChannels>
+      tare_extra_{};  ///< derived features at the tare
 
   std::uint16_t filter_length_ = 1;
   std::uint16_t filter_fill_ = 0;

@@ -17,6 +17,8 @@ const char* ToString(LoadStatus s) {
       return "ADC scaling unusable (full scale or rails)";
     case LoadStatus::kOutputOverflow:
       return "worst-case output overflows int32 (matrix too large for the ADC range)";
+    case LoadStatus::kBadTerms:
+      return "second-order term or temperature range unusable";
   }
   return "unknown";
 }
@@ -25,6 +27,35 @@ double CountsPerMvv(const hal::AdcInfo& adc) {
   if (adc.full_scale_nvv <= 0 || adc.max_counts <= 0 || adc.min_counts >= 0) return 0.0;
   return static_cast<double>(adc.max_counts) / (static_cast<double>(adc.full_scale_nvv) * 1e-6);
 }
+
+namespace {
+
+constexpr double kInt32Max = static_cast<double>(std::numeric_limits<std::int32_t>::max());
+constexpr std::uint64_t kAccLimit = std::uint64_t{1} << 61;
+
+/// Right shift that brings |product| ≤ bound below 2^26 (balances the rounding of the product
+/// against the rounding of its coefficient in a 64-bit accumulator).
+std::uint8_t ProductShift(double bound) {
+  int s = static_cast<int>(std::ceil(std::log2(bound + 1.0))) - 26;
+  if (s < 0) s = 0;
+  if (s > 62) s = 62;
+  return static_cast<std::uint8_t>(s);
+}
+
+/// Exact check with integers: Σ |coef_k| · f_k + |bias| ≤ 2^61 (no wrap-around anywhere).
+bool AccumulatorFits(const std::array<std::int64_t, kMaxFeatures>& coef, std::int64_t bias,
+                     const std::array<std::uint64_t, kMaxFeatures>& fmax, std::size_t count) {
+  std::uint64_t total = static_cast<std::uint64_t>(bias < 0 ? -bias : bias);
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::uint64_t mag = static_cast<std::uint64_t>(coef[k] < 0 ? -coef[k] : coef[k]);
+    std::uint64_t term = 0;
+    if (__builtin_mul_overflow(mag, fmax[k], &term)) return false;
+    if (__builtin_add_overflow(total, term, &total)) return false;
+  }
+  return total <= kAccLimit;
+}
+
+}  // namespace
 
 LoadStatus LoadCalibration(const FloatCalibration& cal, const hal::AdcInfo& adc,
                            FixedCalibration* out, LoadReport* report) {
@@ -50,43 +81,185 @@ LoadStatus LoadCalibration(const FloatCalibration& cal, const hal::AdcInfo& adc,
       }
     }
   }
+  if (cal.product_count > kMaxProducts) return finish(LoadStatus::kBadTerms);
+  for (std::size_t k = 0; k < cal.product_count; ++k) {
+    const ProductTerm& t = cal.products[k];
+    if (t.a > t.b || t.b >= n) return finish(LoadStatus::kBadTerms);
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      if (!std::isfinite(cal.product_matrix[r][k])) return finish(LoadStatus::kNotFinite);
+    }
+  }
+  const bool temp = cal.temperature_compensated;
+  if (temp) {
+    if (!std::isfinite(cal.temp_ref_c) || !std::isfinite(cal.temp_min_c) ||
+        !std::isfinite(cal.temp_max_c)) {
+      return finish(LoadStatus::kNotFinite);
+    }
+    if (!(cal.temp_min_c <= cal.temp_ref_c && cal.temp_ref_c <= cal.temp_max_c) ||
+        cal.temp_min_c < -1000.0 || cal.temp_max_c > 1000.0) {
+      return finish(LoadStatus::kBadTerms);
+    }
+    for (std::size_t c = 0; c < n; ++c) {
+      if (!std::isfinite(cal.bias_slope_mvv_per_c[c]) || !std::isfinite(cal.gain_slope_per_c[c])) {
+        return finish(LoadStatus::kNotFinite);
+      }
+    }
+  }
+  const double min_c = adc.min_counts;
+  const double max_c = adc.max_counts;
   // Largest |x| = |counts − zero| with counts and zero (a tare or the offset) between the rails.
-  const double x_span = static_cast<double>(adc.max_counts) - static_cast<double>(adc.min_counts);
+  const double x_span = max_c - min_c;
   FixedCalibration fixed{};
   fixed.channel_count = static_cast<std::uint8_t>(n);
   fixed.min_counts = adc.min_counts;
   fixed.max_counts = adc.max_counts;
-  constexpr double kInt32Max = static_cast<double>(std::numeric_limits<std::int32_t>::max());
+
+  // Integer zero of the product features and its rounding e_c = zero_c − offset_c (counts).
+  std::array<double, kMaxChannels> offset_counts{};
+  std::array<double, kMaxChannels> e{};
+  std::array<double, kMaxChannels> xmax{};  // bound on |counts − zero|
+  for (std::size_t c = 0; c < n; ++c) {
+    offset_counts[c] = cal.offset_mvv[c] * counts_per_mvv;
+    double z = std::nearbyint(offset_counts[c]);
+    if (z > max_c) z = max_c;
+    if (z < min_c) z = min_c;
+    fixed.zero[c] = static_cast<std::int32_t>(z);
+    e[c] = z - offset_counts[c];
+    xmax[c] = std::fmax(max_c - z, z - min_c);
+  }
+  // Temperature in m°C.
+  double dt_max = 0.0;  // bound on |ΔT|, m°C
+  if (temp) {
+    fixed.temperature = true;
+    fixed.temp_ref_mdegc = static_cast<std::int32_t>(std::lround(cal.temp_ref_c * 1000.0));
+    fixed.temp_min_mdegc = static_cast<std::int32_t>(std::lround(cal.temp_min_c * 1000.0));
+    fixed.temp_max_mdegc = static_cast<std::int32_t>(std::lround(cal.temp_max_c * 1000.0));
+    dt_max = std::fmax(static_cast<double>(fixed.temp_max_mdegc) - fixed.temp_ref_mdegc,
+                       static_cast<double>(fixed.temp_ref_mdegc) - fixed.temp_min_mdegc);
+  }
+  const double dt_ref_err = temp ? fixed.temp_ref_mdegc - cal.temp_ref_c * 1000.0 : 0.0;
+
+  // Feature layout and bounds (f_max with a tare: twice the one-sided bound for derived features).
+  std::size_t count = n;
+  std::array<double, kMaxFeatures> fbound{};
+  std::array<std::uint64_t, kMaxFeatures> fmax_int{};
+  for (std::size_t c = 0; c < n; ++c) fbound[c] = x_span;
+  std::size_t temp_index = 0;
+  if (temp) {
+    temp_index = count;
+    fixed.extra[count - n] = FixedFeature{FeatureKind::kTemperature, 0, 0, 0};
+    fbound[count++] = 2.0 * dt_max;
+  }
+  std::array<std::size_t, kMaxProducts> product_index{};
+  for (std::size_t k = 0; k < cal.product_count; ++k) {
+    const ProductTerm& t = cal.products[k];
+    const double bound = xmax[t.a] * xmax[t.b];
+    const std::uint8_t sh = ProductShift(bound);
+    product_index[k] = count;
+    fixed.extra[count - n] = FixedFeature{FeatureKind::kProduct, t.a, t.b, sh};
+    fbound[count++] = 2.0 * (std::ceil(std::ldexp(bound, -sh)) + 1.0);
+  }
+  std::array<std::size_t, kMaxChannels> temp_product_index{};
+  if (temp) {
+    for (std::size_t c = 0; c < n; ++c) {
+      if (cal.gain_slope_per_c[c] == 0.0) continue;
+      const double bound = xmax[c] * dt_max;
+      const std::uint8_t sh = ProductShift(bound);
+      temp_product_index[c] = count;
+      fixed.extra[count - n] =
+          FixedFeature{FeatureKind::kTempProduct, static_cast<std::uint8_t>(c), 0, sh};
+      fbound[count++] = 2.0 * (std::ceil(std::ldexp(bound, -sh)) + 1.0);
+    }
+  }
+  fixed.extra_count = static_cast<std::uint8_t>(count - n);
+  for (std::size_t k = 0; k < count; ++k) fmax_int[k] = static_cast<std::uint64_t>(fbound[k]);
+
   for (std::size_t r = 0; r < kAxes; ++r) {
     const double lsb = AxisLsb(r);
-    std::array<double, kMaxChannels> m{};  // LSB per count
+    // Real coefficients per feature unit, LSB, and the real bias, LSB.
+    std::array<double, kMaxFeatures> m{};
     double bias_lsb = cal.bias[r] / lsb;
-    double worst = 0.0;
     for (std::size_t c = 0; c < n; ++c) {
       m[c] = cal.matrix[r][c] / lsb / counts_per_mvv;
-      bias_lsb -= m[c] * (cal.offset_mvv[c] * counts_per_mvv);
-      worst += std::fabs(m[c]) * x_span;
+      bias_lsb -= m[c] * offset_counts[c];
     }
-    worst += std::fabs(bias_lsb);
+    // Products: q·(x̃_a + e_a)(x̃_b + e_b) with x̃ = counts − zero, expanded exactly.
+    double rounding_error = 0.0;  // from rounding the derived features, LSB
+    for (std::size_t k = 0; k < cal.product_count; ++k) {
+      const ProductTerm& t = cal.products[k];
+      const double q = cal.product_matrix[r][k] / lsb / (counts_per_mvv * counts_per_mvv);
+      const FixedFeature& f = fixed.extra[product_index[k] - n];
+      m[product_index[k]] = q * std::ldexp(1.0, f.shift);
+      m[t.a] += q * e[t.b];
+      m[t.b] += q * e[t.a];
+      bias_lsb += q * (e[t.a] * e[t.b] - e[t.b] * fixed.zero[t.a] - e[t.a] * fixed.zero[t.b]);
+      if (f.shift > 0) rounding_error += 2.0 * 0.5 * std::fabs(m[product_index[k]]);
+    }
+    // Temperature: −ΔT·(M·α)_r − ΔT·Σ_c M_rc γ_c (x̃_c + e_c), ΔT in m°C against the integer
+    // reference (the reference's rounding folds into the constant and linear terms).
+    if (temp) {
+      double a_r = 0.0;  // LSB per m°C
+      for (std::size_t c = 0; c < n; ++c) {
+        a_r -= cal.matrix[r][c] / lsb * cal.bias_slope_mvv_per_c[c] / 1000.0;
+      }
+      for (std::size_t c = 0; c < n; ++c) {
+        if (cal.gain_slope_per_c[c] == 0.0) continue;
+        const double g =
+            -(cal.matrix[r][c] / lsb / counts_per_mvv) * cal.gain_slope_per_c[c] / 1000.0;
+        const FixedFeature& f = fixed.extra[temp_product_index[c] - n];
+        m[temp_product_index[c]] = g * std::ldexp(1.0, f.shift);
+        a_r += g * e[c];
+        // ΔT_true = ΔT_int + dt_ref_err: the product's share is linear in x̃_c.
+        m[c] += g * dt_ref_err;
+        bias_lsb -= g * dt_ref_err * fixed.zero[c];
+        if (f.shift > 0) rounding_error += 2.0 * 0.5 * std::fabs(m[temp_product_index[c]]);
+      }
+      m[temp_index] = a_r;
+      bias_lsb += a_r * dt_ref_err;
+    }
+    double worst = std::fabs(bias_lsb);
+    double fsum = 1.0;
+    for (std::size_t k = 0; k < count; ++k) {
+      // One-sided bounds for the output (no tare: derived features are at most half of fbound).
+      const double one_sided =
+          k < n ? std::fmax(std::fabs(min_c), std::fabs(max_c)) : fbound[k] / 2;
+      worst += std::fabs(m[k]) * one_sided;
+      fsum += fbound[k];
+    }
     rep.worst_case_output_lsb[r] = worst;
-    if (!std::isfinite(worst) || worst + 1.0 > kInt32Max) {
+    if (!std::isfinite(worst) || worst + rounding_error + 1.0 > kInt32Max) {
       rep.failing_axis = static_cast<std::uint8_t>(r);
       return finish(LoadStatus::kOutputOverflow);
     }
-    // Largest binary point with (worst + rounding + coefficient rounding) · 2^s ≤ 2^61:
-    // every partial sum then stays inside ±2^62 and adding the rounding half cannot overflow.
-    int s = 61 - static_cast<int>(std::ceil(std::log2(worst + static_cast<double>(n) + 2.0)));
+    // Bound with a tare (every feature relative to its value at the tare, bias dropped).
+    double real_bound = std::fabs(bias_lsb);
+    for (std::size_t k = 0; k < count; ++k) real_bound += std::fabs(m[k]) * fbound[k];
+    if (!std::isfinite(real_bound)) {
+      rep.failing_axis = static_cast<std::uint8_t>(r);
+      return finish(LoadStatus::kOutputOverflow);
+    }
+    // Largest binary point with real_bound·2^s + rounding of the coefficients ≤ 2^61: every
+    // partial sum then stays inside ±2^62 and adding the rounding half cannot overflow. Proven
+    // again below with exact integer arithmetic.
+    const double room = std::ldexp(1.0, 61) - 0.5 * fsum - 1.0;
+    int s = real_bound > 0 ? static_cast<int>(std::floor(std::log2(room / real_bound))) : 62;
     if (s > 62) s = 62;
     if (s < 0) s = 0;
-    const double scale = std::ldexp(1.0, s);
-    for (std::size_t c = 0; c < n; ++c) {
-      fixed.coef[r][c] = std::llround(m[c] * scale);
+    for (;; --s) {
+      const double scale = std::ldexp(1.0, s);
+      for (std::size_t k = 0; k < count; ++k) fixed.coef[r][k] = std::llround(m[k] * scale);
+      fixed.bias[r] = std::llround(bias_lsb * scale);
+      if (AccumulatorFits(fixed.coef[r], fixed.bias[r], fmax_int, count)) break;
+      if (s == 0) {
+        rep.failing_axis = static_cast<std::uint8_t>(r);
+        return finish(LoadStatus::kOutputOverflow);
+      }
     }
-    fixed.bias[r] = std::llround(bias_lsb * scale);
     fixed.shift[r] = static_cast<std::uint8_t>(s);
-    // Each coefficient and the bias are off by at most half a unit of 2^-s; the final rounding
-    // adds half an LSB.
-    const double err = 0.5 / scale * (x_span * static_cast<double>(n) + 1.0) + 0.5;
+    const double scale = std::ldexp(1.0, s);
+    // Each coefficient and the bias are off by at most half a unit of 2^-s; derived features
+    // are rounded to ±1/2 (twice with a tare); the final rounding adds half an LSB.
+    const double err = 0.5 / scale * fsum + rounding_error + 0.5;
     rep.worst_case_error_lsb[r] = err;
     rep.worst_case_error_si[r] = err * lsb;
   }

@@ -1,0 +1,122 @@
+// Fitting a calibration from rig data: affine, temperature and second-order models, chosen by
+// cross-validation over whole load blocks, with ridge regularisation.
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "firmware/fixed_calibration.hpp"
+#include "sim/recording.hpp"
+
+namespace ftstack::cal {
+
+/// How rows are grouped into load blocks (the unit that cross-validation holds out).
+struct BlockOptions {
+  /// Per-axis scale of the wrench for hold detection (N, N·m); 0 → the largest |load| seen.
+  std::array<double, 6> scale{};
+  /// A hold ends when any axis moves more than this fraction of its scale from the hold's start.
+  double hold_tolerance = 0.01;
+  /// A hold needs at least this many rows; shorter runs are transitions.
+  std::size_t min_hold_rows = 5;
+  /// Without holds (continuous loading): this many contiguous chunks of equal length.
+  std::size_t continuous_blocks = 20;
+};
+
+/// Rig data ready for fitting: bridges, reference wrench, temperature and block of every row.
+struct RigData {
+  std::string path;
+  Eigen::MatrixXd bridges;  ///< rows × N, input unit (mV/V)
+  Eigen::MatrixXd wrench;   ///< rows × 6, N and N·m
+  Eigen::VectorXd temp_c;   ///< rows, °C; empty without a temp_C column
+  std::vector<double> t_s;  ///< time of every row, s
+  std::vector<int> block;   ///< block of every row, 0 … block_count − 1 (in order of first row)
+  int block_count = 0;
+  std::string block_method;  ///< how blocks were found ("column pose", "holds", "chunks")
+};
+
+/// Groups rows into blocks. A `block` or `pose` column wins (rows with equal values form one
+/// block, wherever they are); otherwise static holds are detected from the reference wrench
+/// (runs of ≥ min_hold_rows rows within hold_tolerance of the run's first row) and every
+/// transition row joins the nearest hold in time; with fewer than two holds covering < 30 % of
+/// the rows the recording is treated as continuous loading and cut into contiguous chunks.
+[[nodiscard]] std::vector<int> DetectBlocks(const Eigen::MatrixXd& wrench,
+                                            const BlockOptions& options, int* block_count,
+                                            std::string* method);
+
+/// Reads the columns a fit needs (b0…, Fx…Mz, optional temp_C, block/pose) and finds blocks.
+/// Throws sim::RecordingError naming the file when columns are missing or N is not 1 … 8.
+[[nodiscard]] RigData RigDataFromRecording(const sim::Recording& rec, const BlockOptions& options);
+
+/// Calibration model families.
+enum class ModelKind {
+  kLinear = 0,     ///< affine: offsets + 6 × N matrix
+  kLinearTemp,     ///< affine + per-channel bias and gain slopes against temperature
+  kQuadratic,      ///< affine + all products of two channels
+  kQuadraticTemp,  ///< both
+};
+[[nodiscard]] const char* ToString(ModelKind kind);
+/// "linear", "linear-temp", "quadratic", "quadratic-temp"; nullopt otherwise.
+[[nodiscard]] std::optional<ModelKind> ParseModelKind(const std::string& name);
+
+struct FitOptions {
+  std::vector<ModelKind> models;  ///< candidates; empty → every model the data supports
+  /// Ridge strengths tried, relative to the standardised features (0 = plain least squares).
+  std::vector<double> lambdas = {0.0, 1e-9, 1e-7, 1e-5, 1e-3, 1e-1};
+  int folds = 10;                 ///< cross-validation folds (whole blocks), ≤ number of blocks
+  std::array<double, 6> rated{};  ///< rated range per axis; 0 → the largest |load| in the data
+  /// The model with the fewest coefficients whose score is within this fraction of the best one
+  /// wins (with its own best λ): a simpler model is preferred when it generalises as well.
+  double simpler_tolerance = 0.01;
+};
+
+/// Cross-validated score of one (model, λ) candidate.
+struct CandidateScore {
+  ModelKind kind = ModelKind::kLinear;
+  double lambda = 0.0;
+  int features = 0;                ///< coefficients per axis (incl. intercept)
+  double score = 0.0;              ///< mean over axes of (held-out RMS / rated)²
+  std::array<double, 6> rms_si{};  ///< held-out RMS per axis, N and N·m
+};
+
+/// Held-out error of one block under the chosen model.
+struct BlockScore {
+  int block = 0;
+  std::size_t rows = 0;
+  double t_start_s = 0.0;
+  double t_end_s = 0.0;
+  double rms_pct = 0.0;                 ///< RMS over axes of error in % of rated
+  std::array<double, 6> mean_wrench{};  ///< mean reference load of the block
+};
+
+struct FitResult {
+  fw::FloatCalibration cal{};
+  ModelKind kind = ModelKind::kLinear;
+  double lambda = 0.0;
+  int folds = 0;
+  std::size_t rows = 0;
+  int block_count = 0;
+  std::string block_method;
+  std::array<double, 6> rated{};
+  std::array<double, 6> heldout_rms_si{};      ///< held-out RMS per axis (whole blocks), N, N·m
+  std::array<double, 6> heldout_p95_si{};      ///< 95th percentile of held-out |error|
+  std::array<double, 6> residual_sigma_si{};   ///< training residual σ (dof-corrected)
+  std::array<double, 6> fit_uncertainty_si{};  ///< parameter part: σ·sqrt(p_eff / n)
+  double load_condition = 0.0;    ///< condition number of [1, wrench/rated] over the rows
+  double design_condition = 0.0;  ///< condition number of the chosen model's standardised design
+  std::vector<CandidateScore> candidates;
+  Eigen::MatrixXd heldout_residual;  ///< rows × 6: prediction − reference, held-out
+  std::vector<BlockScore> blocks;    ///< worst first
+};
+
+/// Fits and cross-validates. Throws std::invalid_argument when the data cannot support a fit
+/// (fewer than 2 blocks, fewer rows than coefficients, NaN).
+[[nodiscard]] FitResult FitCalibration(const RigData& data, const FitOptions& options);
+
+/// Condition number (σmax/σmin) of [1, wrench ./ rated] — how well a load set excites all axes.
+[[nodiscard]] double LoadSetCondition(const Eigen::MatrixXd& wrench,
+                                      const std::array<double, 6>& rated);
+
+}  // namespace ftstack::cal

@@ -1,0 +1,170 @@
+#include "calibration/rig.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <stdexcept>
+
+#include "calibration/fit.hpp"
+#include "hal/sim/sim_adc.hpp"
+#include "sim/simulated_sensor.hpp"
+
+namespace ftstack::cal {
+namespace {
+
+const char* const kAxisNames[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
+
+std::string Pct(double f) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%+.0f%%", f * 100.0);
+  return buf;
+}
+
+void SingleAxisSweeps(const sim::Wrench& rated, const std::vector<double>& levels, double temp,
+                      std::vector<RigStep>* out) {
+  for (int a = 0; a < 6; ++a) {
+    for (double sign : {1.0, -1.0}) {
+      std::vector<double> seq = levels;                                                   // up …
+      for (auto it = levels.rbegin() + 1; it != levels.rend(); ++it) seq.push_back(*it);  // … down
+      seq.push_back(0.0);
+      for (std::size_t i = 0; i < seq.size(); ++i) {
+        RigStep s;
+        s.wrench(a) = sign * seq[i] * rated(a);
+        s.temperature_c = temp;
+        s.label = std::string(kAxisNames[a]) + " " + Pct(sign * seq[i]) +
+                  (i < levels.size() ? " up" : " down");
+        out->push_back(s);
+      }
+    }
+  }
+}
+
+void Combined(const sim::Wrench& rated, double temp, std::vector<RigStep>* out) {
+  // Axial preload × bending, lever loads (F_x with M_y, F_y with M_x), shear × torsion.
+  const int pairs[][2] = {{2, 3}, {2, 4}, {2, 5}, {0, 4}, {1, 3}, {0, 5}, {1, 5}, {0, 1}, {3, 4}};
+  for (const auto& p : pairs) {
+    for (double sa : {0.5, -0.5}) {
+      for (double sb : {0.5, -0.5}) {
+        RigStep s;
+        s.wrench(p[0]) = sa * rated(p[0]);
+        s.wrench(p[1]) = sb * rated(p[1]);
+        s.temperature_c = temp;
+        s.label = std::string(kAxisNames[p[0]]) + " " + Pct(sa) + " x " + kAxisNames[p[1]] + " " +
+                  Pct(sb);
+        out->push_back(s);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<RigStep> DesignRig(const sim::Wrench& rated, const RigDesignOptions& options) {
+  for (int a = 0; a < 6; ++a) {
+    if (!(rated(a) > 0) || !std::isfinite(rated(a))) {
+      throw std::invalid_argument("rated range must be positive on every axis");
+    }
+  }
+  std::vector<double> temps = options.temperatures_c;
+  if (temps.empty()) temps.push_back(20.0);
+  std::mt19937_64 rng(options.seed);
+  std::uniform_real_distribution<double> u(-0.6, 0.6);
+  std::vector<RigStep> steps;
+  for (std::size_t ti = 0; ti < temps.size(); ++ti) {
+    const double temp = temps[ti];
+    RigStep zero;
+    zero.temperature_c = temp;
+    zero.label = "zero";
+    steps.push_back(zero);
+    SingleAxisSweeps(rated, ti == 0 ? options.levels : std::vector<double>{1.0}, temp, &steps);
+    if (options.combined) Combined(rated, temp, &steps);
+    for (int i = 0; i < options.random_combinations; ++i) {
+      RigStep s;
+      for (int a = 0; a < 6; ++a) s.wrench(a) = u(rng) * rated(a);
+      s.temperature_c = temp;
+      s.label = "mixed " + std::to_string(i + 1);
+      steps.push_back(s);
+    }
+    steps.push_back(zero);
+  }
+  return steps;
+}
+
+std::vector<sim::ProfileWrench::Key> RigKeys(const std::vector<RigStep>& steps,
+                                             const RigDesignOptions& options) {
+  if (!(options.hold_s > 0) || !(options.ramp_s > 0)) {
+    throw std::invalid_argument("hold and ramp times must be positive");
+  }
+  std::vector<sim::ProfileWrench::Key> keys;
+  double t = 0.0;
+  for (const RigStep& s : steps) {
+    keys.push_back({t, s.wrench, s.temperature_c});
+    keys.push_back({t + options.hold_s, s.wrench, s.temperature_c});
+    t += options.hold_s + options.ramp_s;
+  }
+  return keys;
+}
+
+double RigCondition(const std::vector<RigStep>& steps, const sim::Wrench& rated) {
+  Eigen::MatrixXd w(static_cast<Eigen::Index>(steps.size()), 6);
+  for (std::size_t i = 0; i < steps.size(); ++i)
+    w.row(static_cast<Eigen::Index>(i)) = steps[i].wrench.transpose();
+  std::array<double, 6> r{};
+  for (int a = 0; a < 6; ++a) r[static_cast<std::size_t>(a)] = rated(a);
+  return LoadSetCondition(w, r);
+}
+
+sim::Recording SimulateRig(const sim::SensorDescription& sensor,
+                           const std::vector<sim::ProfileWrench::Key>& keys, double rate_hz,
+                           std::uint64_t seed, bool with_pose) {
+  if (keys.empty()) throw std::invalid_argument("empty rig sequence");
+  const sim::ProfileWrench profile(keys, true);
+  sim::SimulatedSensor source(*sensor.model, profile);
+  hal::sim::SimAdcParams params = sensor.adc;
+  params.seed = seed;
+  params.realtime = false;
+  hal::sim::SimAdc adc(source, params);
+  hal::AdcConfig cfg;
+  cfg.channel_count = source.channel_count();
+  cfg.gain = sensor.adc_gain;
+  cfg.rate_hz = static_cast<std::uint32_t>(std::lround(rate_hz));
+  if (adc.Configure(cfg) != hal::Status::kOk) {
+    throw std::invalid_argument("simulated ADC refused the configuration");
+  }
+  const double cpm = adc.counts_per_mvv();
+  const std::size_t n = cfg.channel_count;
+  const auto rows = static_cast<std::size_t>(std::floor(profile.duration_s() * rate_hz)) + 1;
+  std::vector<std::vector<double>> cols(7 + n + 1 + (with_pose ? 1 : 0));
+  for (auto& c : cols) c.reserve(rows);
+  std::size_t pose = 0;
+  hal::AdcSample s{};
+  for (std::size_t i = 0; i < rows; ++i) {
+    if (adc.WaitDataReady(1000000) != hal::Status::kOk || adc.Read(s) != hal::Status::kOk) break;
+    const double t = static_cast<double>(i) / static_cast<double>(cfg.rate_hz);
+    cols[0].push_back(t);
+    const sim::Wrench& w = source.last_wrench();
+    for (int a = 0; a < 6; ++a) cols[static_cast<std::size_t>(1 + a)].push_back(w(a));
+    for (std::size_t c = 0; c < n; ++c) cols[7 + c].push_back(s.counts[c] / cpm);
+    cols[7 + n].push_back(s.has_temperature ? s.temperature_mdegc / 1000.0 : 20.0);
+    if (with_pose) {
+      // Keys come in pairs (hold start, hold end); a transition belongs to the nearer hold.
+      while (2 * pose + 2 < keys.size() &&
+             t >= 0.5 * (keys[2 * pose + 1].t_s + keys[2 * pose + 2].t_s)) {
+        ++pose;
+      }
+      cols[8 + n].push_back(static_cast<double>(pose));
+    }
+  }
+  sim::Recording rec;
+  rec.path = "(simulated rig)";
+  rec.metadata.push_back("sensor: " + sensor.name);
+  rec.metadata.push_back("source: ftcal design (simulated rig)");
+  rec.names = {"t", "Fx", "Fy", "Fz", "Mx", "My", "Mz"};
+  for (const auto& b : sim::BridgeColumns(n)) rec.names.push_back(b);
+  rec.names.push_back("temp_C");
+  if (with_pose) rec.names.push_back("pose");
+  rec.columns = std::move(cols);
+  return rec;
+}
+
+}  // namespace ftstack::cal

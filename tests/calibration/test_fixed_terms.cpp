@@ -1,0 +1,248 @@
+// Property tests: the fixed-point core with second-order and temperature terms against the
+// double-precision evaluation of the same calibration, within the loader's proven bound.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "calibration/cal_file.hpp"
+#include "calibration/model.hpp"
+#include "firmware/core.hpp"
+#include "firmware/fixed_calibration.hpp"
+
+namespace ftstack {
+namespace {
+
+constexpr std::array<double, 6> kRated = {200, 200, 400, 10, 10, 8};
+
+struct Case {
+  fw::FloatCalibration cal;
+  hal::AdcInfo adc;
+};
+
+/// A random calibration shaped like a real one: about rated output at 0.6 mV/V per bridge,
+/// second-order terms worth ~1 % of rated at that level, drift of ~0.03 %/°C.
+Case RandomCase(std::mt19937_64& rng, bool products, bool temperature) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::uniform_int_distribution<int> nch(1, 8);
+  Case c;
+  const int n = nch(rng);
+  c.adc = cal::DefaultAdc(static_cast<std::uint8_t>(n));
+  c.cal.channel_count = static_cast<std::uint8_t>(n);
+  for (std::size_t r = 0; r < 6; ++r) {
+    for (int ch = 0; ch < n; ++ch) {
+      c.cal.matrix[r][static_cast<std::size_t>(ch)] = u(rng) * kRated[r] / 0.6;
+    }
+    c.cal.bias[r] = u(rng) * 0.01 * kRated[r];
+  }
+  for (int ch = 0; ch < n; ++ch) c.cal.offset_mvv[static_cast<std::size_t>(ch)] = 0.5 * u(rng);
+  if (products) {
+    std::size_t k = 0;
+    for (int a = 0; a < n; ++a) {
+      for (int b = a; b < n; ++b) {
+        c.cal.products[k] = {static_cast<std::uint8_t>(a), static_cast<std::uint8_t>(b)};
+        for (std::size_t r = 0; r < 6; ++r)
+          c.cal.product_matrix[r][k] = u(rng) * 0.01 * kRated[r] / 0.36;
+        ++k;
+      }
+    }
+    c.cal.product_count = static_cast<std::uint8_t>(k);
+  }
+  if (temperature) {
+    c.cal.temperature_compensated = true;
+    c.cal.temp_ref_c = 20.0 + 5.0 * u(rng) + 0.0004;  // deliberately not on the m°C grid
+    c.cal.temp_min_c = -10.0;
+    c.cal.temp_max_c = 60.0;
+    for (int ch = 0; ch < n; ++ch) {
+      c.cal.bias_slope_mvv_per_c[static_cast<std::size_t>(ch)] = 3e-4 * u(rng);
+      c.cal.gain_slope_per_c[static_cast<std::size_t>(ch)] = 3e-4 * u(rng);
+    }
+  }
+  return c;
+}
+
+/// Random counts between the rails; one in eight samples pinned at a rail per channel.
+std::array<std::int32_t, hal::kMaxChannels> RandomCounts(std::mt19937_64& rng,
+                                                         const hal::AdcInfo& adc) {
+  std::uniform_int_distribution<std::int32_t> u(adc.min_counts, adc.max_counts);
+  std::uniform_int_distribution<int> pick(0, 7);
+  std::array<std::int32_t, hal::kMaxChannels> x{};
+  for (auto& v : x) {
+    const int p = pick(rng);
+    v = p == 0 ? adc.max_counts : p == 1 ? adc.min_counts : u(rng);
+  }
+  return x;
+}
+
+std::array<double, 6> Reference(const Case& c, const std::array<std::int32_t, hal::kMaxChannels>& x,
+                                std::int32_t mdegc) {
+  const double cpm = fw::CountsPerMvv(c.adc);
+  std::array<double, hal::kMaxChannels> mvv{};
+  for (std::size_t i = 0; i < hal::kMaxChannels; ++i) mvv[i] = x[i] / cpm;
+  std::array<double, 6> y = cal::EvaluateCalibration(c.cal, mvv.data(), mdegc / 1000.0);
+  for (std::size_t r = 0; r < 6; ++r) y[r] /= fw::AxisLsb(r);
+  return y;
+}
+
+/// Applies `core` to `samples` random inputs and checks each axis against `ref` − `offset`
+/// within the loader's bound.
+template <typename TempGen>
+void ExpectWithinBound(const Case& c, const fw::WrenchCore& core, const fw::LoadReport& rep,
+                       std::mt19937_64& rng, int samples, TempGen temp,
+                       const std::array<double, 6>& offset, double* worst_seen) {
+  for (int s = 0; s < samples; ++s) {
+    const auto x = RandomCounts(rng, c.adc);
+    const std::int32_t t = temp(s);
+    fw::WrenchLsb y{};
+    bool sat = false;
+    bool range = false;
+    core.Apply(x, t, true, y, &sat, &range);
+    ASSERT_FALSE(sat);
+    if (c.cal.temperature_compensated) {
+      EXPECT_EQ(range, t < std::lround(c.cal.temp_min_c * 1000) ||
+                           t > std::lround(c.cal.temp_max_c * 1000));
+    }
+    const auto ref = Reference(c, x, t);
+    for (std::size_t r = 0; r < 6; ++r) {
+      const double err = std::fabs(y[r] - (ref[r] - offset[r]));
+      if (worst_seen != nullptr) *worst_seen = std::max(*worst_seen, err);
+      ASSERT_LE(err, rep.worst_case_error_lsb[r]) << "sample " << s << " axis " << r;
+    }
+  }
+}
+
+void CheckCases(bool products, bool temperature, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<std::int32_t> temp(-30000, 90000);  // beyond the range too
+  double worst_seen = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Case c = RandomCase(rng, products, temperature);
+    fw::FixedCalibration fixed{};
+    fw::LoadReport rep{};
+    ASSERT_EQ(fw::LoadCalibration(c.cal, c.adc, &fixed, &rep), fw::LoadStatus::kOk);
+    fw::WrenchCore core;
+    core.SetCalibration(fixed);
+    for (std::size_t r = 0; r < 6; ++r) {
+      // Realistic calibrations keep the core's contract: within 1 LSB of exact.
+      ASSERT_LE(rep.worst_case_error_lsb[r], 1.0) << "trial " << trial << " axis " << r;
+    }
+    ExpectWithinBound(
+        c, core, rep, rng, 200, [&](int) { return temp(rng); }, {}, &worst_seen);
+  }
+  std::printf("largest |fixed - double| seen: %.3f LSB\n", worst_seen);
+}
+
+TEST(FixedTerms, LinearWithinOneLsb) { CheckCases(false, false, 1); }
+TEST(FixedTerms, SecondOrderWithinProvenBound) { CheckCases(true, false, 2); }
+TEST(FixedTerms, TemperatureWithinProvenBound) { CheckCases(false, true, 3); }
+TEST(FixedTerms, SecondOrderAndTemperatureWithinProvenBound) { CheckCases(true, true, 4); }
+
+TEST(FixedTerms, TareMakesEveryFeatureRelativeToTheTarePoint) {
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<std::int32_t> temp(-5000, 50000);
+  for (int trial = 0; trial < 100; ++trial) {
+    const Case c = RandomCase(rng, true, true);
+    fw::FixedCalibration fixed{};
+    fw::LoadReport rep{};
+    ASSERT_EQ(fw::LoadCalibration(c.cal, c.adc, &fixed, &rep), fw::LoadStatus::kOk);
+    fw::WrenchCore core;
+    core.SetLimits(fw::CoreLimits{0, 0});
+    core.SetCalibration(fixed);
+    // Keep the tare sample away from the rails (a saturated sample is not usable for a tare).
+    auto tare_x = RandomCounts(rng, c.adc);
+    for (auto& v : tare_x) v /= 2;
+    hal::AdcSample s{};
+    s.channel_count = c.cal.channel_count;
+    s.counts = tare_x;
+    s.has_temperature = true;
+    s.temperature_mdegc = temp(rng);
+    ASSERT_TRUE(core.RequestTare(1));
+    fw::CoreOutput out{};
+    core.Process(s, false, out);
+    ASSERT_TRUE(core.tare_active());
+    const auto ref_tare = Reference(c, tare_x, s.temperature_mdegc);
+    ExpectWithinBound(
+        c, core, rep, rng, 50, [&](int) { return temp(rng); }, ref_tare, nullptr);
+  }
+}
+
+TEST(FixedTerms, LoaderRefusesWhatCouldOverflowAndAcceptsUpToTheEdge) {
+  std::mt19937_64 rng(6);
+  for (int trial = 0; trial < 40; ++trial) {
+    const Case base = RandomCase(rng, true, true);
+    // Scale every coefficient by m; find the largest accepted m by bisection.
+    auto scaled = [&](double m) {
+      Case c = base;
+      for (std::size_t r = 0; r < 6; ++r) {
+        for (auto& v : c.cal.matrix[r]) v *= m;
+        for (auto& v : c.cal.product_matrix[r]) v *= m;
+        c.cal.bias[r] *= m;
+      }
+      return c;
+    };
+    double lo = 1.0;
+    double hi = 1e12;
+    fw::FixedCalibration fixed{};
+    ASSERT_EQ(fw::LoadCalibration(scaled(lo).cal, base.adc, &fixed, nullptr), fw::LoadStatus::kOk);
+    ASSERT_EQ(fw::LoadCalibration(scaled(hi).cal, base.adc, &fixed, nullptr),
+              fw::LoadStatus::kOutputOverflow);
+    for (int i = 0; i < 60; ++i) {
+      const double mid = std::sqrt(lo * hi);
+      if (fw::LoadCalibration(scaled(mid).cal, base.adc, &fixed, nullptr) == fw::LoadStatus::kOk) {
+        lo = mid;
+      } else {
+        hi = mid;
+      }
+    }
+    // At the edge, the extreme inputs still give the exact result within the bound: no wrap.
+    const Case edge = scaled(lo);
+    fw::LoadReport rep{};
+    ASSERT_EQ(fw::LoadCalibration(edge.cal, edge.adc, &fixed, &rep), fw::LoadStatus::kOk);
+    fw::WrenchCore core;
+    core.SetCalibration(fixed);
+    ExpectWithinBound(
+        edge, core, rep, rng, 300, [](int s) { return s % 2 == 0 ? 60000 : -10000; }, {}, nullptr);
+  }
+}
+
+TEST(FixedTerms, BadTermsAreRefused) {
+  std::mt19937_64 rng(7);
+  Case c = RandomCase(rng, true, true);
+  fw::FixedCalibration fixed{};
+  Case bad = c;
+  bad.cal.products[0].b = bad.cal.channel_count;  // no such channel
+  EXPECT_EQ(fw::LoadCalibration(bad.cal, bad.adc, &fixed, nullptr), fw::LoadStatus::kBadTerms);
+  bad = c;
+  bad.cal.product_matrix[3][0] = std::nan("");
+  EXPECT_EQ(fw::LoadCalibration(bad.cal, bad.adc, &fixed, nullptr), fw::LoadStatus::kNotFinite);
+  bad = c;
+  bad.cal.gain_slope_per_c[0] = INFINITY;
+  EXPECT_EQ(fw::LoadCalibration(bad.cal, bad.adc, &fixed, nullptr), fw::LoadStatus::kNotFinite);
+  bad = c;
+  bad.cal.temp_ref_c = 70.0;  // outside its own range
+  EXPECT_EQ(fw::LoadCalibration(bad.cal, bad.adc, &fixed, nullptr), fw::LoadStatus::kBadTerms);
+  EXPECT_FALSE(fixed.valid);  // untouched by every refusal
+}
+
+TEST(FixedTerms, MissingTemperatureUsesTheReferenceAndRaisesTheStatusBit) {
+  std::mt19937_64 rng(8);
+  const Case c = RandomCase(rng, false, true);
+  fw::FixedCalibration fixed{};
+  ASSERT_EQ(fw::LoadCalibration(c.cal, c.adc, &fixed, nullptr), fw::LoadStatus::kOk);
+  fw::WrenchCore core;
+  core.SetLimits(fw::CoreLimits{0, 0});
+  core.SetCalibration(fixed);
+  hal::AdcSample s{};
+  s.channel_count = c.cal.channel_count;
+  s.has_temperature = false;
+  fw::CoreOutput out{};
+  core.Process(s, false, out);
+  EXPECT_NE(out.status & fw::kStatusTempRange, 0);
+  s.has_temperature = true;
+  s.temperature_mdegc = 25000;
+  core.Process(s, false, out);
+  EXPECT_EQ(out.status & fw::kStatusTempRange, 0);
+}
+
+}  // namespace
+}  // namespace ftstack

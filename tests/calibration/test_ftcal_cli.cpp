@@ -1,0 +1,101 @@
+// ftcal end to end: design → simulated rig → fit (with report) → verify → apply; error exits.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "calibration/cal_file.hpp"
+#include "sim/recording.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int code;
+  std::string out;
+};
+
+CliRun Ftcal(const std::string& args) {
+  const std::string cmd = std::string(FTSTACK_BIN_DIR) + "/ftcal " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (p != nullptr && std::fgets(buf, sizeof buf, p) != nullptr) out += buf;
+  const int status = p != nullptr ? pclose(p) : -1;
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+class FtcalCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("ftcal_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string P(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+TEST_F(FtcalCli, DesignFitVerifyApply) {
+  CliRun r = Ftcal("design --sensor builtin --rate-hz 100 --out " + P("profile.csv") +
+                   " --simulate " + P("rig.csv"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("condition number of the load set"), std::string::npos);
+  r = Ftcal("fit --in " + P("rig.csv") + " --out " + P("cal.json") + " --report " +
+            P("report.html") + " --sensor builtin --serial SN1");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("held-out"), std::string::npos);
+  EXPECT_NE(r.out.find("model: linear"), std::string::npos) << r.out;
+  // The report is self-contained: inline SVG, no external references.
+  std::ifstream html(P("report.html"));
+  std::stringstream ss;
+  ss << html.rdbuf();
+  EXPECT_NE(ss.str().find("<svg"), std::string::npos);
+  EXPECT_EQ(ss.str().find("http://"), ss.str().find("http://www.w3.org"));  // only the SVG xmlns
+  EXPECT_EQ(ss.str().find("https://"), std::string::npos);
+  r = Ftcal("verify " + P("cal.json"));
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("OK"), std::string::npos);
+  r = Ftcal("apply --cal " + P("cal.json") + " --in " + P("rig.csv") + " --out " + P("out.csv"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  const ftstack::sim::Recording in = ftstack::sim::ReadRecording(P("rig.csv"));
+  const ftstack::sim::Recording out = ftstack::sim::ReadRecording(P("out.csv"));
+  ASSERT_EQ(in.rows(), out.rows());
+  // Fz within 5 noise σ (≈ 0.04 N) of the reference on every row.
+  const auto& ref = in.Column("Fz");
+  const auto& got = out.Column("Fz");
+  for (std::size_t i = 0; i < ref.size(); ++i) ASSERT_NEAR(got[i], ref[i], 0.2) << i;
+}
+
+TEST_F(FtcalCli, BadInputsExitNonZeroWithFileAndPosition) {
+  {
+    std::ofstream f(P("bad.csv"));
+    f << "t,Fx,Fy,Fz,Mx,My,Mz,b0\n0,0,0,0,0,0,0,0.1\n1,0,0,abc,0,0,0,0.1\n";
+  }
+  CliRun r = Ftcal("fit --in " + P("bad.csv") + " --out " + P("cal.json"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find("bad.csv:3:"), std::string::npos) << r.out;
+  {
+    std::ofstream f(P("nowrench.csv"));
+    f << "t,b0\n0,0.1\n";
+  }
+  r = Ftcal("fit --in " + P("nowrench.csv") + " --out " + P("cal.json"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find("nowrench.csv"), std::string::npos) << r.out;
+  r = Ftcal("verify " + P("missing.json"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find("missing.json"), std::string::npos);
+  r = Ftcal("fit --in " + P("bad.csv") + " --out " + P("c.json") + " --model cubic");
+  EXPECT_NE(r.code, 0);
+}
+
+}  // namespace
