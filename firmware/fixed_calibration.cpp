@@ -217,24 +217,16 @@ LoadStatus LoadCalibration(const FloatCalibration& cal, const hal::AdcInfo& adc,
       m[temp_index] = a_r;
       bias_lsb += a_r * dt_ref_err;
     }
-    double worst = std::fabs(bias_lsb);
+    // Bound on |output| for every input between the rails, with or without a tare (every
+    // feature then relative to its value at the tare): Σ |m_k|·f_max,k + |bias|.
+    double real_bound = std::fabs(bias_lsb);
     double fsum = 1.0;
     for (std::size_t k = 0; k < count; ++k) {
-      // One-sided bounds for the output (no tare: derived features are at most half of fbound).
-      const double one_sided =
-          k < n ? std::fmax(std::fabs(min_c), std::fabs(max_c)) : fbound[k] / 2;
-      worst += std::fabs(m[k]) * one_sided;
+      real_bound += std::fabs(m[k]) * fbound[k];
       fsum += fbound[k];
     }
-    rep.worst_case_output_lsb[r] = worst;
-    if (!std::isfinite(worst) || worst + rounding_error + 1.0 > kInt32Max) {
-      rep.failing_axis = static_cast<std::uint8_t>(r);
-      return finish(LoadStatus::kOutputOverflow);
-    }
-    // Bound with a tare (every feature relative to its value at the tare, bias dropped).
-    double real_bound = std::fabs(bias_lsb);
-    for (std::size_t k = 0; k < count; ++k) real_bound += std::fabs(m[k]) * fbound[k];
-    if (!std::isfinite(real_bound)) {
+    rep.worst_case_output_lsb[r] = real_bound;
+    if (!std::isfinite(real_bound) || real_bound + rounding_error + 1.0 > kInt32Max) {
       rep.failing_axis = static_cast<std::uint8_t>(r);
       return finish(LoadStatus::kOutputOverflow);
     }
