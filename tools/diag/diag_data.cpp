@@ -1,0 +1,173 @@
+#include "tools/diag/diag_data.hpp"
+
+#include <algorithm>
+
+#include "sim/sensor_description.hpp"
+
+namespace ftstack::diag {
+namespace {
+
+struct ProgressRelay {
+  ProgressFn fn;
+  void* user;
+  double base;
+  double span;
+  const char* stage;
+};
+
+void Relay(std::size_t done, std::size_t total, void* user) {
+  const auto* r = static_cast<const ProgressRelay*>(user);
+  if (r->fn != nullptr && total > 0) {
+    r->fn(r->base + r->span * static_cast<double>(done) / static_cast<double>(total), r->stage,
+          r->user);
+  }
+}
+
+sim::Recording Read(const std::string& path, ProgressRelay* relay) {
+  sim::ReadOptions opt;
+  opt.required = {"t"};
+  opt.require_bridges = true;
+  if (relay != nullptr && relay->fn != nullptr) {
+    opt.progress = &Relay;
+    opt.progress_user = relay;
+  }
+  return sim::ReadRecording(path, opt);
+}
+
+bool HasWrench(const sim::Recording& r) {
+  for (const auto& w : sim::WrenchColumns()) {
+    if (!r.Has(w)) return false;
+  }
+  return true;
+}
+
+Eigen::MatrixXd Bridges(const sim::Recording& r, std::size_t n) {
+  Eigen::MatrixXd m(static_cast<Eigen::Index>(r.rows()), static_cast<Eigen::Index>(n));
+  for (std::size_t c = 0; c < n; ++c) {
+    const auto& col = r.Column("b" + std::to_string(c));
+    for (std::size_t i = 0; i < col.size(); ++i)
+      m(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(c)) = col[i];
+  }
+  return m;
+}
+
+Eigen::MatrixXd WrenchOf(const sim::Recording& r) {
+  Eigen::MatrixXd m(static_cast<Eigen::Index>(r.rows()), 6);
+  for (int k = 0; k < 6; ++k) {
+    const auto& col = r.Column(sim::WrenchColumns()[static_cast<std::size_t>(k)]);
+    for (std::size_t i = 0; i < col.size(); ++i) m(static_cast<Eigen::Index>(i), k) = col[i];
+  }
+  return m;
+}
+
+void CheckUsable(const DiagData& d) {
+  if (d.rows() < 64) {
+    throw DiagInputError(d.real_name + ": " + std::to_string(d.rows()) +
+                         " rows; a diagnosis needs at least 64");
+  }
+}
+
+}  // namespace
+
+double DiagData::rate_hz() const {
+  if (t_s.size() < 2) return 0.0;
+  std::vector<double> dt(t_s.size() - 1);
+  for (std::size_t i = 1; i < t_s.size(); ++i) dt[i - 1] = t_s[i] - t_s[i - 1];
+  std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
+  return 1.0 / dt[dt.size() / 2];
+}
+
+DiagData FromRecordings(const sim::Recording& sim, const sim::Recording& real) {
+  const std::size_t nr = real.BridgeCount();
+  const std::size_t ns = sim.BridgeCount();
+  if (nr == 0) throw DiagInputError(real.path + ": no bridge columns b0…");
+  if (ns != nr) {
+    throw DiagInputError(sim.path + ": has " + std::to_string(ns) + " bridge columns but " +
+                         real.path + " has " + std::to_string(nr));
+  }
+  try {
+    sim::CheckAligned(sim, real);
+  } catch (const sim::RecordingError& e) {
+    throw DiagInputError(e.what());
+  }
+  DiagData d;
+  d.sim_name = sim.path;
+  d.real_name = real.path;
+  d.t_s = real.Column("t");
+  d.sim_mvv = Bridges(sim, nr);
+  d.real_mvv = Bridges(real, nr);
+  if (HasWrench(real)) {
+    d.wrench = WrenchOf(real);
+  } else if (HasWrench(sim)) {
+    d.wrench = WrenchOf(sim);
+  }
+  if (real.Has("temp_C")) d.temp_c = real.Column("temp_C");
+  CheckUsable(d);
+  return d;
+}
+
+DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path, ProgressFn progress,
+                     void* user) {
+  ProgressRelay r1{progress, user, 0.0, 0.5, "reading sim"};
+  ProgressRelay r2{progress, user, 0.5, 0.5, "reading real"};
+  try {
+    const sim::Recording sim = Read(sim_path, &r1);
+    const sim::Recording real = Read(real_path, &r2);
+    return FromRecordings(sim, real);
+  } catch (const sim::RecordingError& e) {
+    throw DiagInputError(e.what());
+  }
+}
+
+DiagData LoadModelReal(const std::string& sensor_path, const std::string& real_path,
+                       ProgressFn progress, void* user) {
+  sim::SensorDescription desc;
+  try {
+    desc = sim::LoadSensorDescription(sensor_path);
+  } catch (const std::exception& e) {
+    throw DiagInputError(e.what());
+  }
+  ProgressRelay r1{progress, user, 0.0, 0.8, "reading real"};
+  sim::Recording real;
+  try {
+    sim::ReadOptions opt;
+    opt.required = {"t"};
+    opt.require_bridges = true;
+    opt.require_wrench = true;
+    if (progress != nullptr) {
+      opt.progress = &Relay;
+      opt.progress_user = &r1;
+    }
+    real = sim::ReadRecording(real_path, opt);
+  } catch (const sim::RecordingError& e) {
+    throw DiagInputError(e.what());
+  }
+  const std::size_t nr = real.BridgeCount();
+  if (static_cast<int>(nr) != desc.model->channel_count()) {
+    throw DiagInputError(real_path + ": has " + std::to_string(nr) +
+                         " bridge columns but the model " + sensor_path + " has " +
+                         std::to_string(desc.model->channel_count()));
+  }
+  DiagData d;
+  d.sim_name = sensor_path.empty() ? "builtin" : sensor_path;
+  d.real_name = real_path;
+  d.t_s = real.Column("t");
+  d.real_mvv = Bridges(real, nr);
+  d.wrench = WrenchOf(real);
+  if (real.Has("temp_C")) d.temp_c = real.Column("temp_C");
+  const auto n = static_cast<Eigen::Index>(d.t_s.size());
+  d.sim_mvv.resize(n, static_cast<Eigen::Index>(nr));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const sim::Wrench w = d.wrench.row(i).transpose();
+    const double temp = d.temp_c.empty() ? 20.0 : d.temp_c[static_cast<std::size_t>(i)];
+    const Eigen::VectorXd b = desc.model->BridgeOutputs(w, temp);
+    d.sim_mvv.row(i) = b.transpose();
+    if (progress != nullptr && (i % 20000) == 0) {
+      progress(0.8 + 0.2 * static_cast<double>(i) / static_cast<double>(n), "simulating", user);
+    }
+  }
+  CheckUsable(d);
+  return d;
+}
+
+}  // namespace ftstack::diag

@@ -1,0 +1,53 @@
+// Inputs of a sim-vs-real diagnosis: aligned time, reference wrench, temperature, predicted and
+// measured bridges.
+#pragma once
+
+#include <Eigen/Dense>
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "sim/recording.hpp"
+
+namespace ftstack::diag {
+
+/// Input that cannot be diagnosed; what() is one line naming the file (and line:column where
+/// known).
+class DiagInputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// One aligned pair of recordings, column-major (row i is sample i).
+struct DiagData {
+  std::vector<double> t_s;     ///< sample times, s, strictly increasing
+  Eigen::MatrixXd wrench;      ///< n × 6: Fx Fy Fz (N) Mx My Mz (N·m); 0 columns when absent
+  std::vector<double> temp_c;  ///< body temperature, °C; empty when the real file has none
+  Eigen::MatrixXd sim_mvv;     ///< n × N predicted bridge outputs, mV/V
+  Eigen::MatrixXd real_mvv;    ///< n × N measured bridge outputs, mV/V
+  std::string sim_name;        ///< where the prediction came from (file or sensor description)
+  std::string real_name;       ///< the real recording's path
+
+  [[nodiscard]] std::size_t rows() const { return t_s.size(); }
+  [[nodiscard]] int channels() const { return static_cast<int>(real_mvv.cols()); }
+  [[nodiscard]] bool has_wrench() const { return wrench.cols() == 6; }
+  [[nodiscard]] bool has_temp() const { return !temp_c.empty(); }
+  /// Median sample rate, Hz.
+  [[nodiscard]] double rate_hz() const;
+};
+
+/// Progress callback: (fraction done 0…1, what is happening).
+using ProgressFn = void (*)(double fraction, const char* stage, void* user);
+
+/// Builds the pair from two recordings already read: checks bridge counts and alignment.
+[[nodiscard]] DiagData FromRecordings(const sim::Recording& sim, const sim::Recording& real);
+/// Reads SIM.csv and REAL.csv (recording-format.md) and aligns them.
+[[nodiscard]] DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path,
+                                   ProgressFn progress = nullptr, void* user = nullptr);
+/// Reads REAL.csv and predicts its bridges with the sensor description's model from the real
+/// wrench and temp_C (20 °C where absent).
+[[nodiscard]] DiagData LoadModelReal(const std::string& sensor_path, const std::string& real_path,
+                                     ProgressFn progress = nullptr, void* user = nullptr);
+
+}  // namespace ftstack::diag

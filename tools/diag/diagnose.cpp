@@ -1,0 +1,442 @@
+#include "tools/diag/diagnose.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+
+#include "tools/diag/signal.hpp"
+
+namespace ftstack::diag {
+namespace {
+
+using Mat = Eigen::MatrixXd;
+using Vec = Eigen::VectorXd;
+
+constexpr const char* kWrenchNames[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
+
+/// z of a χ² statistic with ν degrees of freedom (Wilson–Hilferty).
+double ChiSquareZ(double x, double nu) {
+  if (nu <= 0) return 0.0;
+  const double a = 2.0 / (9.0 * nu);
+  return (std::cbrt(x / nu) - (1.0 - a)) / std::sqrt(a);
+}
+
+double HoldRms(const Context& cx, const Mat& target, const Mat* pred) {
+  double s = 0.0;
+  for (int c = 0; c < cx.nc; ++c) {
+    for (int i = 0; i < cx.n; ++i) {
+      if (cx.train[static_cast<std::size_t>(i)]) continue;
+      const double e = target(i, c) - (pred != nullptr ? (*pred)(i, c) : 0.0);
+      s += e * e;
+    }
+  }
+  return std::sqrt(s / std::max(1.0, static_cast<double>(cx.n_hold) * cx.nc));
+}
+
+Vec ChannelRms(const Mat& m) {
+  Vec v(m.cols());
+  for (Eigen::Index c = 0; c < m.cols(); ++c)
+    v(c) = std::sqrt(m.col(c).squaredNorm() / static_cast<double>(m.rows()));
+  return v;
+}
+
+double HoldPenalty(const Context& cx) {
+  return std::log(std::max(2.0, static_cast<double>(cx.n_hold) * cx.nc));
+}
+
+struct Scored {
+  EffectFit fit;
+  double hold_sse = 0.0;
+  double delta = 0.0;
+  double z = 0.0;
+  double score = 0.0;
+  bool eligible = false;
+};
+
+Scored ScoreFit(const Context& cx, const Mat& target, EffectFit fit, double base_hold,
+                double z_claim) {
+  Scored s;
+  const Sums sums = Score(cx, target, &fit.pred);
+  s.hold_sse = sums.hold_sse;
+  s.delta = base_hold - sums.hold_sse;
+  s.z = sums.hold_pp > 0 ? s.delta / (2.0 * std::sqrt(sums.hold_pp)) : 0.0;
+  s.score = s.delta - fit.n_params * HoldPenalty(cx);
+  s.eligible = s.z > z_claim && s.score > 0;
+  s.fit = std::move(fit);
+  return s;
+}
+
+void Locate(Report& r) {
+  const Context& cx = r.cx;
+  const auto& d = *cx.data;
+  const auto m = static_cast<int>(std::llround(cx.block_s * cx.rate_hz));
+  const int blocks = std::max(1, cx.n / std::max(1, m));
+  // Channels: slow (window means) and fast (mean square) χ² tests.
+  for (int c = 0; c < cx.nc; ++c) {
+    double xlow = 0.0;
+    double xfull = 0.0;
+    for (int b = 0; b < blocks; ++b) {
+      double s = 0.0;
+      const int i0 = b * m;
+      const int i1 = b + 1 == blocks ? cx.n : i0 + m;
+      for (int i = i0; i < i1; ++i) s += cx.resid(i, c);
+      const double mean = s / (i1 - i0);
+      xlow += mean * mean * (i1 - i0) * cx.weight(c);
+    }
+    for (int i = 0; i < cx.n; ++i) xfull += cx.resid(i, c) * cx.resid(i, c) * cx.weight(c);
+    const double zlow = ChiSquareZ(xlow, blocks);
+    const double zfull = ChiSquareZ(xfull, cx.n);
+    if (zlow > 6.0 || (zfull > 6.0 && xfull / cx.n > 1.05)) r.mismatch_channels.push_back(c);
+  }
+  if (r.mismatch_channels.empty()) return;
+  const auto nf = static_cast<double>(r.mismatch_channels.size());
+  std::vector<bool> flag(static_cast<std::size_t>(blocks), false);
+  for (int b = 0; b < blocks; ++b) {
+    const int i0 = b * m;
+    const int i1 = b + 1 == blocks ? cx.n : i0 + m;
+    double xm = 0.0;
+    double xs = 0.0;
+    for (int c : r.mismatch_channels) {
+      double s = 0.0;
+      for (int i = i0; i < i1; ++i) {
+        s += cx.resid(i, c);
+        xs += cx.resid(i, c) * cx.resid(i, c) * cx.weight(c);
+      }
+      xm += s * s / (i1 - i0) * cx.weight(c);
+    }
+    flag[static_cast<std::size_t>(b)] =
+        ChiSquareZ(xm, nf) > 4.5 || ChiSquareZ(xs, nf * (i1 - i0)) > 4.5;
+  }
+  // Merge flagged blocks separated by at most one quiet block.
+  std::vector<std::pair<int, int>> runs;
+  for (int b = 0; b < blocks; ++b) {
+    if (!flag[static_cast<std::size_t>(b)]) continue;
+    if (!runs.empty() && b - runs.back().second <= 2) {
+      runs.back().second = b;
+    } else {
+      runs.emplace_back(b, b);
+    }
+  }
+  while (runs.size() > 40) {
+    std::size_t gi = 1;
+    int gap = std::numeric_limits<int>::max();
+    for (std::size_t j = 1; j < runs.size(); ++j) {
+      if (runs[j].first - runs[j - 1].second < gap) {
+        gap = runs[j].first - runs[j - 1].second;
+        gi = j;
+      }
+    }
+    runs[gi - 1].second = runs[gi].second;
+    runs.erase(runs.begin() + static_cast<std::ptrdiff_t>(gi));
+  }
+  for (const auto& [b0, b1] : runs) {
+    const int i0 = b0 * m;
+    const int i1 = std::min(cx.n - 1, b1 + 1 == blocks ? cx.n - 1 : (b1 + 1) * m - 1);
+    r.windows.emplace_back(d.t_s[static_cast<std::size_t>(i0)],
+                           d.t_s[static_cast<std::size_t>(i1)]);
+  }
+  // Load region: where in the load space the excess over noise lives.
+  if (!d.has_wrench()) return;
+  std::vector<double> excess(static_cast<std::size_t>(cx.n));
+  double mean_ex = 0.0;
+  for (int i = 0; i < cx.n; ++i) {
+    double e = 0.0;
+    for (int c : r.mismatch_channels) e += cx.resid(i, c) * cx.resid(i, c) * cx.weight(c) - 1.0;
+    excess[static_cast<std::size_t>(i)] = e / nf;
+    mean_ex += e / nf;
+  }
+  mean_ex /= cx.n;
+  double best_eta = 0.0;
+  int best_k = -1;
+  int best_bin = 0;
+  double best_bin_mean = 0.0;
+  double best_lo = 0.0;
+  double best_hi = 0.0;
+  for (int k = 0; k < 6; ++k) {
+    const double peak = d.wrench.col(k).cwiseAbs().maxCoeff();
+    if (peak <= 0) continue;
+    double sum[6] = {};
+    double cnt[6] = {};
+    for (int i = 0; i < cx.n; ++i) {
+      const double u = d.wrench(i, k) / peak;
+      const int mag = std::min(2, static_cast<int>(std::fabs(u) * 3.0));
+      const int bin = (u >= 0 ? 3 : 0) + mag;
+      sum[bin] += excess[static_cast<std::size_t>(i)];
+      cnt[bin] += 1.0;
+    }
+    double between = 0.0;
+    double total = 0.0;
+    for (int i = 0; i < cx.n; ++i)
+      total += (excess[static_cast<std::size_t>(i)] - mean_ex) *
+               (excess[static_cast<std::size_t>(i)] - mean_ex);
+    int top = -1;
+    double top_mean = -std::numeric_limits<double>::infinity();
+    for (int b = 0; b < 6; ++b) {
+      if (cnt[b] < 20) continue;
+      const double mb = sum[b] / cnt[b];
+      between += cnt[b] * (mb - mean_ex) * (mb - mean_ex);
+      if (mb > top_mean) {
+        top_mean = mb;
+        top = b;
+      }
+    }
+    const double eta = total > 0 ? between / total : 0.0;
+    if (top >= 0 && eta > best_eta) {
+      best_eta = eta;
+      best_k = k;
+      best_bin = top;
+      best_bin_mean = top_mean;
+      const int mag = top % 3;
+      const double a = peak * mag / 3.0;
+      const double b = peak * (mag + 1) / 3.0;
+      best_lo = top >= 3 ? a : -b;
+      best_hi = top >= 3 ? b : -a;
+    }
+  }
+  if (best_k >= 0 && best_eta > 0.01) {
+    r.load_region = {{"component", kWrenchNames[best_k]},  {"sign", best_bin >= 3 ? "+" : "-"},
+                     {"range", {best_lo, best_hi}},        {"excess_ratio", 1.0 + best_bin_mean},
+                     {"mean_excess_ratio", 1.0 + mean_ex}, {"eta_squared", best_eta}};
+  } else {
+    r.load_region = {{"component", nullptr}, {"note", "the excess does not depend on the load"}};
+  }
+}
+
+void Progress(const DiagnoseOptions& o, double f, const char* what) {
+  if (o.progress != nullptr) o.progress(f, what, o.progress_user);
+}
+
+/// Backfits two effects: B on target − A (A fitted alone), then A again on target − B.
+bool FitPair(const Context& cx, const Mat& target, const EffectSpec& a, const EffectSpec& b,
+             const EffectFit& a0, EffectFit* fa, EffectFit* fb) {
+  auto nb = b.fit(cx, target - a0.pred);
+  if (!nb) return false;
+  *fb = std::move(*nb);
+  auto na = a.fit(cx, target - fb->pred);
+  if (!na) return false;
+  *fa = std::move(*na);
+  return true;
+}
+
+}  // namespace
+
+Report Diagnose(const DiagData& data, const DiagnoseOptions& options) {
+  Report r;
+  Progress(options, 0.0, "noise and hold-out split");
+  r.cx = MakeContext(data, options.block_s);
+  const Context& cx = r.cx;
+  r.rate_hz = cx.rate_hz;
+  r.noise_rms = cx.sigma;
+  r.rms_before = ChannelRms(cx.resid);
+  r.hold_rms_before = HoldRms(cx, cx.resid, nullptr);
+  r.hold_rms_after = r.hold_rms_before;
+  r.model = Mat::Zero(cx.n, cx.nc);
+  Locate(r);
+  // Spectrum for the report.
+  const std::size_t seg = WelchSegment(data.rows());
+  if (data.rows() >= seg && seg >= 32) {
+    for (int c = 0; c < cx.nc; ++c) {
+      const Spectrum s = Welch(cx.resid.col(c).data(), data.rows(), cx.rate_hz, seg);
+      if (r.spectrum_power.empty()) {
+        r.spectrum_hz = s.freq_hz;
+        r.spectrum_power.assign(s.power.size(), 0.0);
+      }
+      for (std::size_t k = 0; k < s.power.size(); ++k)
+        r.spectrum_power[k] += s.power[k] * cx.weight(c) / cx.nc;
+    }
+  }
+  const Sums base = Score(cx, cx.resid, nullptr);
+  // Singles.
+  std::vector<Scored> singles;
+  const auto& effects = Effects();
+  for (std::size_t j = 0; j < effects.size(); ++j) {
+    Progress(options, 0.05 + 0.6 * static_cast<double>(j) / static_cast<double>(effects.size()),
+             effects[j].name);
+    auto fit = effects[j].fit(cx, cx.resid);
+    if (!fit) continue;
+    singles.push_back(ScoreFit(cx, cx.resid, std::move(*fit), base.hold_sse, options.z_claim));
+  }
+  std::sort(singles.begin(), singles.end(),
+            [](const Scored& a, const Scored& b) { return a.score > b.score; });
+  for (const auto& s : singles) {
+    CandidateScore c;
+    c.name = s.fit.name;
+    c.variant = s.fit.variant;
+    c.n_params = s.fit.n_params;
+    c.hold_rms_after = HoldRms(cx, cx.resid, &s.fit.pred);
+    c.z = s.z;
+    c.score = s.score;
+    c.eligible = s.eligible;
+    r.candidates.push_back(c);
+  }
+  if (singles.empty() || !singles.front().eligible) {
+    Progress(options, 1.0, "done");
+    return r;
+  }
+  const Scored& best = singles.front();
+  // Pairs: the best single with each other eligible candidate among the top six, backfitted.
+  bool have_pair = false;
+  EffectFit pa;
+  EffectFit pb;
+  double pair_score = best.score;
+  if (options.pairs) {
+    // Forward selection from each of the three best eligible singles: every other effect is fitted
+    // to what the first leaves, the two best partners are kept, the first is refitted to what the
+    // partner leaves, and the pair is scored on the held-out rows.
+    std::vector<std::size_t> top;
+    for (std::size_t j = 0; j < singles.size() && top.size() < 3; ++j) {
+      if (singles[j].eligible && singles[j].score >= 0.5 * best.score) top.push_back(j);
+    }
+    std::size_t step = 0;
+    for (std::size_t x : top) {
+      const Scored& first = singles[x];
+      const Mat rest = cx.resid - first.fit.pred;
+      const Sums rest_base = Score(cx, rest, nullptr);
+      std::vector<std::pair<double, std::string>> partners;
+      for (const auto& spec : effects) {
+        Progress(
+            options,
+            0.65 + 0.33 * static_cast<double>(step++) / static_cast<double>(3 * effects.size()),
+            "pairs");
+        if (first.fit.name == spec.name) continue;
+        // Partners come from the effects that were claimable on their own.
+        const bool claimable = std::any_of(singles.begin(), singles.end(), [&](const Scored& q) {
+          return q.eligible && q.fit.name == spec.name;
+        });
+        if (!claimable) continue;
+        auto fb = spec.fit(cx, rest);
+        if (!fb) continue;
+        const Scored sb = ScoreFit(cx, rest, std::move(*fb), rest_base.hold_sse, options.z_claim);
+        if (sb.eligible) partners.emplace_back(sb.score, spec.name);
+      }
+      std::sort(partners.rbegin(), partners.rend());
+      for (std::size_t y = 0; y < std::min<std::size_t>(2, partners.size()); ++y) {
+        const EffectSpec* sa = FindEffect(first.fit.name);
+        const EffectSpec* sb = FindEffect(partners[y].second);
+        EffectFit fa;
+        EffectFit fb;
+        if (!FitPair(cx, cx.resid, *sa, *sb, first.fit, &fa, &fb)) continue;
+        Mat both = fa.pred + fb.pred;
+        const Sums s = Score(cx, cx.resid, &both);
+        const double delta = base.hold_sse - s.hold_sse;
+        const double score = delta - (fa.n_params + fb.n_params) * HoldPenalty(cx);
+        // The partner must add a significant held-out improvement over the first alone …
+        const Mat diff = both - first.fit.pred;
+        double dd = 0.0;
+        for (int c = 0; c < cx.nc; ++c) {
+          for (int i = 0; i < cx.n; ++i) {
+            if (!cx.train[static_cast<std::size_t>(i)])
+              dd += diff(i, c) * diff(i, c) * cx.weight(c);
+          }
+        }
+        const double inc = first.hold_sse - s.hold_sse;
+        const double z_inc = dd > 0 ? inc / (2.0 * std::sqrt(dd)) : 0.0;
+        // … and carry a visible share (≥ 1 %) of the excess over noise, not a misfit's remainder.
+        const double excess = base.hold_sse - static_cast<double>(cx.n_hold) * cx.nc;
+        if (std::getenv("FTDIAG_DEBUG") != nullptr) {
+          std::fprintf(
+              stderr,
+              "pair %s + %s: score %.1f (best single %.1f) z_inc %.1f inc %.1f excess %.1f\n",
+              fa.name.c_str(), fb.name.c_str(), score, best.score, z_inc, inc, excess);
+        }
+        // … and the pair must beat every model so far on the penalised held-out score.
+        if (z_inc > options.z_claim && inc > 0.01 * excess && score > pair_score) {
+          pair_score = score;
+          pa = std::move(fa);
+          pb = std::move(fb);
+          have_pair = true;
+        }
+      }
+    }
+  }
+  std::vector<EffectFit> claimed;
+  if (have_pair) {
+    // Stronger first: the one whose removal from the pair costs more on held-out rows.
+    const Sums only_a = Score(cx, cx.resid, &pa.pred);
+    const Sums only_b = Score(cx, cx.resid, &pb.pred);
+    if (only_b.hold_sse < only_a.hold_sse) std::swap(pa, pb);
+    claimed.push_back(std::move(pa));
+    claimed.push_back(std::move(pb));
+  } else {
+    claimed.push_back(best.fit);
+  }
+  Mat cum = Mat::Zero(cx.n, cx.nc);
+  for (auto& f : claimed) {
+    ClaimedEffect ce;
+    ce.hold_rms_before = HoldRms(cx, cx.resid, &cum);
+    cum += f.pred;
+    ce.hold_rms_after = HoldRms(cx, cx.resid, &cum);
+    ce.rms_after = ChannelRms(cx.resid - cum);
+    ce.fit = std::move(f);
+    r.effects.push_back(std::move(ce));
+  }
+  r.model = cum;
+  r.verdict = r.effects.front().fit.name;
+  // The noise reported is re-estimated once the claimed effects are removed (broadband effects
+  // such as ringing or skew on fast edges lift the spectrum's median a little).
+  for (int c = 0; c < cx.nc; ++c) {
+    const Vec rest = cx.resid.col(c) - cum.col(c);
+    r.noise_rms(c) = std::min(r.noise_rms(c),
+                              RobustNoise(rest.data(), static_cast<std::size_t>(cx.n), cx.rate_hz));
+  }
+  r.hold_rms_after = HoldRms(cx, cx.resid, &cum);
+  Progress(options, 1.0, "done");
+  return r;
+}
+
+nlohmann::json ToJson(const Report& r) {
+  auto vec = [](const Vec& v) {
+    auto a = nlohmann::json::array();
+    for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v(i));
+    return a;
+  };
+  nlohmann::json j;
+  j["schema"] = "ftdiag-report/1";
+  j["rate_hz"] = r.rate_hz;
+  j["noise_rms"] = vec(r.noise_rms);
+  j["rms_before"] = vec(r.rms_before);
+  auto windows = nlohmann::json::array();
+  for (const auto& [a, b] : r.windows) windows.push_back({a, b});
+  j["mismatch"] = {{"channels", r.mismatch_channels}, {"windows", windows}};
+  if (!r.load_region.is_null()) j["mismatch"]["load_region"] = r.load_region;
+  if (!r.cx.peak_hz.empty()) {
+    j["mismatch"]["spectral_peaks_hz"] = r.cx.peak_hz;
+  }
+  j["verdict"] = r.verdict;
+  auto effects = nlohmann::json::array();
+  for (const auto& e : r.effects) {
+    nlohmann::json ej;
+    ej["name"] = e.fit.name;
+    ej["channels"] = e.fit.channels;
+    ej["params"] = e.fit.params;
+    ej["uncertainty"] = e.fit.sigma;
+    ej["evidence"] = e.fit.evidence;
+    ej["rms_after"] = vec(e.rms_after);
+    ej["holdout"] = {{"rms_before", e.hold_rms_before}, {"rms_after", e.hold_rms_after}};
+    ej["model"] = e.fit.variant;
+    ej["n_params"] = e.fit.n_params;
+    effects.push_back(ej);
+  }
+  j["effects"] = effects;
+  j["holdout"] = {{"rms_before", r.hold_rms_before},
+                  {"rms_after", r.hold_rms_after},
+                  {"rows", r.cx.n_hold},
+                  {"block_s", r.cx.block_s},
+                  {"scheme", "every third block of block_s held out; fits use the other rows"}};
+  auto cands = nlohmann::json::array();
+  for (const auto& c : r.candidates) {
+    cands.push_back({{"name", c.name},
+                     {"model", c.variant},
+                     {"n_params", c.n_params},
+                     {"holdout_rms_after", c.hold_rms_after},
+                     {"z", c.z},
+                     {"score", c.score},
+                     {"eligible", c.eligible}});
+  }
+  j["candidates"] = cands;
+  return j;
+}
+
+}  // namespace ftstack::diag

@@ -1,0 +1,78 @@
+// Candidate physical effects of the diagnosis: each a parametric model of the sim-vs-real residual.
+#pragma once
+
+#include <Eigen/Dense>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tools/diag/diag_data.hpp"
+
+namespace ftstack::diag {
+
+/// Everything the effect models share, computed once from the data.
+struct Context {
+  const DiagData* data = nullptr;
+  int n = 0;                        ///< rows
+  int nc = 0;                       ///< channels
+  Eigen::MatrixXd resid;            ///< n × N real − sim, mV/V
+  Eigen::VectorXd sigma;            ///< robust noise per channel, mV/V
+  Eigen::VectorXd weight;           ///< 1/σ² per channel
+  std::vector<std::uint8_t> train;  ///< 1 = row used for fitting, 0 = held out
+  std::size_t n_train = 0;
+  std::size_t n_hold = 0;
+  double block_s = 0.0;        ///< length of the interleaved hold-out blocks
+  Eigen::VectorXd zero;        ///< sim at zero wrench per channel (regression intercept), mV/V
+  Eigen::MatrixXd load;        ///< n × N: sim − zero (the load-induced part)
+  Eigen::MatrixXd sens;        ///< N × 6 sim sensitivity d(mV/V)/d(wrench) by regression
+  Eigen::VectorXd load_range;  ///< per channel max − min of load, mV/V
+  std::vector<double> dtemp;   ///< temp − 20 °C; empty without temperature
+  bool uniform = true;         ///< sampling uniform to 1e-6 relative
+  double dt = 0.0;             ///< median sample interval, s
+  double rate_hz = 0.0;
+  int search_stride =
+      1;  ///< row step used inside nonlinear parameter searches (final fits use all)
+  std::vector<double> peak_hz;  ///< prominent lines of the residual spectrum, strongest first
+  std::vector<double> peak_ratio;
+};
+
+/// Builds the context: residual, noise, hold-out blocks (every third block of ~block_s).
+[[nodiscard]] Context MakeContext(const DiagData& d, double block_s = 0.5);
+
+/// A fitted effect: its prediction of the residual and what to report.
+struct EffectFit {
+  std::string name;
+  std::string variant;  ///< which parametrisation won inside the effect
+  int n_params = 0;
+  Eigen::MatrixXd pred;  ///< n × N predicted residual, mV/V
+  nlohmann::json params = nlohmann::json::object();
+  nlohmann::json sigma = nlohmann::json::object();  ///< 1-σ uncertainty of params (same keys)
+  std::vector<int> channels;                        ///< channels the effect acts on
+  std::string evidence;
+  double train_sse_w = 0.0;  ///< whitened training SSE after the fit
+};
+
+using FitFn = std::optional<EffectFit> (*)(const Context&, const Eigen::MatrixXd& target);
+
+struct EffectSpec {
+  const char* name;
+  FitFn fit;
+};
+
+/// Every effect of the vocabulary except `none`, in spec order.
+[[nodiscard]] const std::vector<EffectSpec>& Effects();
+/// The effect named `name`, or nullptr.
+[[nodiscard]] const EffectSpec* FindEffect(const std::string& name);
+
+/// Whitened sums over train or hold-out rows.
+struct Sums {
+  double train_sse = 0.0;
+  double hold_sse = 0.0;
+  double hold_pp = 0.0;  ///< Σ (pred)²/σ² on hold-out rows
+};
+[[nodiscard]] Sums Score(const Context& cx, const Eigen::MatrixXd& target,
+                         const Eigen::MatrixXd* pred);
+
+}  // namespace ftstack::diag

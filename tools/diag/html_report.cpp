@@ -1,0 +1,346 @@
+#include "tools/diag/html_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <stdexcept>
+
+namespace ftstack::diag {
+namespace {
+
+constexpr const char* kWrenchNames[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
+
+std::string Esc(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '<':
+        o += "&lt;";
+        break;
+      case '>':
+        o += "&gt;";
+        break;
+      case '&':
+        o += "&amp;";
+        break;
+      case '"':
+        o += "&quot;";
+        break;
+      default:
+        o += c;
+    }
+  }
+  return o;
+}
+
+std::string Num(double v, const char* f = "%.4g") {
+  char b[64];
+  std::snprintf(b, sizeof b, f, v);
+  return b;
+}
+
+/// Nice tick values covering [lo, hi].
+std::vector<double> Ticks(double lo, double hi, int want) {
+  std::vector<double> t;
+  if (!(hi > lo)) return t;
+  const double raw = (hi - lo) / want;
+  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = mag;
+  for (double m : {1.0, 2.0, 5.0, 10.0}) {
+    step = m * mag;
+    if (step >= raw) break;
+  }
+  for (double v = std::ceil(lo / step) * step; v <= hi + 1e-12 * std::fabs(hi); v += step)
+    t.push_back(std::fabs(v) < step * 1e-9 ? 0.0 : v);
+  return t;
+}
+
+/// Reduces a long line to min/max per pixel column, keeping order.
+void Reduce(const Series& s, double x0, double x1, int cols, std::vector<double>* rx,
+            std::vector<double>* ry) {
+  if (s.x.size() <= static_cast<std::size_t>(cols) * 2 || s.points) {
+    const std::size_t stride = s.points ? std::max<std::size_t>(1, s.x.size() / 4000) : 1;
+    for (std::size_t i = 0; i < s.x.size(); i += stride) {
+      rx->push_back(s.x[i]);
+      ry->push_back(s.y[i]);
+    }
+    return;
+  }
+  int cur = -1;
+  double mn = 0;
+  double mx = 0;
+  double xmn = 0;
+  double xmx = 0;
+  auto flush = [&] {
+    if (cur < 0) return;
+    if (xmn <= xmx) {
+      rx->push_back(xmn);
+      ry->push_back(mn);
+      rx->push_back(xmx);
+      ry->push_back(mx);
+    } else {
+      rx->push_back(xmx);
+      ry->push_back(mx);
+      rx->push_back(xmn);
+      ry->push_back(mn);
+    }
+  };
+  for (std::size_t i = 0; i < s.x.size(); ++i) {
+    const int col = static_cast<int>((s.x[i] - x0) / (x1 - x0) * cols);
+    if (col != cur) {
+      flush();
+      cur = col;
+      mn = mx = s.y[i];
+      xmn = xmx = s.x[i];
+    } else {
+      if (s.y[i] < mn) {
+        mn = s.y[i];
+        xmn = s.x[i];
+      }
+      if (s.y[i] > mx) {
+        mx = s.y[i];
+        xmx = s.x[i];
+      }
+    }
+  }
+  flush();
+}
+
+}  // namespace
+
+std::string SvgPlot(const PlotSpec& spec, const std::vector<Series>& series) {
+  const int ml = 70;
+  const int mr = 20;
+  const int mt = 28;
+  const int mb = 42;
+  const int pw = spec.width - ml - mr;
+  const int ph = spec.height - mt - mb;
+  double x0 = std::numeric_limits<double>::infinity();
+  double x1 = -x0;
+  double y0 = x0;
+  double y1 = -x0;
+  auto ty = [&](double v) { return spec.log_y ? std::log10(std::max(v, 1e-300)) : v; };
+  for (const auto& s : series) {
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+      x0 = std::min(x0, s.x[i]);
+      x1 = std::max(x1, s.x[i]);
+      y0 = std::min(y0, ty(s.y[i]));
+      y1 = std::max(y1, ty(s.y[i]));
+    }
+  }
+  if (!(x1 > x0)) {
+    x0 = 0;
+    x1 = 1;
+  }
+  if (!(y1 > y0)) {
+    y0 = (std::isfinite(y0) ? y0 : 0) - 1;
+    y1 = y0 + 2;
+  }
+  const double pad = 0.05 * (y1 - y0);
+  y0 -= pad;
+  y1 += pad;
+  auto px = [&](double x) { return ml + (x - x0) / (x1 - x0) * pw; };
+  auto py = [&](double y) { return mt + (1.0 - (ty(y) - y0) / (y1 - y0)) * ph; };
+  auto pyl = [&](double yl) { return mt + (1.0 - (yl - y0) / (y1 - y0)) * ph; };
+  std::string o;
+  o += "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(spec.width) +
+       "\" height=\"" + std::to_string(spec.height) +
+       "\" font-family=\"sans-serif\" font-size=\"12\">";
+  o += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>";
+  o += "<text x=\"" + std::to_string(ml) + "\" y=\"18\" font-weight=\"bold\">" + Esc(spec.title) +
+       "</text>";
+  for (const auto& [a, b] : spec.spans) {
+    const double xa = px(std::max(a, x0));
+    const double xb = px(std::min(b, x1));
+    o += "<rect x=\"" + Num(xa) + "\" y=\"" + std::to_string(mt) + "\" width=\"" +
+         Num(std::max(1.0, xb - xa)) + "\" height=\"" + std::to_string(ph) +
+         "\" fill=\"#f6d7a7\" opacity=\"0.6\"/>";
+  }
+  o += "<rect x=\"" + std::to_string(ml) + "\" y=\"" + std::to_string(mt) + "\" width=\"" +
+       std::to_string(pw) + "\" height=\"" + std::to_string(ph) +
+       "\" fill=\"none\" stroke=\"#444\"/>";
+  for (double t : Ticks(x0, x1, 8)) {
+    o += "<line x1=\"" + Num(px(t)) + "\" x2=\"" + Num(px(t)) + "\" y1=\"" +
+         std::to_string(mt + ph) + "\" y2=\"" + std::to_string(mt + ph + 5) +
+         "\" stroke=\"#444\"/>";
+    o += "<text x=\"" + Num(px(t)) + "\" y=\"" + std::to_string(mt + ph + 18) +
+         "\" text-anchor=\"middle\">" + Num(t) + "</text>";
+  }
+  for (double t : Ticks(y0, y1, 5)) {
+    o += "<line x1=\"" + std::to_string(ml) + "\" x2=\"" + std::to_string(ml + pw) + "\" y1=\"" +
+         Num(pyl(t)) + "\" y2=\"" + Num(pyl(t)) + "\" stroke=\"#ddd\"/>";
+    o += "<text x=\"" + std::to_string(ml - 5) + "\" y=\"" + Num(pyl(t) + 4) +
+         "\" text-anchor=\"end\">" + (spec.log_y ? "1e" + Num(t, "%.0f") : Num(t)) + "</text>";
+  }
+  o += "<text x=\"" + std::to_string(ml + pw / 2) + "\" y=\"" + std::to_string(spec.height - 6) +
+       "\" text-anchor=\"middle\">" + Esc(spec.x_label) + "</text>";
+  o += "<text transform=\"translate(14," + std::to_string(mt + ph / 2) +
+       ") rotate(-90)\" text-anchor=\"middle\">" + Esc(spec.y_label) + "</text>";
+  int legend_x = ml + 10;
+  for (const auto& s : series) {
+    std::vector<double> rx;
+    std::vector<double> ry;
+    Reduce(s, x0, x1, pw, &rx, &ry);
+    if (s.points) {
+      o += "<g fill=\"" + s.color + "\" opacity=\"0.5\">";
+      for (std::size_t i = 0; i < rx.size(); ++i) {
+        o += "<circle cx=\"" + Num(px(rx[i]), "%.1f") + "\" cy=\"" + Num(py(ry[i]), "%.1f") +
+             "\" r=\"1.5\"/>";
+      }
+      o += "</g>";
+    } else {
+      o += "<polyline fill=\"none\" stroke=\"" + s.color + "\" stroke-width=\"1\" points=\"";
+      for (std::size_t i = 0; i < rx.size(); ++i) {
+        o += Num(px(rx[i]), "%.1f") + "," + Num(py(ry[i]), "%.1f") + " ";
+      }
+      o += "\"/>";
+    }
+    if (!s.label.empty()) {
+      o += "<rect x=\"" + std::to_string(legend_x) + "\" y=\"" + std::to_string(mt + 6) +
+           "\" width=\"12\" height=\"4\" fill=\"" + s.color + "\"/>";
+      o += "<text x=\"" + std::to_string(legend_x + 16) + "\" y=\"" + std::to_string(mt + 12) +
+           "\">" + Esc(s.label) + "</text>";
+      legend_x += 24 + 7 * static_cast<int>(s.label.size());
+    }
+  }
+  o += "</svg>";
+  return o;
+}
+
+std::string HtmlReport(const DiagData& data, const Report& r) {
+  const Context& cx = r.cx;
+  std::string h;
+  h += "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>ftdiag report</title><style>"
+       "body{font-family:sans-serif;margin:20px;max-width:1060px}table{border-collapse:collapse}"
+       "td,th{border:1px solid #bbb;padding:3px 8px;font-size:13px}th{background:#eee}"
+       ".verdict{font-size:22px;font-weight:bold}.ev{background:#eef6ee;padding:6px;border-left:"
+       "4px solid #4a4}"
+       "</style></head><body>";
+  h += "<h1>ftdiag: sim vs real</h1>";
+  h += "<p>Real: <code>" + Esc(data.real_name) + "</code>, sim: <code>" + Esc(data.sim_name) +
+       "</code>, " + std::to_string(data.rows()) + " rows × " + std::to_string(data.channels()) +
+       " bridges at " + Num(r.rate_hz) + " Hz.</p>";
+  h += "<p class=\"verdict\">Verdict: " + Esc(r.verdict);
+  for (std::size_t i = 1; i < r.effects.size(); ++i) h += " + " + Esc(r.effects[i].fit.name);
+  h += "</p>";
+  h += "<p>Held-out RMS (rows not used for fitting, all channels): <b>" + Num(r.hold_rms_before) +
+       "</b> → <b>" + Num(r.hold_rms_after) + "</b> mV/V.</p>";
+  for (const auto& e : r.effects) {
+    h += "<h2>" + Esc(e.fit.name) + "</h2><p class=\"ev\">" + Esc(e.fit.evidence) +
+         "</p><p>Model: " + Esc(e.fit.variant) + " (" + std::to_string(e.fit.n_params) +
+         " parameters). Parameters: <code>" + Esc(e.fit.params.dump()) + "</code> ± <code>" +
+         Esc(e.fit.sigma.dump()) + "</code>. Held-out RMS " + Num(e.hold_rms_before) + " → " +
+         Num(e.hold_rms_after) + " mV/V.</p>";
+  }
+  // Channel table.
+  h += "<h2>Channels</h2><table><tr><th>channel</th><th>noise RMS</th><th>RMS before</th><th>RMS "
+       "after</th><th>mismatch</th></tr>";
+  for (int c = 0; c < cx.nc; ++c) {
+    const double after = r.effects.empty() ? r.rms_before(c) : r.effects.back().rms_after(c);
+    const bool mm = std::find(r.mismatch_channels.begin(), r.mismatch_channels.end(), c) !=
+                    r.mismatch_channels.end();
+    h += "<tr><td>b" + std::to_string(c) + "</td><td>" + Num(r.noise_rms(c)) + "</td><td>" +
+         Num(r.rms_before(c)) + "</td><td>" + Num(after) + "</td><td>" + (mm ? "yes" : "") +
+         "</td></tr>";
+  }
+  h += "</table>";
+  if (!r.load_region.is_null() && r.load_region.contains("range")) {
+    h += "<p>Load region carrying the excess: <b>" + r.load_region["component"].get<std::string>() +
+         " " + r.load_region["sign"].get<std::string>() + "</b> between " +
+         Num(r.load_region["range"][0].get<double>()) + " and " +
+         Num(r.load_region["range"][1].get<double>()) + " (mean squared residual there " +
+         Num(r.load_region["excess_ratio"].get<double>()) + " × noise²).</p>";
+  }
+  // Plots: the channel with most residual energy.
+  int c = 0;
+  double be = -1;
+  const std::vector<int> pick =
+      r.mismatch_channels.empty() ? std::vector<int>{} : r.mismatch_channels;
+  for (int k = 0; k < cx.nc; ++k) {
+    const double e = (cx.resid.col(k).squaredNorm()) * cx.weight(k);
+    if (e > be) {
+      be = e;
+      c = k;
+    }
+  }
+  Series res{data.t_s, {}, "#888", "residual b" + std::to_string(c)};
+  Series model{data.t_s, {}, "#d22", "model"};
+  Series after{data.t_s, {}, "#26c", "after"};
+  res.y.resize(data.rows());
+  model.y.resize(data.rows());
+  after.y.resize(data.rows());
+  for (std::size_t i = 0; i < data.rows(); ++i) {
+    const auto ii = static_cast<Eigen::Index>(i);
+    res.y[i] = cx.resid(ii, c);
+    model.y[i] = r.model(ii, c);
+    after.y[i] = cx.resid(ii, c) - r.model(ii, c);
+  }
+  PlotSpec p1;
+  p1.title = "Residual real − sim of b" + std::to_string(c) +
+             " against time (shaded: located mismatch windows)";
+  p1.x_label = "t (s)";
+  p1.y_label = "mV/V";
+  p1.spans = r.windows;
+  h += "<h2>Residual against time</h2>" + SvgPlot(p1, {res, model});
+  PlotSpec p2 = p1;
+  p2.title = "Before (grey) and after removing the model (blue), b" + std::to_string(c);
+  p2.spans.clear();
+  h += SvgPlot(p2, {res, after});
+  if (data.has_wrench()) {
+    int k = 2;
+    if (!r.load_region.is_null() && r.load_region.contains("range")) {
+      const std::string comp = r.load_region["component"].get<std::string>();
+      for (int j = 0; j < 6; ++j) {
+        if (comp == kWrenchNames[j]) k = j;
+      }
+    }
+    Series sc{{}, res.y, "#888", "residual", true};
+    Series sm{{}, model.y, "#d22", "model", true};
+    sc.x.resize(data.rows());
+    for (std::size_t i = 0; i < data.rows(); ++i)
+      sc.x[i] = data.wrench(static_cast<Eigen::Index>(i), k);
+    sm.x = sc.x;
+    PlotSpec p3;
+    p3.title = std::string("Residual of b") + std::to_string(c) + " against " + kWrenchNames[k];
+    p3.x_label = std::string(kWrenchNames[k]) + (k < 3 ? " (N)" : " (N·m)");
+    p3.y_label = "mV/V";
+    h += "<h2>Residual against load</h2>" + SvgPlot(p3, {sc, sm});
+  }
+  if (!r.spectrum_hz.empty()) {
+    Series sp{std::vector<double>(r.spectrum_hz.begin() + 1, r.spectrum_hz.end()),
+              std::vector<double>(r.spectrum_power.begin() + 1, r.spectrum_power.end()), "#333",
+              "residual PSD / noise"};
+    PlotSpec p4;
+    p4.title = "Residual spectrum (Welch), averaged over channels, noise floor = 1";
+    p4.x_label = "frequency (Hz)";
+    p4.y_label = "power / noise";
+    p4.log_y = true;
+    h += "<h2>Spectrum</h2>" + SvgPlot(p4, {sp});
+  }
+  h += "<h2>All candidates (held-out "
+       "ranking)</h2><table><tr><th>effect</th><th>model</th><th>params</th>"
+       "<th>held-out RMS after</th><th>z</th><th>score</th><th>claimable</th></tr>";
+  for (const auto& cand : r.candidates) {
+    h += "<tr><td>" + Esc(cand.name) + "</td><td>" + Esc(cand.variant) + "</td><td>" +
+         std::to_string(cand.n_params) + "</td><td>" + Num(cand.hold_rms_after) + "</td><td>" +
+         Num(cand.z, "%.1f") + "</td><td>" + Num(cand.score, "%.1f") + "</td><td>" +
+         (cand.eligible ? "yes" : "") + "</td></tr>";
+  }
+  h += "</table><p>Held-out rows: every third block of " + Num(cx.block_s) +
+       " s. Score = held-out Δχ² − parameters × ln(held-out samples); an effect is claimed when "
+       "its held-out z &gt; 6 and score &gt; 0.</p>";
+  h += "</body></html>\n";
+  return h;
+}
+
+void WriteHtml(const std::string& path, const DiagData& data, const Report& report) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot write");
+  out << HtmlReport(data, report);
+  if (!out) throw std::runtime_error(path + ": write failed");
+}
+
+}  // namespace ftstack::diag

@@ -1,0 +1,81 @@
+// Numerical building blocks of the diagnosis: spectra, robust noise, least squares, filters, 1-D
+// searches.
+#pragma once
+
+#include <Eigen/Dense>
+#include <functional>
+#include <vector>
+
+namespace ftstack::diag {
+
+/// Welch power spectrum (Hann, 50 % overlap, linear detrend per segment) of x sampled at rate_hz.
+/// power[k] is the mean |X_k|² / Σw² over segments, so white noise of variance σ² gives σ² in
+/// every bin; freq_hz[k] = k·rate/segment for k = 0 … segment/2.
+struct Spectrum {
+  std::vector<double> freq_hz;
+  std::vector<double> power;
+  int segments = 0;
+};
+[[nodiscard]] Spectrum Welch(const double* x, std::size_t n, double rate_hz, std::size_t segment);
+/// The segment length used for a record of n rows: a power of two ≤ 1024 giving ≥ 8 segments.
+[[nodiscard]] std::size_t WelchSegment(std::size_t n);
+
+/// White-noise σ of x from the median Welch level over 5 %…95 % of the Nyquist band (robust to
+/// slow effects and to narrow lines), corrected for the median of the χ² averaging distribution.
+[[nodiscard]] double RobustNoise(const double* x, std::size_t n, double rate_hz);
+
+/// Weighted linear least squares by normal equations, accumulated row by row.
+class NormalEq {
+ public:
+  explicit NormalEq(int p);
+  void Add(const double* x, double y, double w = 1.0);
+  /// Row with only `nnz` non-zero features at indices idx.
+  void AddSparse(const int* idx, const double* val, int nnz, double y, double w = 1.0);
+  struct Result {
+    Eigen::VectorXd beta;
+    Eigen::MatrixXd cov_unit;  ///< (XᵀWX)⁻¹; times the residual variance gives the covariance
+    double sse = 0.0;          ///< weighted residual sum of squares
+    double rows = 0.0;
+  };
+  [[nodiscard]] Result Solve() const;
+  [[nodiscard]] int p() const { return p_; }
+
+ private:
+  int p_;
+  Eigen::MatrixXd xtx_;
+  Eigen::VectorXd xty_;
+  double yty_ = 0.0;
+  double rows_ = 0.0;
+};
+
+/// First-order low pass with unit DC gain and time constant tau_s, exact for inputs linear
+/// between samples; starts at rest at the first input value.
+void FirstOrderLowPass(const double* t_s, const double* x, std::size_t n, double tau_s, double* y);
+
+/// Second-order low pass ÿ + 2ζω ẏ + ω² y = ω² x (ω = 2π·freq_hz), unit DC gain, exact for inputs
+/// linear between samples; starts at rest at the first input value.
+void SecondOrderLowPass(const double* t_s, const double* x, std::size_t n, double freq_hz,
+                        double damping_ratio, double* y);
+
+/// Rate-independent first-order hysteresis operator (Dahl type) of x with characteristic travel
+/// width: z moves toward sign(dx) by 1 − exp(−|dx|/width) per step; starts at 0. Output in [−1, 1].
+void DahlOperator(const double* x, std::size_t n, double width, double* z);
+
+/// Play (backlash) operator of x with total width `width`, scaled to [−1, 1]: z = 2·(p − x)/width
+/// where p follows x only once x has moved width/2 past it; starts centred.
+void PlayOperator(const double* x, std::size_t n, double width, double* z);
+
+/// Value of a sampled signal at time tq (cubic Catmull-Rom on uniform grids, else linear; clamped
+/// at the ends). t must be increasing.
+[[nodiscard]] double InterpolateAt(const double* t, const double* x, std::size_t n, double tq,
+                                   bool uniform);
+
+/// Minimises f over a grid, then refines with golden-section search between the best point's
+/// neighbours. Returns the argument; *fmin receives the value.
+double MinimizeOnGrid(const std::function<double(double)>& f, const std::vector<double>& grid,
+                      int golden_iterations, double* fmin);
+
+/// Pearson correlation of two equally long series.
+[[nodiscard]] double Correlation(const double* a, const double* b, std::size_t n);
+
+}  // namespace ftstack::diag
