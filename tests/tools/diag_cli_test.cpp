@@ -149,14 +149,25 @@ TEST_F(DiagCli, RefusesBadInputWithOneLineNamingTheFile) {
 }
 
 TEST_F(DiagCli, ModelOptionPredictsFromTheRealWrench) {
-  // The fixture's sim is the built-in sensor's linear model; --model builtin must reproduce it.
-  WritePair(testing::MakeFixture({{"zero_offset", 8}}, 6, 200.0, 1e-4, 1.0));
-  const CliRun r =
-      Ftdiag("diagnose --model builtin --real " + P("real.csv") + " --json " + P("m.json"));
+  // A linear sensor description with the fixture's own sensitivity: --model must reproduce its sim.
+  const auto fx = testing::MakeFixture({{"zero_offset", 8}}, 6, 200.0, 1e-4, 1.0);
+  WritePair(fx);
+  const Eigen::MatrixXd s = sim::MakeDefaultSensor()->Sensitivity();
+  nlohmann::json j{{"schema", "ftstack-sensor/1"}, {"name", "fixture"}};
+  auto rows = nlohmann::json::array();
+  for (int i = 0; i < s.rows(); ++i) {
+    auto row = nlohmann::json::array();
+    for (int k = 0; k < 6; ++k) row.push_back(s(i, k));
+    rows.push_back(row);
+  }
+  j["model"] = {{"type", "linear"}, {"sensitivity_mvv", rows}};
+  std::ofstream(P("sensor.json")) << j.dump();
+  const CliRun r = Ftdiag("diagnose --model " + P("sensor.json") + " --real " + P("real.csv") +
+                          " --json " + P("m.json"));
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream in(P("m.json"));
-  const auto j = nlohmann::json::parse(in);
-  EXPECT_EQ(j["verdict"], "zero_offset");
+  const auto out = nlohmann::json::parse(in);
+  EXPECT_EQ(out["verdict"], "zero_offset");
 }
 
 }  // namespace
