@@ -30,7 +30,7 @@ const char* Env(const char* name) {
 /// The HX711 front end with everything it needs: the gpiochip and its lines, the clock.
 class Hx711Board final : public hal::Adc {
  public:
-  Hx711Board(const HardwareAdcOptions& options) : options_(options) {}
+  explicit Hx711Board(const HardwareAdcOptions& options) : options_(options) {}
 
   /// Opens the chip and requests the lines; false with a reason.
   bool Open(std::string* error) {
@@ -108,7 +108,7 @@ class Hx711Board final : public hal::Adc {
 /// The ADS131M front end: spidev node, /DRDY line on a gpiochip, clock.
 class SpiBoard final : public hal::Adc {
  public:
-  SpiBoard(const HardwareAdcOptions& options) : options_(options) {}
+  explicit SpiBoard(const HardwareAdcOptions& options) : options_(options) {}
 
   bool Open(std::string* error) {
     // ADS131M0x: SPI mode 1 (CPOL 0, CPHA 1).
