@@ -4,6 +4,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <system_error>
 
 #include "calibration/cal_file.hpp"
@@ -11,6 +12,7 @@
 #include "hal/sim/sim_adc.hpp"
 #include "sim/default_sensor.hpp"
 #include "sim/recording.hpp"
+#include "sim/sensor_description.hpp"
 #include "sim/simulated_sensor.hpp"
 #include "sim/wrench_source.hpp"
 #include "tools/ftd/hardware_adc.hpp"
@@ -84,7 +86,9 @@ void Ftd::Start() {
   std::uint8_t channels = 6;
   try {
     if (opt_.adc == "sim") {
-      model_ = sim::MakeDefaultSensor();
+      const sim::SensorDescription desc = sim::DefaultSensorDescription();
+      model_ = desc.model;
+      sim_gain_ = desc.adc_gain;
       channels = static_cast<std::uint8_t>(model_->channel_count());
       if (!opt_.replay.empty()) {
         sim::ReadOptions ro;
@@ -99,10 +103,17 @@ void Ftd::Start() {
         source_ = std::make_unique<sim::ConstantWrench>(w);
       }
       sensor_ = std::make_unique<sim::SimulatedSensor>(*model_, *source_);
+      // The built-in sensor's converter at the requested rate (its datasheet noise); a rate the
+      // converter cannot run keeps the nominal operating point's noise.
       hal::sim::SimAdcParams params;
+      try {
+        params = sim::AdcParamsAt(desc, opt_.rate_hz);
+      } catch (const std::invalid_argument&) {
+        params = desc.adc;
+        params.required_rate_hz = 0;
+      }
       params.seed = opt_.seed;
       params.realtime = opt_.paced;
-      params.noise_rms_mvv = sim::kDefaultNoiseMvv;
       adc_ = std::make_unique<hal::sim::SimAdc>(*sensor_, params);
     } else {
       std::string error;
@@ -120,6 +131,7 @@ void Ftd::Start() {
   fw::DeviceConfig cfg;
   cfg.adc.channel_count = channels;
   cfg.adc.rate_hz = opt_.rate_hz;
+  if (opt_.adc == "sim") cfg.adc.gain = sim_gain_;
   // Configure once to learn the ADC's scaling, which the fixed-point calibration is made for.
   if (const hal::Status s = adc_->Configure(cfg.adc); s != hal::Status::kOk) {
     throw FtdError(std::string("ADC configuration failed: ") + hal::ToString(s));

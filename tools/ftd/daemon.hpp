@@ -98,7 +98,8 @@ class Ftd {
   void SamplingLoop();
 
   FtdOptions opt_;
-  std::unique_ptr<sim::SensorModel> model_;
+  std::shared_ptr<const sim::SensorModel> model_;
+  std::uint16_t sim_gain_ = 128;  ///< PGA gain of the built-in sensor's converter
   std::unique_ptr<sim::WrenchSource> source_;
   std::unique_ptr<sim::SimulatedSensor> sensor_;
   std::unique_ptr<hal::Adc> adc_;
