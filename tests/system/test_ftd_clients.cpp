@@ -12,6 +12,7 @@
 #include "calibration/ideal.hpp"
 #include "firmware/register_map.hpp"
 #include "sim/default_sensor.hpp"
+#include "tests/system/builtin_adc.hpp"
 #include "tests/system/ftd_process.hpp"
 
 namespace ftstack {
@@ -66,10 +67,11 @@ std::string Replace(std::string s, const std::string& from, const std::string& t
 /// calibration matrix), as in test_ftd_modbus.
 std::array<double, 6> SampleSigma() {
   const auto model = sim::MakeDefaultSensor();
-  const hal::AdcInfo adc = cal::DefaultAdc(6);
+  const test::BuiltinAdc builtin = test::BuiltinSimAdc();
+  const hal::AdcInfo adc = builtin.info;
   const cal::CalFile c = cal::IdealCalibration(*model, adc);
   const double q = adc.full_scale_nvv * 1e-6 / adc.max_counts;
-  const double var = sim::kDefaultNoiseMvv * sim::kDefaultNoiseMvv + q * q / 12.0;
+  const double var = builtin.noise_rms_mvv * builtin.noise_rms_mvv + q * q / 12.0;
   std::array<double, 6> s{};
   for (std::size_t i = 0; i < 6; ++i) {
     double s2 = 0;

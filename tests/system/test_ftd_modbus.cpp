@@ -21,6 +21,7 @@
 #include "firmware/register_map.hpp"
 #include "sim/default_sensor.hpp"
 #include "sim/recording.hpp"
+#include "tests/system/builtin_adc.hpp"
 #include "tests/system/ftd_process.hpp"
 
 namespace ftstack {
@@ -39,10 +40,11 @@ struct Expected {
 };
 Expected DeriveExpected() {
   const auto model = sim::MakeDefaultSensor();
-  const hal::AdcInfo adc = cal::DefaultAdc(6);
+  const test::BuiltinAdc builtin = test::BuiltinSimAdc();
+  const hal::AdcInfo adc = builtin.info;
   const cal::CalFile c = cal::IdealCalibration(*model, adc);
   const double q_mvv = adc.full_scale_nvv * 1e-6 / adc.max_counts;
-  const double var = sim::kDefaultNoiseMvv * sim::kDefaultNoiseMvv + q_mvv * q_mvv / 12.0;
+  const double var = builtin.noise_rms_mvv * builtin.noise_rms_mvv + q_mvv * q_mvv / 12.0;
   Expected e;
   for (std::size_t i = 0; i < 6; ++i) {
     double s2 = 0;
@@ -294,7 +296,8 @@ std::uint32_t FileCrcField(const std::string& path) {
 
 TEST(FtdModbus, CalibrationSlotsAndTheirCrc) {
   const auto model = sim::MakeDefaultSensor();
-  const hal::AdcInfo adc = cal::DefaultAdc(6);
+  const test::BuiltinAdc builtin = test::BuiltinSimAdc();
+  const hal::AdcInfo adc = builtin.info;
   // Built-in calibration: registers 72–73 hold the CRC-32 of the documented fixed-point layout.
   {
     const fw::FixedCalibration fixed = cal::ToFixed(cal::IdealCalibration(*model, adc), adc);
@@ -587,7 +590,8 @@ TEST(FtdModbus, LogWritesTheRecordingFormatAndDurationEndsCleanly) {
   for (double v : rec.Column("Fz")) sum += v;
   const double n = static_cast<double>(rec.rows());
   EXPECT_NEAR(sum / n, -100.0, kSigmas * e.sigma_si[2] / std::sqrt(n) + e.fixed_error_si[2]);
-  const hal::AdcInfo adc = cal::DefaultAdc(6);
+  const test::BuiltinAdc builtin = test::BuiltinSimAdc();
+  const hal::AdcInfo adc = builtin.info;
   const double mvv_per_count = adc.full_scale_nvv * 1e-6 / adc.max_counts;
   for (std::size_t i = 0; i < rec.rows(); i += 97) {
     EXPECT_NEAR(rec.Column("b2")[i], rec.Column("raw2")[i] * mvv_per_count, 1e-9);
