@@ -79,3 +79,14 @@ if [ -x "$B/bench_physics" ]; then
               printf "  full chain, physical/linear model = %.2f; model build %.1f us\n",
                      t["BM_FullChainSample/0"] / t["BM_FullChainSample/1"], t["BM_BuildModel"] / 1000 }'
 fi
+
+# --- calibration fit (issue 4): 1 000 000 rig rows, 10-fold block CV over the lambda grid -----
+if [ -x "$B/bench_cal" ]; then
+  section "calibration fit of 1 000 000 rows (10-fold CV over whole blocks, 6 ridge strengths)"
+  "$B/bench_cal" --benchmark_format=csv 2>/dev/null |
+    awk -F, 'NR==1 { for (i = 1; i <= NF; ++i) { h=$i; gsub(/"/,"",h); col[h]=i }; next }
+      $1 ~ /BM_/ { n=$1; gsub(/"/,"",n); sub(/\/iterations:[0-9]+/,"",n); t[n]=$col["real_time"]; l=$col["label"]; gsub(/"/,"",l)
+        printf "  %-16s %7.0f ms wall, %7.0f ms CPU  (%d rows, %d blocks, %s)\n",
+        n, $col["real_time"], $col["cpu_time"], $col["rows"], $col["blocks"], l }
+      END { if (t["BM_FitLinear1M"] > 0) printf "  auto (linear + quadratic) / linear only = %.2f\n", t["BM_FitAuto1M"] / t["BM_FitLinear1M"] }'
+fi

@@ -336,6 +336,8 @@ CalFile LoadCalFile(const std::string& path) {
     }
     throw CalFileError(path + ":" + std::to_string(line) + ":" + std::to_string(col) +
                        ": not valid JSON (truncated or corrupt)");
+  } catch (const nlohmann::json::exception& e) {  // e.g. a number out of double's range
+    throw CalFileError(path + ": not valid JSON (corrupt): " + e.what());
   }
   try {
     return FromJson(j, path);
@@ -344,8 +346,7 @@ CalFile LoadCalFile(const std::string& path) {
   }
 }
 
-void SaveCalFile(const std::string& path, const CalFile& file) {
-  const std::string text = ToJson(file).dump(2) + "\n";
+void WriteFileAtomic(const std::string& path, const std::string& text) {
   const std::string tmp = path + ".tmp";
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (fd < 0) throw CalFileError(tmp + ": cannot write: " + std::strerror(errno));
@@ -372,6 +373,10 @@ void SaveCalFile(const std::string& path, const CalFile& file) {
     (void)::fsync(dfd);
     ::close(dfd);
   }
+}
+
+void SaveCalFile(const std::string& path, const CalFile& file) {
+  WriteFileAtomic(path, ToJson(file).dump(2) + "\n");
 }
 
 }  // namespace ftstack::cal

@@ -57,6 +57,8 @@ struct CalFile {
 [[nodiscard]] CalFile LoadCalFile(const std::string& path);
 /// Writes atomically: temporary file, fsync, rename over `path`, fsync of the directory.
 void SaveCalFile(const std::string& path, const CalFile& file);
+/// The same for any text.
+void WriteFileAtomic(const std::string& path, const std::string& text);
 
 /// The default ADC of the simulated sensor: 24-bit, ±3.90625 mV/V (gain 128, ratio 0.5).
 [[nodiscard]] hal::AdcInfo DefaultAdc(std::uint8_t channels);

@@ -283,10 +283,23 @@ std::vector<int> DetectBlocks(const Eigen::MatrixXd& wrench, const BlockOptions&
       start = i;
     }
   }
+  // A slow ramp also breaks into runs within tolerance; holds are the long runs: at least a
+  // fifth of the "N50" length (runs at least that long cover half of the rows).
+  std::vector<std::size_t> lengths;
+  for (const Run& r : runs) lengths.push_back(r.end - r.begin);
+  std::sort(lengths.rbegin(), lengths.rend());
+  std::size_t n50 = 0;
+  std::size_t acc = 0;
+  for (std::size_t len : lengths) {
+    acc += len;
+    n50 = len;
+    if (2 * acc >= rows) break;
+  }
+  const std::size_t min_hold = std::max(options.min_hold_rows, n50 / 5);
   std::vector<Run> holds;
   std::size_t covered = 0;
   for (const Run& r : runs) {
-    if (r.end - r.begin >= options.min_hold_rows) {
+    if (r.end - r.begin >= min_hold) {
       holds.push_back(r);
       covered += r.end - r.begin;
     }

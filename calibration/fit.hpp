@@ -19,7 +19,8 @@ struct BlockOptions {
   std::array<double, 6> scale{};
   /// A hold ends when any axis moves more than this fraction of its scale from the hold's start.
   double hold_tolerance = 0.01;
-  /// A hold needs at least this many rows; shorter runs are transitions.
+  /// A hold needs at least this many rows, and at least a fifth of the N50 run length (runs at
+  /// least that long cover half the rows), so a slow ramp's short runs stay transitions.
   std::size_t min_hold_rows = 5;
   /// Without holds (continuous loading): this many contiguous chunks of equal length.
   std::size_t continuous_blocks = 20;
@@ -39,7 +40,7 @@ struct RigData {
 
 /// Groups rows into blocks. A `block` or `pose` column wins (rows with equal values form one
 /// block, wherever they are); otherwise static holds are detected from the reference wrench
-/// (runs of ≥ min_hold_rows rows within hold_tolerance of the run's first row) and every
+/// (long runs of rows within hold_tolerance of the run's first row, see BlockOptions) and every
 /// transition row joins the nearest hold in time; with fewer than two holds covering < 30 % of
 /// the rows the recording is treated as continuous loading and cut into contiguous chunks.
 [[nodiscard]] std::vector<int> DetectBlocks(const Eigen::MatrixXd& wrench,

@@ -213,6 +213,29 @@ TEST(Blocks, HoldsAreFoundAndTransitionsJoinTheNearestHold) {
   EXPECT_EQ(b[37], 2);
 }
 
+TEST(Blocks, SlowRampsDoNotBecomeHolds) {
+  // 20 holds of 500 rows joined by 400-row ramps of 40 % of the scale (1 % every 10 rows).
+  const int hold = 500;
+  const int ramp = 400;
+  Eigen::MatrixXd w = Eigen::MatrixXd::Zero(20 * hold + 19 * ramp, 6);
+  Eigen::Index row = 0;
+  for (int h = 0; h < 20; ++h) {
+    const double level = (h % 2) * 0.4;
+    for (int i = 0; i < hold; ++i) w(row++, 1) = level;
+    if (h == 19) break;
+    for (int i = 1; i <= ramp; ++i) {
+      w(row++, 1) = level + ((h % 2) ? -0.4 : 0.4) * i / static_cast<double>(ramp + 1);
+    }
+  }
+  BlockOptions bo;
+  bo.scale = {1, 1, 1, 1, 1, 1};
+  int count = 0;
+  std::string method;
+  (void)DetectBlocks(w, bo, &count, &method);
+  EXPECT_EQ(method, "holds");
+  EXPECT_EQ(count, 20);
+}
+
 TEST(Blocks, ContinuousLoadingIsCutIntoContiguousChunks) {
   Eigen::MatrixXd w(1000, 6);
   for (int i = 0; i < 1000; ++i) w.row(i).setConstant(std::sin(i * 0.05) * 100);

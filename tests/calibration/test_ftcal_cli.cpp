@@ -76,6 +76,34 @@ TEST_F(FtcalCli, DesignFitVerifyApply) {
   for (std::size_t i = 0; i < ref.size(); ++i) ASSERT_NEAR(got[i], ref[i], 0.2) << i;
 }
 
+TEST_F(FtcalCli, ImportAtiThenInstallIntoSlots) {
+  const char* env = std::getenv("FTSTACK_SHARED_DIR");
+  const std::string ati = std::string(env != nullptr && *env != '\0' ? env : FTSTACK_SHARED_DIR) +
+                          "/data/ati/FT11712.cal";
+  CliRun r = Ftcal("import-ati " + ati + " --out " + P("ati.json"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("version 1.0"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("rated 200"), std::string::npos) << r.out;  // Fz max
+  r = Ftcal("verify " + P("ati.json"));
+  EXPECT_EQ(r.code, 0) << r.out;
+  r = Ftcal("install " + P("ati.json") + " --slots " + P("dev"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("slot A"), std::string::npos) << r.out;
+  // A truncated file is refused and slot A stays active.
+  {
+    std::ifstream in(P("ati.json"));
+    std::stringstream ss;
+    ss << in.rdbuf();
+    std::ofstream(P("cut.json")) << ss.str().substr(0, ss.str().size() / 2);
+  }
+  r = Ftcal("install " + P("cut.json") + " --slots " + P("dev"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find("cut.json:"), std::string::npos) << r.out;
+  r = Ftcal("active --slots " + P("dev"));
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("slot A: serial FT11712"), std::string::npos) << r.out;
+}
+
 TEST_F(FtcalCli, BadInputsExitNonZeroWithFileAndPosition) {
   {
     std::ofstream f(P("bad.csv"));

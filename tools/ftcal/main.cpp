@@ -5,10 +5,12 @@
 #include <sstream>
 
 #include "calibration/apply.hpp"
+#include "calibration/ati.hpp"
 #include "calibration/cal_file.hpp"
 #include "calibration/fit.hpp"
 #include "calibration/fit_report.hpp"
 #include "calibration/rig.hpp"
+#include "calibration/slots.hpp"
 #include "sim/recording.hpp"
 #include "sim/sensor_description.hpp"
 #include "tools/common.hpp"
@@ -67,6 +69,20 @@ int main(int argc, char** argv) {
   apply->add_option("--cal", cal_path, "calibration file")->required();
   apply->add_option("--in", in_path, "recording with b* columns")->required();
   apply->add_option("--out", out_path, "output recording t,Fx,Fy,Fz,Mx,My,Mz")->required();
+
+  std::string ati_path;
+  auto* import_ati = app.add_subcommand("import-ati", "convert an ATI DAQ .cal file (gauge volts)");
+  import_ati->add_option("file", ati_path, "ATI calibration file, version 1.0 or 1.1")->required();
+  import_ati->add_option("--out", out_path, "calibration file to write")->required();
+
+  std::string slots_dir;
+  auto* install = app.add_subcommand(
+      "install", "verify a calibration and make it active in a slot directory (A/B, atomic)");
+  install->add_option("cal", cal_path, "calibration file")->required();
+  install->add_option("--slots", slots_dir, "slot directory (cal_A.json, cal_B.json, active)")
+      ->required();
+  auto* active = app.add_subcommand("active", "show the active calibration of a slot directory");
+  active->add_option("--slots", slots_dir, "slot directory")->required();
 
   auto* verify = app.add_subcommand("verify", "check a calibration file's integrity");
   verify->add_option("cal", cal_path, "calibration file")->required();
@@ -128,6 +144,39 @@ int main(int argc, char** argv) {
         std::printf("report: %s\n", report_path.c_str());
       }
       std::printf("wrote %s\n", out_path.c_str());
+    } else if (*import_ati) {
+      const cal::AtiImport imp = cal::ImportAtiCal(ati_path);
+      for (const std::string& w : imp.warnings)
+        std::fprintf(stderr, "ftcal: warning: %s\n", w.c_str());
+      cal::SaveCalFile(out_path, imp.file);
+      std::printf("%s: ATI calibration version %s, serial %s, %d gauges, matrix from %s\n",
+                  ati_path.c_str(), imp.version.c_str(), imp.file.serial.c_str(),
+                  imp.file.cal.channel_count,
+                  imp.used_user_axis ? "UserAxis rows" : "Axis rows / scale + BasicTransform");
+      static const char* const kAxisNames[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
+      for (std::size_t a = 0; a < 6; ++a) {
+        std::printf("  %s (%s/V):", kAxisNames[a], a < 3 ? "N" : "N*m");
+        for (std::size_t c = 0; c < imp.file.cal.channel_count; ++c) {
+          std::printf(" %10.5f", imp.file.cal.matrix[a][c]);
+        }
+        std::printf("   rated %g\n", imp.file.rated[a]);
+      }
+      fw::LoadReport rep{};
+      (void)cal::ToFixed(imp.file, imp.file.adc, &rep);
+      PrintWorstCase(rep);
+      std::printf("wrote %s (input unit V)\n", out_path.c_str());
+    } else if (*install) {
+      cal::CalSlots slots(slots_dir);
+      const char slot = slots.InstallFromPath(cal_path);
+      std::printf("%s: installed into slot %c (now active)\n", cal_path.c_str(), slot);
+    } else if (*active) {
+      cal::CalSlots slots(slots_dir);
+      char slot = 0;
+      std::string note;
+      const cal::CalFile f = slots.LoadActive(&slot, &note);
+      if (!note.empty()) std::fprintf(stderr, "ftcal: warning: %s\n", note.c_str());
+      std::printf("slot %c: serial %s, date %s, source %s\n", slot, f.serial.c_str(),
+                  f.date.c_str(), f.source.c_str());
     } else if (*apply) {
       const cal::CalFile cal = cal::LoadCalFile(cal_path);
       sim::ReadOptions opt;
