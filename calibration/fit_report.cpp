@@ -100,7 +100,7 @@ std::string ResidualPlot(const FitResult& fit, const RigData& d, int comp) {
   const double pw = w - l - 12;
   const double ph = h - t - 40;
   const Eigen::Index rows = d.wrench.rows();
-  const Eigen::Index stride = std::max<Eigen::Index>(1, rows / 1500);
+  const Eigen::Index stride = std::max<Eigen::Index>(1, rows / 800);
   const double rc = fit.rated[static_cast<std::size_t>(comp)];
   double xmax = 0;
   double ymax = 0;

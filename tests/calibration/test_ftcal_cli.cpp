@@ -40,7 +40,9 @@ class FtcalCli : public ::testing::Test {
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
   }
-  void TearDown() override { fs::remove_all(dir_); }
+  void TearDown() override {
+    if (std::getenv("FTCAL_KEEP") == nullptr) fs::remove_all(dir_);
+  }
   std::string P(const std::string& name) const { return (dir_ / name).string(); }
   fs::path dir_;
 };
@@ -62,6 +64,25 @@ TEST_F(FtcalCli, DesignFitVerifyApply) {
   EXPECT_NE(ss.str().find("<svg"), std::string::npos);
   EXPECT_EQ(ss.str().find("http://"), ss.str().find("http://www.w3.org"));  // only the SVG xmlns
   EXPECT_EQ(ss.str().find("https://"), std::string::npos);
+  // 1 bar chart + 6 residual plots, and headless Chromium renders it to a non-trivial image.
+  std::size_t svgs = 0;
+  for (std::size_t at = ss.str().find("<svg"); at != std::string::npos;
+       at = ss.str().find("<svg", at + 1)) {
+    ++svgs;
+  }
+  EXPECT_EQ(svgs, 7u);
+  if (std::system("command -v chromium > /dev/null 2>&1") == 0) {
+    const std::string png = P("report.png");
+    const std::string cmd =
+        "chromium --headless --no-sandbox --disable-gpu --disable-quic "
+        "--no-first-run --disable-background-networking "
+        "--disable-component-update --disable-sync --user-data-dir=" +
+        P("chrome") + " --screenshot=" + png + " --window-size=1200,1600 file://" +
+        P("report.html") + " > /dev/null 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0);
+    ASSERT_TRUE(fs::exists(png));
+    EXPECT_GT(fs::file_size(png), 50000u);  // a blank 1200×1600 page compresses to a few kB
+  }
   r = Ftcal("verify " + P("cal.json"));
   EXPECT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("OK"), std::string::npos);
