@@ -12,6 +12,8 @@
 
 #include "calibration/cal_file.hpp"
 #include "sim/recording.hpp"
+#include "sim/sensor_description.hpp"
+#include "tests/calibration/test_models.hpp"
 
 namespace {
 
@@ -123,6 +125,43 @@ TEST_F(FtcalCli, ImportAtiThenInstallIntoSlots) {
   r = Ftcal("active --slots " + P("dev"));
   EXPECT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("slot A: serial FT11712"), std::string::npos) << r.out;
+}
+
+/// Runs ftsim (the record helper's generator, with its effects) and fits its "real" output.
+CliRun Ftsim(const std::string& args) {
+  const std::string cmd = std::string(FTSTACK_BIN_DIR) + "/ftsim " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (p != nullptr && std::fgets(buf, sizeof buf, p) != nullptr) out += buf;
+  const int status = p != nullptr ? pclose(p) : -1;
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+TEST_F(FtcalCli, RecordingsFromFtsimWithEffectsPickTheRightModelAtTheNoiseFloor) {
+  const auto floor = ftstack::testing::NoiseFloor(ftstack::sim::DefaultSensorDescription());
+  struct Scenario {
+    std::string args;
+    std::string model;
+  };
+  const Scenario scenarios[] = {
+      {"--profile rig --effect bridge_nonlinearity:channels=[0,3] --seed 3", "quadratic"},
+      {"--profile thermal --effect thermal_zero_drift --effect thermal_span_drift --seed 4",
+       "linear-temp"},
+  };
+  for (const Scenario& sc : scenarios) {
+    CliRun r = Ftsim("record --sensor builtin --out " + P("real.csv") + " " + sc.args);
+    ASSERT_EQ(r.code, 0) << r.out;
+    r = Ftcal("fit --in " + P("real.csv") + " --out " + P("cal.json") + " --sensor builtin");
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("model: " + sc.model + ","), std::string::npos) << sc.args << "\n"
+                                                                         << r.out;
+    const ftstack::cal::CalFile cal = ftstack::cal::LoadCalFile(P("cal.json"));
+    for (int a = 0; a < 6; ++a) {
+      EXPECT_LE(cal.uncertainty[static_cast<std::size_t>(a)], 1.1 * floor(a))
+          << sc.args << " axis " << a;
+    }
+  }
 }
 
 TEST_F(FtcalCli, BadInputsExitNonZeroWithFileAndPosition) {
