@@ -23,17 +23,24 @@ class Scanner {
  public:
   Scanner(const std::string& text, std::string path) : text_(text), path_(std::move(path)) {}
 
+  /// 1-based line and column of byte `pos`.
+  void Position(std::size_t pos, std::size_t* line, std::size_t* col) const {
+    *line = 1;
+    *col = 1;
+    for (std::size_t i = 0; i < pos && i < text_.size(); ++i) {
+      if (text_[i] == '\n') {
+        ++*line;
+        *col = 1;
+      } else {
+        ++*col;
+      }
+    }
+  }
+
   [[noreturn]] void Fail(std::size_t pos, const std::string& why) const {
     std::size_t line = 1;
     std::size_t col = 1;
-    for (std::size_t i = 0; i < pos && i < text_.size(); ++i) {
-      if (text_[i] == '\n') {
-        ++line;
-        col = 1;
-      } else {
-        ++col;
-      }
-    }
+    Position(pos, &line, &col);
     throw CalFileError(path_ + ":" + std::to_string(line) + ":" + std::to_string(col) + ": " + why);
   }
 
@@ -96,14 +103,7 @@ class Scanner {
     Element el;
     std::size_t line = 1;
     std::size_t col = 1;
-    for (std::size_t k = 0; k < lt; ++k) {
-      if (text_[k] == '\n') {
-        ++line;
-        col = 1;
-      } else {
-        ++col;
-      }
-    }
+    Position(lt, &line, &col);
     el.line = line;
     el.column = col;
     std::size_t k = lt + 1;
