@@ -68,6 +68,12 @@ if [ -x "$B/bench_record" ]; then
         printf "  %-22s %8.0f rows %8.1f ms CPU\n", $1, $col["rows"], $4 }
       END { if (t["BM_RecordNone/300"] > 0) printf "  300 s: creep / none = %.2f, three effects / none = %.2f\n",
             t["BM_RecordCreep/300"] / t["BM_RecordNone/300"], t["BM_RecordThree/300"] / t["BM_RecordNone/300"] }'
+
+# --- ftdiag (issue 7): sim-vs-real diagnosis of 60 000 rows × 6 channels (target < 2 s) -------
+if [ -x "$B/bench_diag" ]; then
+  section "ftdiag diagnose, 60 000 rows x 6 channels (ms per diagnosis; target < 2000 ms)"
+  "$B/bench_diag" --benchmark_format=csv 2>/dev/null |
+    awk -F, 'NR>1 && $1 ~ /BM_/ { gsub(/"/,"",$1); printf "  %-26s %8.0f ms\n", $1, $3 }'
 fi
 
 # --- physics (issue 3): full-chain sample wrench → counts, physical vs linear model, same run ---

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "tools/diag/html_report.hpp"
+#include "tools/diag/scorecard.hpp"
 
 namespace ftstack::diag {
 namespace {
@@ -93,6 +94,44 @@ void AddCommands(CLI::App& app) {
                 "length of the interleaved hold-out blocks, s (default 0.5)");
   d->callback([] { g_exit = RunDiagnose(args); });
   AddDemoCommand(app, &g_exit);
+
+  static int seeds = 3;
+  static double duration_s = 120.0;
+  static std::string out;
+  auto* sc = app.add_subcommand(
+      "scorecard", "diagnose simulator recordings of every effect and write the docs table");
+  sc->add_option("--seeds", seeds, "seeds (and sizes ×1, ×0.5, ×2 cycling) per effect (default 3)");
+  sc->add_option("--duration-s", duration_s, "recording length, s (default 120)");
+  sc->add_option("--out", out, "Markdown file to write (default: print)");
+  sc->callback([] {
+    try {
+      std::vector<ScoreResult> results;
+      int passed = 0;
+      for (const auto& c : StandardCases(seeds, duration_s)) {
+        results.push_back(RunCase(c));
+        const auto& r = results.back();
+        passed += r.passed();
+        std::fprintf(stderr, "%-40s seed %llu: %-28s %s\n", c.effect.c_str(),
+                     static_cast<unsigned long long>(c.seed), r.verdict.c_str(),
+                     r.passed() ? "ok" : "MISSED");
+      }
+      const std::string cmd = "ftdiag scorecard --seeds " + std::to_string(seeds) +
+                              " --duration-s " + std::to_string(static_cast<int>(duration_s));
+      const std::string md = ScorecardMarkdown(results, cmd);
+      if (out.empty()) {
+        std::fputs(md.c_str(), stdout);
+      } else {
+        std::ofstream f(out);
+        f << md;
+        if (!f) throw std::runtime_error(out + ": cannot write");
+      }
+      std::printf("scorecard: %d/%zu cases meet every criterion\n", passed, results.size());
+      g_exit = 0;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "ftdiag scorecard: %s\n", e.what());
+      g_exit = 2;
+    }
+  });
 }
 
 int LastExitCode() { return g_exit; }

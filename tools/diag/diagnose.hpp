@@ -60,6 +60,10 @@ struct Report {
 
 /// Runs the whole diagnosis on aligned data. `data` must outlive the report.
 [[nodiscard]] Report Diagnose(const DiagData& data, const DiagnoseOptions& options = {});
+/// One pass with the given noise per channel (nullptr: the robust estimate). Diagnose() runs it
+/// once more with the refined noise when the claimed model shows the first estimate too high.
+[[nodiscard]] Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
+                                  const Eigen::VectorXd* sigma);
 
 /// The JSON report, schema "ftdiag-report/1" (diagnosis.md), plus documented extra keys.
 [[nodiscard]] nlohmann::json ToJson(const Report& report);

@@ -1267,7 +1267,7 @@ std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target) {
 
 }  // namespace
 
-Context MakeContext(const DiagData& d, double block_s) {
+Context MakeContext(const DiagData& d, double block_s, const Eigen::VectorXd* sigma) {
   Context cx;
   cx.data = &d;
   cx.n = static_cast<int>(d.rows());
@@ -1289,6 +1289,7 @@ Context MakeContext(const DiagData& d, double block_s) {
     // Floor: a tiny fraction of the channel's signal scale, so identical files do not divide by 0.
     const double scale = std::max(1e-9, d.sim_mvv.col(c).cwiseAbs().maxCoeff() * 1e-9);
     s = std::max(s, scale);
+    if (sigma != nullptr) s = (*sigma)(c);
     cx.sigma(c) = s;
     cx.weight(c) = 1.0 / (s * s);
   }

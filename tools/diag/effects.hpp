@@ -39,7 +39,9 @@ struct Context {
 };
 
 /// Builds the context: residual, noise, hold-out blocks (every third block of ~block_s).
-[[nodiscard]] Context MakeContext(const DiagData& d, double block_s = 0.5);
+/// `sigma` (one per channel), when given, replaces the robust noise estimate.
+[[nodiscard]] Context MakeContext(const DiagData& d, double block_s = 0.5,
+                                  const Eigen::VectorXd* sigma = nullptr);
 
 /// A fitted effect: its prediction of the residual and what to report.
 struct EffectFit {
