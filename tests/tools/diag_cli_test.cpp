@@ -98,6 +98,19 @@ TEST_F(DiagCli, WritesTheSpecJsonAndHtml) {
   EXPECT_NE(hs.str().find("<svg"), std::string::npos);
   EXPECT_EQ(hs.str().find("http://"),
             hs.str().find("http://www.w3.org/2000/svg"));  // no network references
+  // It renders offline in headless Chromium (when installed): a screenshot of real size appears.
+  if (std::system("command -v chromium > /dev/null 2>&1") == 0) {
+    const std::string shot = P("shot.png");
+    const std::string cmd =
+        "timeout 90 chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
+        "--disable-background-networking --disable-component-update --disable-sync "
+        "--user-data-dir=" +
+        P("chrome") + " --screenshot=" + shot + " --window-size=1200,2400 file://" + P("out.html") +
+        " > /dev/null 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    ASSERT_TRUE(fs::exists(shot));
+    EXPECT_GT(fs::file_size(shot), 50000u);  // a blank 1200×2400 PNG is a few kB
+  }
 }
 
 TEST_F(DiagCli, RefusesBadInputWithOneLineNamingTheFile) {

@@ -1217,7 +1217,7 @@ std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target) {
   double lf = std::log(bf);
   double lz = std::log(bz);
   for (int round = 0; round < 2; ++round) {
-    const std::vector<int>& chans = round == 0 ? coarse : all;
+    const std::vector<int>& chans = coarse;  // all channels only in the final fit
     if (round == 1) st = std::max(1, st / 2);
     std::vector<double> g1;
     for (int j = -2; j <= 2; ++j) g1.push_back(lf + 0.04 * j / (round + 1));

@@ -173,7 +173,8 @@ std::string SvgPlot(const PlotSpec& spec, const std::vector<Series>& series) {
     o += "<line x1=\"" + std::to_string(ml) + "\" x2=\"" + std::to_string(ml + pw) + "\" y1=\"" +
          Num(pyl(t)) + "\" y2=\"" + Num(pyl(t)) + "\" stroke=\"#ddd\"/>";
     o += "<text x=\"" + std::to_string(ml - 5) + "\" y=\"" + Num(pyl(t) + 4) +
-         "\" text-anchor=\"end\">" + (spec.log_y ? "1e" + Num(t, "%.0f") : Num(t)) + "</text>";
+         "\" text-anchor=\"end\">" + (spec.log_y ? Num(std::pow(10.0, t), "%.2g") : Num(t)) +
+         "</text>";
   }
   o += "<text x=\"" + std::to_string(ml + pw / 2) + "\" y=\"" + std::to_string(spec.height - 6) +
        "\" text-anchor=\"middle\">" + Esc(spec.x_label) + "</text>";
@@ -216,7 +217,8 @@ std::string HtmlReport(const DiagData& data, const Report& r) {
   h += "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>ftdiag report</title><style>"
        "body{font-family:sans-serif;margin:20px;max-width:1060px}table{border-collapse:collapse}"
        "td,th{border:1px solid #bbb;padding:3px 8px;font-size:13px}th{background:#eee}"
-       ".verdict{font-size:22px;font-weight:bold}.ev{background:#eef6ee;padding:6px;border-left:"
+       "code{word-break:break-all}.verdict{font-size:22px;font-weight:bold}.ev{background:#eef6ee;"
+       "padding:6px;border-left:"
        "4px solid #4a4}"
        "</style></head><body>";
   h += "<h1>ftdiag: sim vs real</h1>";
