@@ -9,9 +9,9 @@ section() { printf '\n== %s ==\n' "$*"; }
 
 # --- firmware core (issue 2): ns per sample, fixed point vs double-precision Eigen, same run ----
 if [ -x "$B/bench_core" ]; then
-  section "fixed-point core vs double-precision Eigen (ns per sample, one run)"
+  section "fixed-point core vs double-precision Eigen (CPU ns per sample, one run)"
   "$B/bench_core" --benchmark_min_time="$MIN_TIME" --benchmark_format=csv 2>/dev/null |
-    awk -F, 'NR>1 && $1 ~ /BM_/ { gsub(/"/,"",$1); t[$1]=$3; printf "  %-24s %8.1f ns\n", $1, $3 }
+    awk -F, 'NR>1 && $1 ~ /BM_/ { gsub(/"/,"",$1); t[$1]=$4; printf "  %-24s %8.1f ns CPU\n", $1, $4 }
       END {
         for (n = 6; n <= 8; n += 2) {
           f = t["BM_FixedMatrix/" n]; e = t["BM_EigenDouble/" n]; c = t["BM_FixedCore/" n "/1"];
