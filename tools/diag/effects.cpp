@@ -233,19 +233,14 @@ std::optional<EffectFit> FitZeroOffset(const Context& cx, const Mat& target) {
 // Smooth functions of time per channel (hat splines), knots chosen by BIC on training rows.
 std::optional<EffectFit> FitZeroDrift(const Context& cx, const Mat& target) {
   const double duration = cx.data->t_s.back() - cx.data->t_s.front();
-  double best_bic = std::numeric_limits<double>::infinity();
-  int best_k = 0;
-  std::vector<Vec> best_beta;
-  double best_sse = 0.0;
-  int worse = 0;
-  for (int k : {1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48}) {
-    if (duration / k < 3.0 * cx.block_s) break;
+  // Per channel hat-spline fit with k intervals on every st-th training row.
+  auto fit_k = [&](int k, int st, std::vector<Vec>* beta) {
     const HatBasis hb = MakeHat(cx, k);
-    std::vector<Vec> beta;
     double sse_w = 0.0;
+    beta->clear();
     for (int c = 0; c < cx.nc; ++c) {
       NormalEq ne(k + 1);
-      for (int i = 0; i < cx.n; ++i) {
+      for (int i = 0; i < cx.n; i += st) {
         if (!cx.train[static_cast<std::size_t>(i)]) continue;
         int j = 0;
         double fr = 0.0;
@@ -255,20 +250,30 @@ std::optional<EffectFit> FitZeroDrift(const Context& cx, const Mat& target) {
         ne.AddSparse(idx, val, 2, target(i, c));
       }
       const auto r = ne.Solve();
-      sse_w += r.sse * cx.weight(c);
-      beta.push_back(r.beta);
+      sse_w += r.sse * cx.weight(c) * st;
+      beta->push_back(r.beta);
     }
+    return sse_w;
+  };
+  double best_bic = std::numeric_limits<double>::infinity();
+  int best_k = 0;
+  std::vector<Vec> best_beta;
+  double best_sse = 0.0;
+  int worse = 0;
+  for (int k : {1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48}) {
+    if (duration / k < 3.0 * cx.block_s) break;
+    std::vector<Vec> beta;
+    const double sse_w = fit_k(k, cx.search_stride, &beta);
     const double bic = sse_w + cx.nc * (k + 1) * Penalty(cx);
     if (bic < best_bic) {
       best_bic = bic;
       best_k = k;
-      best_beta = std::move(beta);
-      best_sse = sse_w;
       worse = 0;
     } else if (++worse >= 2) {
       break;
     }
   }
+  if (best_k > 0) best_sse = fit_k(best_k, 1, &best_beta);
   if (best_k == 0) return std::nullopt;
   EffectFit best;
   best.name = "zero_drift";
