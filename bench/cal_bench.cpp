@@ -21,7 +21,7 @@ const cal::RigData& Data() {
     const auto keys = cal::RigKeys(cal::DesignRig(d.model->rated(), ro), ro);
     // Rate chosen so the sequence gives at least 1e6 rows; then exactly 1e6 are kept.
     const double rate = 1e6 / keys.back().t_s * 1.001;
-    sim::Recording rec = cal::SimulateRig(d, keys, rate, 1);
+    Recording rec = cal::SimulateRig(d, keys, rate, 1);
     for (auto& c : rec.columns) c.resize(1000000);
     cal::BlockOptions bo;
     for (int a = 0; a < 6; ++a) bo.scale[static_cast<std::size_t>(a)] = d.model->rated()(a);

@@ -16,8 +16,8 @@ namespace {
 
 using namespace ftstack;
 
-sim::Wrench Load() {
-  sim::Wrench w;
+Wrench Load() {
+  Wrench w;
   w << 40, -25, 150, 2.5, -1.2, 0.8;
   return w;
 }
@@ -43,7 +43,7 @@ BENCHMARK(BM_BuildFlexureBody);
 void BM_BridgeOutputs(benchmark::State& state) {
   const auto m = sim::ParsePhysicalSensor(sim::DefaultSensorJson(), "builtin");
   std::array<double, 8> out{};
-  sim::Wrench w = Load();
+  Wrench w = Load();
   for (auto _ : state) {
     m->BridgeOutputsInto(w, 23.0, out.data());
     benchmark::DoNotOptimize(out);

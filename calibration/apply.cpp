@@ -7,7 +7,7 @@
 
 namespace ftstack::cal {
 
-sim::Recording ApplyCalibration(const CalFile& cal, const sim::Recording& in) {
+Recording ApplyCalibration(const CalFile& cal, const Recording& in) {
   const std::size_t n = cal.cal.channel_count;
   if (in.BridgeCount() < n) {
     throw CalFileError(in.path + ": has " + std::to_string(in.BridgeCount()) +
@@ -47,7 +47,7 @@ sim::Recording ApplyCalibration(const CalFile& cal, const sim::Recording& in) {
     for (std::size_t r = 0; r < 6; ++r) out[r + 1][i] = o.wrench[r] * fw::AxisLsb(r);
     status[i] = o.status;
   }
-  sim::Recording rec;
+  Recording rec;
   rec.path = "(applied)";
   rec.metadata.push_back("calibration: " + cal.serial);
   rec.names = {"t", "Fx", "Fy", "Fz", "Mx", "My", "Mz", "status"};

@@ -2,7 +2,7 @@
 #pragma once
 
 #include "calibration/cal_file.hpp"
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 
 namespace ftstack::cal {
 
@@ -10,6 +10,6 @@ namespace ftstack::cal {
 /// (rounded, clipped at the rails), runs fw::WrenchCore on them and returns a recording with
 /// columns t,Fx,Fy,Fz,Mx,My,Mz in N and N·m (plus `status`). A `temp_C` column, where present,
 /// feeds the core's temperature compensation (as m°C, like hal::AdcSample).
-[[nodiscard]] sim::Recording ApplyCalibration(const CalFile& cal, const sim::Recording& in);
+[[nodiscard]] Recording ApplyCalibration(const CalFile& cal, const Recording& in);
 
 }  // namespace ftstack::cal

@@ -323,12 +323,12 @@ std::vector<int> DetectBlocks(const Eigen::MatrixXd& wrench, const BlockOptions&
   return block;
 }
 
-RigData RigDataFromRecording(const sim::Recording& rec, const BlockOptions& options) {
+RigData RigDataFromRecording(const Recording& rec, const BlockOptions& options) {
   RigData d;
   d.path = rec.path;
   const std::size_t n = rec.BridgeCount();
   if (n < 1 || n > fw::kMaxChannels) {
-    throw sim::RecordingError(
+    throw RecordingError(
         rec.path + ": needs bridge columns b0 … b{N-1} with 1 <= N <= 8, has " + std::to_string(n));
   }
   const std::size_t rows = rec.rows();
@@ -341,7 +341,7 @@ RigData RigDataFromRecording(const sim::Recording& rec, const BlockOptions& opti
     }
   }
   for (std::size_t a = 0; a < 6; ++a) {
-    const auto& col = rec.Column(sim::WrenchColumns()[a]);
+    const auto& col = rec.Column(WrenchColumns()[a]);
     for (std::size_t i = 0; i < rows; ++i) {
       d.wrench(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(a)) = col[i];
     }

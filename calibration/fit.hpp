@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "firmware/fixed_calibration.hpp"
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 
 namespace ftstack::cal {
 
@@ -48,8 +48,8 @@ struct RigData {
                                             std::string* method);
 
 /// Reads the columns a fit needs (b0…, Fx…Mz, optional temp_C, block/pose) and finds blocks.
-/// Throws sim::RecordingError naming the file when columns are missing or N is not 1 … 8.
-[[nodiscard]] RigData RigDataFromRecording(const sim::Recording& rec, const BlockOptions& options);
+/// Throws RecordingError naming the file when columns are missing or N is not 1 … 8.
+[[nodiscard]] RigData RigDataFromRecording(const Recording& rec, const BlockOptions& options);
 
 /// Calibration model families.
 enum class ModelKind {

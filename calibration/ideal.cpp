@@ -5,7 +5,7 @@ namespace ftstack::cal {
 CalFile IdealCalibration(const sim::SensorModel& model, const hal::AdcInfo& adc) {
   const Eigen::MatrixXd s = model.Sensitivity();
   const Eigen::MatrixXd m = s.completeOrthogonalDecomposition().pseudoInverse();  // 6 × N
-  const Eigen::VectorXd zero = model.BridgeOutputs(sim::Wrench::Zero(), 20.0);
+  const Eigen::VectorXd zero = model.BridgeOutputs(Wrench::Zero(), 20.0);
   CalFile f;
   f.serial = model.name();
   f.source = "ideal";
@@ -19,7 +19,7 @@ CalFile IdealCalibration(const sim::SensorModel& model, const hal::AdcInfo& adc)
     f.cal.offset_mvv[static_cast<std::size_t>(c)] = zero(c);
   f.adc = adc;
   f.adc.channel_count = f.cal.channel_count;
-  const sim::Wrench rated = model.rated();
+  const Wrench rated = model.rated();
   for (int i = 0; i < 6; ++i) f.rated[static_cast<std::size_t>(i)] = rated(i);
   return f;
 }

@@ -20,7 +20,7 @@ std::string Pct(double f) {
   return buf;
 }
 
-void SingleAxisSweeps(const sim::Wrench& rated, const std::vector<double>& levels, double temp,
+void SingleAxisSweeps(const Wrench& rated, const std::vector<double>& levels, double temp,
                       std::vector<RigStep>* out) {
   for (int a = 0; a < 6; ++a) {
     for (double sign : {1.0, -1.0}) {
@@ -39,7 +39,7 @@ void SingleAxisSweeps(const sim::Wrench& rated, const std::vector<double>& level
   }
 }
 
-void Combined(const sim::Wrench& rated, double temp, std::vector<RigStep>* out) {
+void Combined(const Wrench& rated, double temp, std::vector<RigStep>* out) {
   // Axial preload × bending, lever loads (F_x with M_y, F_y with M_x), shear × torsion.
   const int pairs[][2] = {{2, 3}, {2, 4}, {2, 5}, {0, 4}, {1, 3}, {0, 5}, {1, 5}, {0, 1}, {3, 4}};
   for (const auto& p : pairs) {
@@ -59,7 +59,7 @@ void Combined(const sim::Wrench& rated, double temp, std::vector<RigStep>* out) 
 
 }  // namespace
 
-std::vector<RigStep> DesignRig(const sim::Wrench& rated, const RigDesignOptions& options) {
+std::vector<RigStep> DesignRig(const Wrench& rated, const RigDesignOptions& options) {
   for (int a = 0; a < 6; ++a) {
     if (!(rated(a) > 0) || !std::isfinite(rated(a))) {
       throw std::invalid_argument("rated range must be positive on every axis");
@@ -105,7 +105,7 @@ std::vector<sim::ProfileWrench::Key> RigKeys(const std::vector<RigStep>& steps,
   return keys;
 }
 
-double RigCondition(const std::vector<RigStep>& steps, const sim::Wrench& rated) {
+double RigCondition(const std::vector<RigStep>& steps, const Wrench& rated) {
   Eigen::MatrixXd w(static_cast<Eigen::Index>(steps.size()), 6);
   for (std::size_t i = 0; i < steps.size(); ++i)
     w.row(static_cast<Eigen::Index>(i)) = steps[i].wrench.transpose();
@@ -114,7 +114,7 @@ double RigCondition(const std::vector<RigStep>& steps, const sim::Wrench& rated)
   return LoadSetCondition(w, r);
 }
 
-sim::Recording SimulateRig(const sim::SensorDescription& sensor,
+Recording SimulateRig(const sim::SensorDescription& sensor,
                            const std::vector<sim::ProfileWrench::Key>& keys, double rate_hz,
                            std::uint64_t seed, bool with_pose) {
   if (keys.empty()) throw std::invalid_argument("empty rig sequence");
@@ -142,7 +142,7 @@ sim::Recording SimulateRig(const sim::SensorDescription& sensor,
     if (adc.WaitDataReady(1000000) != hal::Status::kOk || adc.Read(s) != hal::Status::kOk) break;
     const double t = static_cast<double>(i) / static_cast<double>(cfg.rate_hz);
     cols[0].push_back(t);
-    const sim::Wrench& w = source.last_wrench();
+    const Wrench& w = source.last_wrench();
     for (int a = 0; a < 6; ++a) cols[static_cast<std::size_t>(1 + a)].push_back(w(a));
     for (std::size_t c = 0; c < n; ++c) cols[7 + c].push_back(s.counts[c] / cpm);
     cols[7 + n].push_back(s.has_temperature ? s.temperature_mdegc / 1000.0 : 20.0);
@@ -155,12 +155,12 @@ sim::Recording SimulateRig(const sim::SensorDescription& sensor,
       cols[8 + n].push_back(static_cast<double>(pose));
     }
   }
-  sim::Recording rec;
+  Recording rec;
   rec.path = "(simulated rig)";
   rec.metadata.push_back("sensor: " + sensor.name);
   rec.metadata.push_back("source: ftcal design (simulated rig)");
   rec.names = {"t", "Fx", "Fy", "Fz", "Mx", "My", "Mz"};
-  for (const auto& b : sim::BridgeColumns(n)) rec.names.push_back(b);
+  for (const auto& b : BridgeColumns(n)) rec.names.push_back(b);
   rec.names.push_back("temp_C");
   if (with_pose) rec.names.push_back("pose");
   rec.columns = std::move(cols);

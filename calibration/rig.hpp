@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 #include "sim/sensor_description.hpp"
 #include "sim/wrench_source.hpp"
 
@@ -27,13 +27,13 @@ struct RigDesignOptions {
 
 /// One static load of the sequence.
 struct RigStep {
-  sim::Wrench wrench = sim::Wrench::Zero();  ///< N, N·m
+  Wrench wrench = Wrench::Zero();  ///< N, N·m
   double temperature_c = 20.0;
   std::string label;  ///< e.g. "+Fz 50% up", "Fz 50% x Mx -50%"
 };
 
 /// Proposes a rig sequence for a sensor of rated range `rated` (N, N·m).
-[[nodiscard]] std::vector<RigStep> DesignRig(const sim::Wrench& rated,
+[[nodiscard]] std::vector<RigStep> DesignRig(const Wrench& rated,
                                              const RigDesignOptions& options);
 
 /// Keyframes of the sequence: each step held hold_s after a ramp_s transition.
@@ -41,12 +41,12 @@ struct RigStep {
                                                            const RigDesignOptions& options);
 
 /// Condition number of the sequence's loads (cal::LoadSetCondition over the steps).
-[[nodiscard]] double RigCondition(const std::vector<RigStep>& steps, const sim::Wrench& rated);
+[[nodiscard]] double RigCondition(const std::vector<RigStep>& steps, const Wrench& rated);
 
 /// Runs the keyframes through the sensor: sim::SimulatedSensor → hal::sim::SimAdc (its noise,
 /// resolution and seed) → counts → mV/V. Columns t, Fx…Mz (the applied reference), b0…, temp_C,
 /// and `pose` (index of the step being held or approached) when `with_pose`.
-[[nodiscard]] sim::Recording SimulateRig(const sim::SensorDescription& sensor,
+[[nodiscard]] Recording SimulateRig(const sim::SensorDescription& sensor,
                                          const std::vector<sim::ProfileWrench::Key>& keys,
                                          double rate_hz, std::uint64_t seed,
                                          bool with_pose = false);

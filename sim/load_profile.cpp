@@ -7,7 +7,7 @@
 #include <numbers>
 #include <sstream>
 
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 
 namespace ftstack::sim {
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "sim/effects.hpp"
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 #include "sim/sensor_description.hpp"
 
 namespace ftstack::sim {

@@ -5,10 +5,9 @@
 #include <array>
 #include <string>
 
-namespace ftstack::sim {
+#include "measurement/wrench.hpp"
 
-/// Wrench Fx Fy Fz (N) Mx My Mz (N·m) in the sensor frame.
-using Wrench = Eigen::Matrix<double, 6, 1>;
+namespace ftstack::sim {
 
 /// A sensor as the simulator sees it: from load and temperature to bridge outputs.
 class SensorModel {

@@ -5,7 +5,7 @@
 #include <memory>
 #include <vector>
 
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 #include "sim/sensor_model.hpp"
 
 namespace ftstack::sim {

@@ -286,10 +286,10 @@ TEST(AtiImport, MalformedFilesAreRefusedWithPosition) {
 
 TEST(AtiImport, AppliedToVoltsThroughTheFixedPointCore) {
   const AtiImport imp = ImportAtiCal(SharedFile("data/ati/FT11712.cal"));
-  sim::Recording rec;
+  Recording rec;
   rec.names = {"t", "b0", "b1", "b2", "b3", "b4", "b5"};
   rec.columns = {{0.0}, {0.1}, {-0.2}, {0.3}, {1.5}, {-0.7}, {0.25}};
-  const sim::Recording out = ApplyCalibration(imp.file, rec);
+  const Recording out = ApplyCalibration(imp.file, rec);
   const Eigen::MatrixXd m = Matrix(imp.file);
   // 16-bit counts over ±10 V: the input is quantised to 10/32767 V before the matrix.
   const double q = 10.0 / 32767.0;
@@ -298,7 +298,7 @@ TEST(AtiImport, AppliedToVoltsThroughTheFixedPointCore) {
     for (int c = 0; c < 6; ++c) {
       expect += m(a, c) * std::round(rec.columns[static_cast<std::size_t>(c + 1)][0] / q) * q;
     }
-    EXPECT_NEAR(out.Column(sim::WrenchColumns()[static_cast<std::size_t>(a)])[0], expect,
+    EXPECT_NEAR(out.Column(WrenchColumns()[static_cast<std::size_t>(a)])[0], expect,
                 a < 3 ? 1e-3 : 1e-5);
   }
 }

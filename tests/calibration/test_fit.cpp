@@ -24,7 +24,7 @@ FitResult FitSimulated(const sim::SensorDescription& d, const RigDesignOptions& 
                        std::uint64_t seed, const std::vector<ModelKind>& models = {},
                        RigData* data_out = nullptr) {
   const auto keys = RigKeys(DesignRig(d.model->rated(), ro), ro);
-  const sim::Recording rec = SimulateRig(d, keys, kRateHz, seed);
+  const Recording rec = SimulateRig(d, keys, kRateHz, seed);
   BlockOptions bo;
   bo.scale = Rated(d);
   RigData data = RigDataFromRecording(rec, bo);
@@ -37,12 +37,12 @@ FitResult FitSimulated(const sim::SensorDescription& d, const RigDesignOptions& 
 }
 
 /// RMS per axis of the fixed-point core's output against the reference on a fresh recording.
-std::array<double, 6> FixedPointRms(const CalFile& cal, const sim::Recording& rec) {
-  const sim::Recording out = ApplyCalibration(cal, rec);
+std::array<double, 6> FixedPointRms(const CalFile& cal, const Recording& rec) {
+  const Recording out = ApplyCalibration(cal, rec);
   std::array<double, 6> rms{};
   for (std::size_t a = 0; a < 6; ++a) {
-    const auto& ref = rec.Column(sim::WrenchColumns()[a]);
-    const auto& got = out.Column(sim::WrenchColumns()[a]);
+    const auto& ref = rec.Column(WrenchColumns()[a]);
+    const auto& got = out.Column(WrenchColumns()[a]);
     double ss = 0;
     for (std::size_t i = 0; i < ref.size(); ++i) ss += (got[i] - ref[i]) * (got[i] - ref[i]);
     rms[a] = std::sqrt(ss / static_cast<double>(ref.size()));
@@ -81,7 +81,7 @@ void ExpectFixedPointNearFloor(const sim::SensorDescription& d, const FitResult&
                                const RigDesignOptions& ro, std::uint64_t seed,
                                const Eigen::Matrix<double, 6, 1>& floor) {
   const CalFile cal = CalFileFromFit(r, DefaultAdc(6), "t", "2026-01-01");
-  const sim::Recording fresh =
+  const Recording fresh =
       SimulateRig(d, RigKeys(DesignRig(d.model->rated(), ro), ro), kRateHz, seed);
   ExpectNearFloor(FixedPointRms(cal, fresh), floor, "fixed-point, fresh data");
 }
@@ -255,7 +255,7 @@ TEST(Blocks, PoseColumnWins) {
   ro.levels = {0.5, 1.0};
   ro.random_combinations = 4;
   const auto steps = DesignRig(d.model->rated(), ro);
-  const sim::Recording rec = SimulateRig(d, RigKeys(steps, ro), 100.0, 3, true);
+  const Recording rec = SimulateRig(d, RigKeys(steps, ro), 100.0, 3, true);
   const RigData data = RigDataFromRecording(rec, BlockOptions{});
   EXPECT_EQ(data.block_method, "column pose");
   // Every step is one pose, except that the repeated zero loads are separate poses too.
@@ -263,7 +263,7 @@ TEST(Blocks, PoseColumnWins) {
 }
 
 TEST(Design, ProposedLoadSetIsWellConditioned) {
-  const sim::Wrench rated = sim::DefaultRated();
+  const Wrench rated = sim::DefaultRated();
   const auto steps = DesignRig(rated, RigDesignOptions{});
   const double kappa = RigCondition(steps, rated);
   EXPECT_LT(kappa, 10.0);

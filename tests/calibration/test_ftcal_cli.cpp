@@ -11,7 +11,7 @@
 #include <string>
 
 #include "calibration/cal_file.hpp"
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 #include "sim/sensor_description.hpp"
 #include "tests/calibration/test_models.hpp"
 
@@ -90,8 +90,8 @@ TEST_F(FtcalCli, DesignFitVerifyApply) {
   EXPECT_NE(r.out.find("OK"), std::string::npos);
   r = Ftcal("apply --cal " + P("cal.json") + " --in " + P("rig.csv") + " --out " + P("out.csv"));
   ASSERT_EQ(r.code, 0) << r.out;
-  const ftstack::sim::Recording in = ftstack::sim::ReadRecording(P("rig.csv"));
-  const ftstack::sim::Recording out = ftstack::sim::ReadRecording(P("out.csv"));
+  const ftstack::Recording in = ftstack::ReadRecording(P("rig.csv"));
+  const ftstack::Recording out = ftstack::ReadRecording(P("out.csv"));
   ASSERT_EQ(in.rows(), out.rows());
   // Fz within 5 noise σ (≈ 0.04 N) of the reference on every row.
   const auto& ref = in.Column("Fz");

@@ -18,12 +18,12 @@ class DistortedSensor final : public sim::SensorModel {
                   Eigen::VectorXd zero_drift_mvv_per_c, Eigen::VectorXd gain_drift_per_c)
       : base_(base),
         s_(base.Sensitivity()),
-        z_(base.BridgeOutputs(sim::Wrench::Zero(), 20.0)),
+        z_(base.BridgeOutputs(Wrench::Zero(), 20.0)),
         k_(std::move(quad_per_mvv)),
         d_(std::move(zero_drift_mvv_per_c)),
         g_(std::move(gain_drift_per_c)) {}
   [[nodiscard]] int channel_count() const override { return base_.channel_count(); }
-  [[nodiscard]] Eigen::VectorXd BridgeOutputs(const sim::Wrench& w, double t_c) const override {
+  [[nodiscard]] Eigen::VectorXd BridgeOutputs(const Wrench& w, double t_c) const override {
     const Eigen::VectorXd u = s_ * w;
     const double dt = t_c - 20.0;
     Eigen::VectorXd out(u.size());
@@ -32,7 +32,7 @@ class DistortedSensor final : public sim::SensorModel {
     }
     return out;
   }
-  [[nodiscard]] sim::Wrench rated() const override { return base_.rated(); }
+  [[nodiscard]] Wrench rated() const override { return base_.rated(); }
   [[nodiscard]] std::string name() const override { return "distorted-" + base_.name(); }
 
  private:

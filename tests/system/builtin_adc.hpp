@@ -26,7 +26,7 @@ inline BuiltinAdc BuiltinSimAdc(std::uint32_t rate_hz = 1000) {
     params = desc.adc;
     params.required_rate_hz = 0;
   }
-  sim::ConstantWrench zero(sim::Wrench::Zero());
+  sim::ConstantWrench zero(Wrench::Zero());
   sim::SimulatedSensor sensor(*desc.model, zero);
   hal::sim::SimAdc adc(sensor, params);
   hal::AdcConfig cfg;

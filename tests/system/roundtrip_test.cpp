@@ -14,13 +14,13 @@ namespace ftstack {
 namespace {
 
 struct RoundTrip {
-  sim::Wrench mean_recovered;  // N, N·m
-  sim::Wrench reference;       // noise-free double-precision chain, N, N·m
-  sim::Wrench tolerance;       // derived
-  sim::Wrench linearisation;   // reference − applied (model nonlinearity), N, N·m
+  Wrench mean_recovered;  // N, N·m
+  Wrench reference;       // noise-free double-precision chain, N, N·m
+  Wrench tolerance;       // derived
+  Wrench linearisation;   // reference − applied (model nonlinearity), N, N·m
 };
 
-RoundTrip RunChain(const sim::SensorDescription& desc, const sim::Wrench& applied, int samples,
+RoundTrip RunChain(const sim::SensorDescription& desc, const Wrench& applied, int samples,
                    std::uint64_t seed) {
   sim::ConstantWrench source(applied, 20.0);
   sim::SimulatedSensor sensor(*desc.model, source);
@@ -59,7 +59,7 @@ RoundTrip RunChain(const sim::SensorDescription& desc, const sim::Wrench& applie
       m(r, c) = cal.cal.matrix[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)];
   }
   const Eigen::VectorXd b = desc.model->BridgeOutputs(applied, 20.0);
-  const Eigen::VectorXd b0 = desc.model->BridgeOutputs(sim::Wrench::Zero(), 20.0);
+  const Eigen::VectorXd b0 = desc.model->BridgeOutputs(Wrench::Zero(), 20.0);
   rt.reference = m * (b - b0);
   rt.linearisation = rt.reference - applied;
 
@@ -77,8 +77,8 @@ class RoundTripTest : public ::testing::TestWithParam<int> {};
 
 TEST_P(RoundTripTest, RecoversTheAppliedWrenchWithinDerivedTolerance) {
   const sim::SensorDescription desc = sim::DefaultSensorDescription();
-  const sim::Wrench rated = desc.model->rated();
-  sim::Wrench applied = sim::Wrench::Zero();
+  const Wrench rated = desc.model->rated();
+  Wrench applied = Wrench::Zero();
   const int k = GetParam();
   if (k < 6) {
     applied(k) = 0.6 * rated(k);  // one axis at 60 % of rated
@@ -103,7 +103,7 @@ TEST(RoundTrip, ToleranceIsTightEnoughToCatchAOnePercentGainError) {
   // The derived tolerance must be meaningful: a one-percent gain error on one bridge has to
   // exceed it at 60 % of rated Fz, otherwise the test above could not fail.
   const sim::SensorDescription desc = sim::DefaultSensorDescription();
-  sim::Wrench applied = sim::Wrench::Zero();
+  Wrench applied = Wrench::Zero();
   applied(2) = 0.6 * desc.model->rated()(2);
   const RoundTrip rt = RunChain(desc, applied, 400, 5);
   const Eigen::MatrixXd s = desc.model->Sensitivity();

@@ -20,7 +20,7 @@
 #include "firmware/modbus_server.hpp"
 #include "firmware/register_map.hpp"
 #include "sim/default_sensor.hpp"
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 #include "tests/system/builtin_adc.hpp"
 #include "tests/system/ftd_process.hpp"
 
@@ -520,7 +520,7 @@ TEST(FtdModbus, EveryReplyComesFromOneSample) {
   // the sequence/timestamp of one sample with the wrench of another cannot pass.
   char path[] = "/tmp/ftd_ramp_XXXXXX.csv";
   close(mkstemps(path, 4));
-  sim::Recording rec;
+  Recording rec;
   std::vector<double> t, fz, zero;
   for (int i = 0; i <= 40; ++i) {
     t.push_back(i * 0.5);
@@ -528,8 +528,8 @@ TEST(FtdModbus, EveryReplyComesFromOneSample) {
     zero.push_back(0.0);
   }
   rec.SetColumn("t", t);
-  for (const std::string& n : sim::WrenchColumns()) rec.SetColumn(n, n == "Fz" ? fz : zero);
-  sim::WriteRecording(path, rec);
+  for (const std::string& n : WrenchColumns()) rec.SetColumn(n, n == "Fz" ? fz : zero);
+  WriteRecording(path, rec);
   test::FtdProcess ftd({"--replay", path, "--rate-hz", "1000", "--modbus-tcp", "127.0.0.1:0"});
   ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
   const Expected e = DeriveExpected();
@@ -577,11 +577,11 @@ TEST(FtdModbus, LogWritesTheRecordingFormatAndDurationEndsCleanly) {
       {"--sim-wrench", "0,0,-100,0,0,0", "--rate-hz", "1000", "--duration-s", "1", "--log", path},
       false);
   ASSERT_EQ(ftd.Wait(20.0), 0) << ftd.Stderr();
-  sim::ReadOptions ro;
+  ReadOptions ro;
   ro.required = {"t", "status", "temp_C", "raw0", "raw5"};
   ro.require_bridges = true;
   ro.require_wrench = true;
-  const sim::Recording rec = sim::ReadRecording(path, ro);
+  const Recording rec = ReadRecording(path, ro);
   EXPECT_GE(rec.rows(), 900u);
   EXPECT_LE(rec.rows(), 1100u);
   EXPECT_EQ(rec.BridgeCount(), 6u);

@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 #include "tests/tools/diag_fixture.hpp"
 
 namespace ftstack::diag {
@@ -41,15 +41,15 @@ class DiagCli : public ::testing::Test {
   /// Writes the fixture as sim.csv / real.csv (recording-format.md).
   void WritePair(const testing::Fixture& fx) {
     const auto& d = fx.data;
-    sim::Recording sim;
-    sim::Recording real;
+    Recording sim;
+    Recording real;
     sim.SetColumn("t", d.t_s);
     real.SetColumn("t", d.t_s);
     for (int k = 0; k < 6; ++k) {
       std::vector<double> col(d.rows());
       for (std::size_t i = 0; i < d.rows(); ++i) col[i] = d.wrench(static_cast<Eigen::Index>(i), k);
-      sim.SetColumn(sim::WrenchColumns()[static_cast<std::size_t>(k)], col);
-      real.SetColumn(sim::WrenchColumns()[static_cast<std::size_t>(k)], col);
+      sim.SetColumn(WrenchColumns()[static_cast<std::size_t>(k)], col);
+      real.SetColumn(WrenchColumns()[static_cast<std::size_t>(k)], col);
     }
     for (int c = 0; c < d.channels(); ++c) {
       std::vector<double> s(d.rows());
@@ -62,8 +62,8 @@ class DiagCli : public ::testing::Test {
       real.SetColumn("b" + std::to_string(c), r);
     }
     real.SetColumn("temp_C", d.temp_c);
-    sim::WriteRecording(P("sim.csv"), sim);
-    sim::WriteRecording(P("real.csv"), real);
+    WriteRecording(P("sim.csv"), sim);
+    WriteRecording(P("real.csv"), real);
   }
   std::string P(const std::string& name) const { return (dir_ / name).string(); }
   fs::path dir_;

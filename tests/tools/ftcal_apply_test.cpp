@@ -13,7 +13,7 @@
 
 #include "calibration/ideal.hpp"
 #include "sim/default_sensor.hpp"
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 
 namespace ftstack {
 namespace {
@@ -47,32 +47,32 @@ TEST(FtcalApply, MatchesDoublePrecisionWithinInputQuantisationAndFixedPointBound
   // A recording of random wrenches inside the rated range, noise-free bridge outputs.
   std::mt19937_64 rng(9);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  sim::Recording rec;
+  Recording rec;
   rec.names = {"t", "b0", "b1", "b2", "b3", "b4", "b5", "note"};
   rec.columns.assign(rec.names.size(), {});
   const int rows = 500;
   for (int i = 0; i < rows; ++i) {
-    sim::Wrench w;
+    Wrench w;
     for (int k = 0; k < 6; ++k) w(k) = u(rng) * model->rated()(k);
     const Eigen::VectorXd b = model->BridgeOutputs(w, 20.0);
     rec.columns[0].push_back(i * 0.001);
     for (int c = 0; c < 6; ++c) rec.columns[static_cast<std::size_t>(c + 1)].push_back(b(c));
     rec.columns[7].push_back(i);  // unknown column: ignored
   }
-  sim::WriteRecording(tmp / "in.csv", rec);
+  WriteRecording(tmp / "in.csv", rec);
   ASSERT_EQ(RunFtcal("apply --cal " + tmp / "cal.json" + " --in " + tmp / "in.csv" + " --out " +
                          tmp / "out.csv",
                      tmp / "err.txt"),
             0)
       << Slurp(tmp / "err.txt");
-  const sim::Recording in = sim::ReadRecording(tmp / "in.csv");
-  const sim::Recording out = sim::ReadRecording(tmp / "out.csv");
+  const Recording in = ReadRecording(tmp / "in.csv");
+  const Recording out = ReadRecording(tmp / "out.csv");
   ASSERT_EQ(out.rows(), static_cast<std::size_t>(rows));
 
   fw::LoadReport rep{};
   (void)cal::ToFixed(cal, cal.adc, &rep);
   const double cpm = fw::CountsPerMvv(cal.adc);
-  const auto& names = sim::WrenchColumns();
+  const auto& names = WrenchColumns();
   for (std::size_t r = 0; r < 6; ++r) {
     // Inputs are rounded to whole counts (±0.5 count per channel) before the core.
     double tol = rep.worst_case_error_si[r];

@@ -10,7 +10,7 @@
 #include <sstream>
 #include <string>
 
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 
 namespace {
 
@@ -38,15 +38,15 @@ TEST(FtsimRecordCli, WritesRealSimAndTruth) {
                              "/r.csv --sim-out " + d + "/s.csv --truth " + d +
                              "/t.json --effect creep:tau_s=5 --effect 'zero_offset:channels=[1]'");
   ASSERT_EQ(r.status, 0) << r.err;
-  ftstack::sim::ReadOptions opt;
+  ftstack::ReadOptions opt;
   opt.require_wrench = true;
   opt.require_bridges = true;
-  const auto real = ftstack::sim::ReadRecording(d + "/r.csv", opt);
-  const auto sim = ftstack::sim::ReadRecording(d + "/s.csv", opt);
+  const auto real = ftstack::ReadRecording(d + "/r.csv", opt);
+  const auto sim = ftstack::ReadRecording(d + "/s.csv", opt);
   EXPECT_EQ(real.rows(), 601u);  // 3 s at the taps profile's 200 Hz, both ends included
   EXPECT_EQ(real.BridgeCount(), 6u);
   EXPECT_TRUE(real.Has("temp_C"));
-  EXPECT_NO_THROW(ftstack::sim::CheckAligned(sim, real));
+  EXPECT_NO_THROW(ftstack::CheckAligned(sim, real));
   std::ifstream tj(d + "/t.json");
   const auto truth = nlohmann::json::parse(tj);
   ASSERT_EQ(truth["effects"].size(), 2u);
@@ -55,7 +55,7 @@ TEST(FtsimRecordCli, WritesRealSimAndTruth) {
   EXPECT_EQ(truth["effects"][1]["params"]["channels"], nlohmann::json::array({1}));
 
   ASSERT_EQ(Ftsim("--profile taps --duration-s 1 --no-temp --out " + d + "/n.csv").status, 0);
-  EXPECT_FALSE(ftstack::sim::ReadRecording(d + "/n.csv").Has("temp_C"));
+  EXPECT_FALSE(ftstack::ReadRecording(d + "/n.csv").Has("temp_C"));
 }
 
 TEST(FtsimRecordCli, BadInputGivesOneLineReason) {

@@ -34,8 +34,8 @@ void AddDemoCommand(CLI::App& app, int* exit_code) {
       const std::string dir = out_dir.empty() ? "ftdiag-demo-" + name : out_dir;
       std::filesystem::create_directories(dir);
       const sim::RecordResult rec = sim::MakeRecording(req);
-      sim::WriteRecording(dir + "/real.csv", rec.real);
-      sim::WriteRecording(dir + "/sim.csv", rec.sim);
+      WriteRecording(dir + "/real.csv", rec.real);
+      WriteRecording(dir + "/sim.csv", rec.sim);
       sim::WriteTruth(dir + "/truth.json", rec.truth);
       std::printf(
           "recorded %s (%s profile, %zu rows, seed %llu): effect hidden in real.csv, truth in "

@@ -23,25 +23,25 @@ void Relay(std::size_t done, std::size_t total, void* user) {
   }
 }
 
-sim::Recording Read(const std::string& path, ProgressRelay* relay) {
-  sim::ReadOptions opt;
+Recording Read(const std::string& path, ProgressRelay* relay) {
+  ReadOptions opt;
   opt.required = {"t"};
   opt.require_bridges = true;
   if (relay != nullptr && relay->fn != nullptr) {
     opt.progress = &Relay;
     opt.progress_user = relay;
   }
-  return sim::ReadRecording(path, opt);
+  return ReadRecording(path, opt);
 }
 
-bool HasWrench(const sim::Recording& r) {
-  for (const auto& w : sim::WrenchColumns()) {
+bool HasWrench(const Recording& r) {
+  for (const auto& w : WrenchColumns()) {
     if (!r.Has(w)) return false;
   }
   return true;
 }
 
-Eigen::MatrixXd Bridges(const sim::Recording& r, std::size_t n) {
+Eigen::MatrixXd Bridges(const Recording& r, std::size_t n) {
   Eigen::MatrixXd m(static_cast<Eigen::Index>(r.rows()), static_cast<Eigen::Index>(n));
   for (std::size_t c = 0; c < n; ++c) {
     const auto& col = r.Column("b" + std::to_string(c));
@@ -51,10 +51,10 @@ Eigen::MatrixXd Bridges(const sim::Recording& r, std::size_t n) {
   return m;
 }
 
-Eigen::MatrixXd WrenchOf(const sim::Recording& r) {
+Eigen::MatrixXd WrenchOf(const Recording& r) {
   Eigen::MatrixXd m(static_cast<Eigen::Index>(r.rows()), 6);
   for (int k = 0; k < 6; ++k) {
-    const auto& col = r.Column(sim::WrenchColumns()[static_cast<std::size_t>(k)]);
+    const auto& col = r.Column(WrenchColumns()[static_cast<std::size_t>(k)]);
     for (std::size_t i = 0; i < col.size(); ++i) m(static_cast<Eigen::Index>(i), k) = col[i];
   }
   return m;
@@ -77,7 +77,7 @@ double DiagData::rate_hz() const {
   return 1.0 / dt[dt.size() / 2];
 }
 
-DiagData FromRecordings(const sim::Recording& sim, const sim::Recording& real) {
+DiagData FromRecordings(const Recording& sim, const Recording& real) {
   const std::size_t nr = real.BridgeCount();
   const std::size_t ns = sim.BridgeCount();
   if (nr == 0) throw DiagInputError(real.path + ": no bridge columns b0…");
@@ -86,8 +86,8 @@ DiagData FromRecordings(const sim::Recording& sim, const sim::Recording& real) {
                          real.path + " has " + std::to_string(nr));
   }
   try {
-    sim::CheckAligned(sim, real);
-  } catch (const sim::RecordingError& e) {
+    CheckAligned(sim, real);
+  } catch (const RecordingError& e) {
     throw DiagInputError(e.what());
   }
   DiagData d;
@@ -111,10 +111,10 @@ DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path, 
   ProgressRelay r1{progress, user, 0.0, 0.5, "reading sim"};
   ProgressRelay r2{progress, user, 0.5, 0.5, "reading real"};
   try {
-    const sim::Recording sim = Read(sim_path, &r1);
-    const sim::Recording real = Read(real_path, &r2);
+    const Recording sim = Read(sim_path, &r1);
+    const Recording real = Read(real_path, &r2);
     return FromRecordings(sim, real);
-  } catch (const sim::RecordingError& e) {
+  } catch (const RecordingError& e) {
     throw DiagInputError(e.what());
   }
 }
@@ -128,9 +128,9 @@ DiagData LoadModelReal(const std::string& sensor_path, const std::string& real_p
     throw DiagInputError(e.what());
   }
   ProgressRelay r1{progress, user, 0.0, 0.8, "reading real"};
-  sim::Recording real;
+  Recording real;
   try {
-    sim::ReadOptions opt;
+    ReadOptions opt;
     opt.required = {"t"};
     opt.require_bridges = true;
     opt.require_wrench = true;
@@ -138,8 +138,8 @@ DiagData LoadModelReal(const std::string& sensor_path, const std::string& real_p
       opt.progress = &Relay;
       opt.progress_user = &r1;
     }
-    real = sim::ReadRecording(real_path, opt);
-  } catch (const sim::RecordingError& e) {
+    real = ReadRecording(real_path, opt);
+  } catch (const RecordingError& e) {
     throw DiagInputError(e.what());
   }
   const std::size_t nr = real.BridgeCount();
@@ -158,7 +158,7 @@ DiagData LoadModelReal(const std::string& sensor_path, const std::string& real_p
   const auto n = static_cast<Eigen::Index>(d.t_s.size());
   d.sim_mvv.resize(n, static_cast<Eigen::Index>(nr));
   for (Eigen::Index i = 0; i < n; ++i) {
-    const sim::Wrench w = d.wrench.row(i).transpose();
+    const Wrench w = d.wrench.row(i).transpose();
     const double temp = d.temp_c.empty() ? 20.0 : d.temp_c[static_cast<std::size_t>(i)];
     const Eigen::VectorXd b = desc.model->BridgeOutputs(w, temp);
     d.sim_mvv.row(i) = b.transpose();

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 
 namespace ftstack::diag {
 
@@ -41,7 +41,7 @@ struct DiagData {
 using ProgressFn = void (*)(double fraction, const char* stage, void* user);
 
 /// Builds the pair from two recordings already read: checks bridge counts and alignment.
-[[nodiscard]] DiagData FromRecordings(const sim::Recording& sim, const sim::Recording& real);
+[[nodiscard]] DiagData FromRecordings(const Recording& sim, const Recording& real);
 /// Reads SIM.csv and REAL.csv (recording-format.md) and aligns them.
 [[nodiscard]] DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path,
                                    ProgressFn progress = nullptr, void* user = nullptr);

@@ -11,7 +11,7 @@
 #include "calibration/fit_report.hpp"
 #include "calibration/rig.hpp"
 #include "calibration/slots.hpp"
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 #include "sim/sensor_description.hpp"
 #include "tools/common.hpp"
 
@@ -104,17 +104,17 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     if (*fit) {
-      sim::ReadOptions opt;
+      ReadOptions opt;
       opt.require_bridges = true;
       opt.require_wrench = true;
-      const sim::Recording rec = sim::ReadRecording(in_path, opt);
+      const Recording rec = ReadRecording(in_path, opt);
       cal::FitOptions fo;
       fo.folds = folds;
       hal::AdcInfo adc{};
       bool have_adc = false;
       if (!sensor_path.empty()) {
         const sim::SensorDescription s = sim::LoadSensorDescription(sensor_path);
-        const sim::Wrench r = s.model->rated();
+        const Wrench r = s.model->rated();
         for (int a = 0; a < 6; ++a) fo.rated[static_cast<std::size_t>(a)] = r(a);
         adc.channel_count = static_cast<std::uint8_t>(s.model->channel_count());
         const std::int64_t half = std::int64_t{1} << (s.adc.resolution_bits - 1);
@@ -179,10 +179,10 @@ int main(int argc, char** argv) {
                   f.date.c_str(), f.source.c_str());
     } else if (*apply) {
       const cal::CalFile cal = cal::LoadCalFile(cal_path);
-      sim::ReadOptions opt;
+      ReadOptions opt;
       opt.require_bridges = true;
-      const sim::Recording in = sim::ReadRecording(in_path, opt);
-      sim::WriteRecording(out_path, cal::ApplyCalibration(cal, in));
+      const Recording in = ReadRecording(in_path, opt);
+      WriteRecording(out_path, cal::ApplyCalibration(cal, in));
       std::fprintf(stderr, "ftcal: wrote %zu rows to %s\n", in.rows(), out_path.c_str());
     } else if (*verify) {
       const cal::CalFile cal = cal::LoadCalFile(cal_path);
@@ -209,7 +209,7 @@ int main(int argc, char** argv) {
       std::printf("%zu loads, %.1f s; condition number of the load set: %.3g\n", steps.size(),
                   keys.back().t_s, cal::RigCondition(steps, s.model->rated()));
       if (!profile_out.empty()) {
-        sim::Recording prof;
+        Recording prof;
         prof.names = {"t", "Fx", "Fy", "Fz", "Mx", "My", "Mz", "temp_C"};
         prof.columns.resize(8);
         for (const auto& k : keys) {
@@ -219,11 +219,11 @@ int main(int argc, char** argv) {
           prof.columns[7].push_back(k.temperature_c);
         }
         prof.metadata.push_back("source: ftcal design");
-        sim::WriteRecording(profile_out, prof);
+        WriteRecording(profile_out, prof);
         std::printf("wrote %s\n", profile_out.c_str());
       }
       if (!simulate_out.empty()) {
-        sim::WriteRecording(simulate_out, cal::SimulateRig(s, keys, rate_hz, 1));
+        WriteRecording(simulate_out, cal::SimulateRig(s, keys, rate_hz, 1));
         std::printf("wrote %s\n", simulate_out.c_str());
       }
     }

@@ -11,7 +11,7 @@
 #include "calibration/ideal.hpp"
 #include "hal/sim/sim_adc.hpp"
 #include "sim/default_sensor.hpp"
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 #include "sim/sensor_description.hpp"
 #include "sim/simulated_sensor.hpp"
 #include "sim/wrench_source.hpp"
@@ -91,12 +91,12 @@ void Ftd::Start() {
       sim_gain_ = desc.adc_gain;
       channels = static_cast<std::uint8_t>(model_->channel_count());
       if (!opt_.replay.empty()) {
-        sim::ReadOptions ro;
+        ReadOptions ro;
         ro.required = {"t"};
         ro.require_wrench = true;
-        source_ = sim::ReplayWrench(sim::ReadRecording(opt_.replay, ro));
+        source_ = sim::ReplayWrench(ReadRecording(opt_.replay, ro));
       } else {
-        sim::Wrench w = sim::Wrench::Zero();
+        Wrench w = Wrench::Zero();
         if (opt_.sim_wrench) {
           for (int i = 0; i < 6; ++i) w(i) = (*opt_.sim_wrench)[static_cast<std::size_t>(i)];
         }
@@ -253,13 +253,13 @@ void Ftd::DrainLog() {
       std::vector<std::string> names{"t"};
       for (std::size_t c = 0; c < s.channel_count; ++c) names.push_back("b" + std::to_string(c));
       for (std::size_t c = 0; c < s.channel_count; ++c) names.push_back("raw" + std::to_string(c));
-      for (const std::string& n : sim::WrenchColumns()) names.push_back(n);
+      for (const std::string& n : WrenchColumns()) names.push_back(n);
       if (s.has_temperature) names.push_back("temp_C");
       names.push_back("status");
       std::vector<std::string> meta{"source: ftd", "adc: " + opt_.adc,
                                     "rate_hz: " + std::to_string(opt_.rate_hz),
                                     "wrench: measured (tool frame), N and N·m"};
-      writer_ = std::make_unique<sim::RecordingWriter>(opt_.log, meta, names);
+      writer_ = std::make_unique<RecordingWriter>(opt_.log, meta, names);
       log_started_ = true;
     }
     if (log_started_ && logged_rows_ > 0 && s.timestamp_us < last_log_timestamp_us_) {

@@ -20,8 +20,10 @@ namespace ftstack::sim {
 class SensorModel;
 class WrenchSource;
 class SimulatedSensor;
-class RecordingWriter;
 }  // namespace ftstack::sim
+namespace ftstack {
+class RecordingWriter;
+}  // namespace ftstack
 namespace ftstack::hal::sim {
 class SimAdc;
 }
@@ -108,7 +110,7 @@ class Ftd {
   std::unique_ptr<fw::RegisterMap> map_;
   std::unique_ptr<fw::ModbusTcpServer> tcp_;
   std::unique_ptr<fw::ModbusRtuServer> rtu_;
-  std::unique_ptr<sim::RecordingWriter> writer_;
+  std::unique_ptr<RecordingWriter> writer_;
 
   // Single-producer (sampling thread) single-consumer (DrainLog) ring of published samples.
   std::vector<fw::DeviceSample> ring_;

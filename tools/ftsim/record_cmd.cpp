@@ -38,8 +38,8 @@ void Run(const RecordOptions& o, bool noise_given) {
   req.effects = sim::ParseEffects(o.effects);
   req.temperature = !o.no_temp;
   const sim::RecordResult res = sim::MakeRecording(req);
-  sim::WriteRecording(o.out, res.real);
-  if (!o.sim_out.empty()) sim::WriteRecording(o.sim_out, res.sim);
+  WriteRecording(o.out, res.real);
+  if (!o.sim_out.empty()) WriteRecording(o.sim_out, res.sim);
   if (!o.truth.empty()) sim::WriteTruth(o.truth, res.truth);
 }
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace ftstack::sim {
+namespace ftstack {
 
 /// A malformed recording. what() is "FILE:LINE:COLUMN: reason" (line and column 1-based; column
 /// counts characters) or "FILE: reason" when no position applies.
@@ -89,4 +89,4 @@ class RecordingWriter {
   std::string line_;
 };
 
-}  // namespace ftstack::sim
+}  // namespace ftstack

@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 
 namespace ftstack::sim {
 namespace {

@@ -1,4 +1,4 @@
-#include "sim/recording.hpp"
+#include "measurement/recording.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -6,7 +6,9 @@
 #include <fstream>
 #include <sstream>
 
-namespace ftstack::sim {
+#include "measurement/wrench.hpp"
+
+namespace ftstack {
 namespace {
 
 [[noreturn]] void Fail(const std::string& path, std::size_t line, std::size_t col,
@@ -76,7 +78,7 @@ std::string Recording::Meta(const std::string& key) const {
 }
 
 const std::vector<std::string>& WrenchColumns() {
-  static const std::vector<std::string> kNames = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
+  static const std::vector<std::string> kNames(kWrenchAxisNames.begin(), kWrenchAxisNames.end());
   return kNames;
 }
 
@@ -276,4 +278,4 @@ void RecordingWriter::WriteRow(const std::vector<double>& values) {
 
 void RecordingWriter::Flush() { std::fflush(file_); }
 
-}  // namespace ftstack::sim
+}  // namespace ftstack
