@@ -1,4 +1,4 @@
-// The Modbus register map, version 1 (shared spec modbus-map.md): input image, holding registers.
+// The Modbus register map, version 1 (docs/spec/modbus-map.md): input image, holding registers.
 #pragma once
 
 #include <array>

@@ -1,4 +1,4 @@
-// The sensor status bits published in Modbus input register 1 (docs: shared spec modbus-map.md).
+// The sensor status bits published in Modbus input register 1 (docs/spec/modbus-map.md).
 #pragma once
 
 #include <cstdint>

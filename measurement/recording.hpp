@@ -1,4 +1,4 @@
-// Reading and writing recordings (the shared CSV format): columns by name, errors with line:column.
+// Reading and writing recordings (docs/spec/recording-format.md): columns by name, errors with line:column.
 #pragma once
 
 #include <cstddef>

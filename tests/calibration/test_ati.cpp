@@ -13,16 +13,10 @@
 
 #include "calibration/apply.hpp"
 #include "calibration/ati.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace ftstack::cal {
 namespace {
-
-/// The shared data folder: $FTSTACK_SHARED_DIR when set (a worktree outside the checkout's
-/// parent), else the build's FTSTACK_SHARED_DIR.
-std::string SharedFile(const std::string& rel) {
-  const char* env = std::getenv("FTSTACK_SHARED_DIR");
-  return std::string(env != nullptr && *env != '\0' ? env : FTSTACK_SHARED_DIR) + "/" + rel;
-}
 
 std::string ReadText(const std::string& path) {
   std::ifstream in(path);
@@ -83,7 +77,7 @@ Eigen::MatrixXd Matrix(const CalFile& f) {
 }
 
 TEST(AtiImport, Version10AxisRowsScaledAndTransformedLikeAtisLibrary) {
-  const std::string path = SharedFile("data/ati/FT11712.cal");
+  const std::string path = test::TestDataPath("ati/FT11712.cal");
   const AtiImport imp = ImportAtiCal(path);
   EXPECT_EQ(imp.version, "1.0");
   EXPECT_FALSE(imp.used_user_axis);
@@ -96,17 +90,16 @@ TEST(AtiImport, Version10AxisRowsScaledAndTransformedLikeAtisLibrary) {
   const std::array<double, 6> rated = {65, 65, 200, 5, 5, 5};
   for (std::size_t a = 0; a < 6; ++a) EXPECT_DOUBLE_EQ(imp.file.rated[a], rated[a]);
   // The file saves and verifies through our own format and fixed-point loader.
-  const auto tmp = std::filesystem::temp_directory_path() / "ati_ft11712.json";
-  SaveCalFile(tmp.string(), imp.file);
-  const CalFile back = LoadCalFile(tmp.string());
+  const test::TempDir tmp("ati");
+  SaveCalFile(tmp / "ft11712.json", imp.file);
+  const CalFile back = LoadCalFile(tmp / "ft11712.json");
   EXPECT_LT((Matrix(back) - got).cwiseAbs().maxCoeff(), 1e-12);
-  std::filesystem::remove(tmp);
 }
 
 TEST(AtiImport, Version11WrittenFromVersion10NumbersAgrees) {
   // Write a v1.1 file whose UserAxis rows are derived here (by hand, 5 decimals as ATI prints
   // them) from the v1.0 Axis numbers; importing it must give the same calibration.
-  const std::string v10 = SharedFile("data/ati/FT11712.cal");
+  const std::string v10 = test::TestDataPath("ati/FT11712.cal");
   const RawAxis raw = ReadAxisRows(ReadText(v10));
   const Eigen::MatrixXd user = HandTransformDz(raw, 0.0120142);
   const char* names[6] = {"Fx", "Fy", "Fz", "Tx", "Ty", "Tz"};
@@ -285,7 +278,7 @@ TEST(AtiImport, MalformedFilesAreRefusedWithPosition) {
 }
 
 TEST(AtiImport, AppliedToVoltsThroughTheFixedPointCore) {
-  const AtiImport imp = ImportAtiCal(SharedFile("data/ati/FT11712.cal"));
+  const AtiImport imp = ImportAtiCal(test::TestDataPath("ati/FT11712.cal"));
   Recording rec;
   rec.names = {"t", "b0", "b1", "b2", "b3", "b4", "b5"};
   rec.columns = {{0.0}, {0.1}, {-0.2}, {0.3}, {1.5}, {-0.7}, {0.25}};

@@ -14,6 +14,8 @@
 #include "measurement/recording.hpp"
 #include "sim/sensor_description.hpp"
 #include "tests/calibration/test_models.hpp"
+#include "tests/support/chromium.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace {
 
@@ -73,16 +75,9 @@ TEST_F(FtcalCli, DesignFitVerifyApply) {
     ++svgs;
   }
   EXPECT_EQ(svgs, 7u);
-  if (std::system("command -v chromium > /dev/null 2>&1") == 0) {
+  if (ftstack::test::HaveChromium()) {
     const std::string png = P("report.png");
-    const std::string cmd =
-        "chromium --headless --no-sandbox --disable-gpu --disable-quic "
-        "--no-first-run --disable-background-networking "
-        "--disable-component-update --disable-sync --user-data-dir=" +
-        P("chrome") + " --screenshot=" + png + " --window-size=1200,1600 file://" +
-        P("report.html") + " > /dev/null 2>&1";
-    EXPECT_EQ(std::system(cmd.c_str()), 0);
-    ASSERT_TRUE(fs::exists(png));
+    ASSERT_TRUE(ftstack::test::RenderWithChromium(P("report.html"), png, P("chrome")));
     EXPECT_GT(fs::file_size(png), 50000u);  // a blank 1200×1600 page compresses to a few kB
   }
   r = Ftcal("verify " + P("cal.json"));
@@ -100,9 +95,7 @@ TEST_F(FtcalCli, DesignFitVerifyApply) {
 }
 
 TEST_F(FtcalCli, ImportAtiThenInstallIntoSlots) {
-  const char* env = std::getenv("FTSTACK_SHARED_DIR");
-  const std::string ati = std::string(env != nullptr && *env != '\0' ? env : FTSTACK_SHARED_DIR) +
-                          "/data/ati/FT11712.cal";
+  const std::string ati = ftstack::test::TestDataPath("ati/FT11712.cal");
   CliRun r = Ftcal("import-ati " + ati + " --out " + P("ati.json"));
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("version 1.0"), std::string::npos) << r.out;

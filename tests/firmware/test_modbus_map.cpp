@@ -15,9 +15,16 @@
 #include "firmware/register_map.hpp"
 #include "hal/sim/sim_adc.hpp"
 #include "tests/firmware/fake_adc.hpp"
+#include "tests/firmware/register_map_fixture.hpp"
 
 namespace ftstack::fw {
 namespace {
+
+using maptest::g_now_us;
+using maptest::kGain;
+using maptest::kMvvPerCount;
+using maptest::kRatedLsb;
+using maptest::RegisterMapTest;
 
 // ---------------------------------------------------------------------------------------------
 // Packing: published IEEE-754 and two's-complement bit patterns, high word first.
@@ -69,8 +76,6 @@ TEST(Overload, IntegerSquareRootIsExactFloor) {
   EXPECT_EQ(ISqrt64(std::numeric_limits<std::uint64_t>::max()), 0xFFFFFFFFu);
   EXPECT_EQ(ISqrt64(0), 0u);
 }
-
-constexpr WrenchLsb kRatedLsb = {200000, 200000, 400000, 1000000, 1000000, 800000};
 
 struct RefShares {
   double fxy_mz, fz_mxy;
@@ -300,74 +305,6 @@ TEST(Seqlock, ReadersNeverSeeTornValues) {
 
 // ---------------------------------------------------------------------------------------------
 // Register map over a Device driven by a scripted ADC.
-
-std::uint64_t g_now_us = 1000000;
-std::uint64_t FakeClock() { return g_now_us; }
-
-constexpr std::array<double, 6> kGain = {100.0, 100.0, 200.0, 5.0, 5.0, 4.0};  // per mV/V
-constexpr double kMvvPerCount = 3.90625 / 8388607.0;
-
-class RegisterMapTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    g_now_us = 1000000;
-    adc_.counts = {};
-    FloatCalibration fc;
-    fc.channel_count = 6;
-    for (std::size_t i = 0; i < 6; ++i) fc.matrix[i][i] = kGain[i];
-    hal::AdcInfo info{6, -(1 << 23), (1 << 23) - 1, 3906250, 1000, false};
-    ASSERT_EQ(LoadCalibration(fc, info, &cfg_.slots[0].fixed, &report_), LoadStatus::kOk);
-    cfg_.slots[0].crc32 = 0xCAFEF00Du;
-    cfg_.slots[0].present = true;
-    cfg_.adc.channel_count = 6;
-    cfg_.adc.rate_hz = 1000;
-    cfg_.rated_lsb = kRatedLsb;
-    cfg_.tare_samples = 4;
-    cfg_.clock_us = &FakeClock;
-  }
-  void StartDevice() {
-    ASSERT_EQ(device_.Start(cfg_), DeviceStatus::kOk);
-    map_ = std::make_unique<RegisterMap>(device_);
-  }
-  void Step(int n = 1) {
-    for (int i = 0; i < n; ++i) {
-      bool published = false;
-      ASSERT_EQ(device_.Step(&published), hal::Status::kOk);
-      g_now_us += 1000;
-    }
-  }
-  std::array<std::uint16_t, kInputRegisterCount> Input() {
-    std::array<std::uint16_t, kInputRegisterCount> r{};
-    EXPECT_EQ(map_->ReadInput(0, kInputRegisterCount, r.data()), ModbusException::kNone);
-    return r;
-  }
-  std::uint16_t Holding(std::uint16_t addr) {
-    std::uint16_t v = 0xDEAD;
-    EXPECT_EQ(map_->ReadHolding(addr, 1, &v), ModbusException::kNone);
-    return v;
-  }
-  ModbusException Write(std::uint16_t addr, std::initializer_list<std::uint16_t> values) {
-    std::vector<std::uint16_t> v(values);
-    return map_->WriteHolding(addr, v.data(), static_cast<std::uint16_t>(v.size()));
-  }
-  ModbusException WriteFloats(std::uint16_t addr, std::initializer_list<float> values) {
-    std::vector<std::uint16_t> v(values.size() * 2);
-    std::size_t i = 0;
-    for (float f : values) PackFloat32(f, &v[2 * i++]);
-    return map_->WriteHolding(addr, v.data(), static_cast<std::uint16_t>(v.size()));
-  }
-  /// The wrench in SI a count vector produces through the diagonal test calibration.
-  static double ExpectedSi(std::size_t axis, std::int32_t counts) {
-    return kGain[axis] * counts * kMvvPerCount;
-  }
-
-  test::FakeAdc adc_;
-  WrenchCore core_;
-  Device device_{adc_, core_};
-  DeviceConfig cfg_;
-  LoadReport report_;
-  std::unique_ptr<RegisterMap> map_;
-};
 
 TEST_F(RegisterMapTest, InputImageCarriesOneSampleInTheSpecifiedLayout) {
   StartDevice();

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "measurement/recording.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace ftstack::sim {
 namespace {
@@ -64,8 +65,8 @@ TEST(Recording, RefusalsNameLineAndColumn) {
 }
 
 TEST(Recording, WriteThenReadRoundTripsAndAlignmentIsChecked) {
-  const auto dir = std::filesystem::temp_directory_path() / "ftstack_rec_test";
-  std::filesystem::create_directories(dir);
+  const test::TempDir tmp("rec");
+  const std::filesystem::path& dir = tmp.path();
   Recording r;
   r.metadata = {"sensor: test"};
   r.names = {"t", "b0", "b1"};
@@ -95,18 +96,17 @@ TEST(Recording, WriteThenReadRoundTripsAndAlignmentIsChecked) {
   for (auto& col : shorter.columns) col.pop_back();
   EXPECT_THROW(CheckAligned(shorter, r), RecordingError);
   EXPECT_THROW((void)ReadRecording((dir / "missing.csv").string()), RecordingError);
-  std::filesystem::remove_all(dir);
 }
 
 TEST(Recording, StreamingWriterRefusesWrongWidth) {
-  const auto path = (std::filesystem::temp_directory_path() / "ftstack_w.csv").string();
+  const test::TempDir tmp("rec");
+  const std::string path = tmp / "w.csv";
   RecordingWriter w(path, {}, {"t", "b0"});
   w.WriteRow({0.0, 1.0});
   EXPECT_THROW(w.WriteRow({1.0}), RecordingError);
   w.Flush();
   const Recording back = ReadRecording(path);
   EXPECT_EQ(back.rows(), 1u);
-  std::filesystem::remove(path);
 }
 
 }  // namespace

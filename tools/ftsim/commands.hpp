@@ -5,9 +5,9 @@
 
 namespace ftstack::tools {
 
-/// `ftsim pivot …` — the crossed-strip flexure pivot solver (see shared spec cli.md).
+/// `ftsim pivot …` — the crossed-strip flexure pivot solver (docs/spec/cli.md).
 void AddPivotCommand(CLI::App& app);
-/// `ftsim record …` — recordings with known physics and injected effects (see cli.md).
+/// `ftsim record …` — recordings with known physics and injected effects (docs/spec/cli.md).
 void AddRecordCommand(CLI::App& app);
 
 }  // namespace ftstack::tools

@@ -1,4 +1,4 @@
-// `ftsim record` — simulated recordings with known physics and injected effects (cli.md).
+// `ftsim record` — simulated recordings with known physics and injected effects (docs/spec/cli.md).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
