@@ -204,6 +204,10 @@ void ModbusTcpServer::Accept() {
         slot = &c;
       }
     }
+    if (slot == nullptr) {  // no connection slots at all (cannot happen with kMaxConnections > 0)
+      ::close(fd);
+      return;
+    }
     if (slot->fd >= 0) {  // full: the longest-silent client makes room
       Close(*slot);
       counters_.dropped.fetch_add(1, std::memory_order_relaxed);

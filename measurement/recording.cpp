@@ -5,6 +5,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <system_error>
 
 #include "measurement/wrench.hpp"
 
@@ -203,7 +204,7 @@ Recording ParseRecording(const std::string& text, const std::string& path,
 
 Recording ReadRecording(const std::string& path, const ReadOptions& options) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw RecordingError(path + ": cannot open: " + std::strerror(errno));
+  if (!in) throw RecordingError(path + ": cannot open: " + std::generic_category().message(errno));
   std::stringstream ss;
   ss << in.rdbuf();
   return ParseRecording(ss.str(), path, options);
@@ -241,7 +242,9 @@ RecordingWriter::RecordingWriter(const std::string& path, const std::vector<std:
                                  const std::vector<std::string>& names)
     : path_(path), width_(names.size()) {
   file_ = std::fopen(path.c_str(), "w");
-  if (file_ == nullptr) throw RecordingError(path + ": cannot write: " + std::strerror(errno));
+  if (file_ == nullptr) {
+    throw RecordingError(path + ": cannot write: " + std::generic_category().message(errno));
+  }
   std::string head;
   for (const auto& m : metadata) {
     head.append("# ");
@@ -249,7 +252,7 @@ RecordingWriter::RecordingWriter(const std::string& path, const std::vector<std:
     head.push_back('\n');
   }
   for (std::size_t i = 0; i < names.size(); ++i) {
-    if (i) head.push_back(',');
+    if (i > 0) head.push_back(',');
     head.append(names[i]);
   }
   head.push_back('\n');
@@ -267,12 +270,12 @@ void RecordingWriter::WriteRow(const std::vector<double>& values) {
   }
   line_.clear();
   for (std::size_t i = 0; i < values.size(); ++i) {
-    if (i) line_ += ',';
+    if (i > 0) line_ += ',';
     AppendNumber(line_, values[i]);
   }
   line_ += '\n';
   if (std::fwrite(line_.data(), 1, line_.size(), file_) != line_.size()) {
-    throw RecordingError(path_ + ": write failed: " + std::strerror(errno));
+    throw RecordingError(path_ + ": write failed: " + std::generic_category().message(errno));
   }
 }
 

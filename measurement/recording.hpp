@@ -1,4 +1,4 @@
-// Reading and writing recordings (docs/spec/recording-format.md): columns by name, errors with line:column.
+// Recordings (docs/spec/recording-format.md): read and write by column name, errors at line:column.
 #pragma once
 
 #include <cstddef>

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <cstring>
 
+#include "hal/errno_text.hpp"
+
 namespace ftstack::hal::gpio {
 namespace {
 
@@ -72,9 +74,9 @@ Status GpiodV1Chip::Open(const char* path, const char* consumer) {
   chip_ = path_[0] == '/' ? gpiod_chip_open(path_.data()) : gpiod_chip_open_lookup(path_.data());
   if (chip_ == nullptr) {
     const int err = errno != 0 ? errno : ENODEV;
-    std::snprintf(
-        error_.data(), error_.size(), "cannot open GPIO chip %s: %s", path_.data(),
-        err == ENOTTY || err == EINVAL ? "not a GPIO character device" : std::strerror(err));
+    std::snprintf(error_.data(), error_.size(), "cannot open GPIO chip %s: %s", path_.data(),
+                  err == ENOTTY || err == EINVAL ? "not a GPIO character device"
+                                                 : hal::ErrnoText(err).c_str());
     return Status::kUnavailable;
   }
   error_[0] = '\0';
@@ -83,7 +85,7 @@ Status GpiodV1Chip::Open(const char* path, const char* consumer) {
 
 Status GpiodV1Chip::Fail(const char* what, std::uint32_t offset, int err) {
   std::snprintf(error_.data(), error_.size(), "GPIO chip %s line %u: %s: %s", path_.data(),
-                static_cast<unsigned>(offset), what, std::strerror(err));
+                static_cast<unsigned>(offset), what, hal::ErrnoText(err).c_str());
   return Status::kUnavailable;
 }
 

@@ -11,6 +11,8 @@
 #include <cstdio>
 #include <cstring>
 
+#include "hal/errno_text.hpp"
+
 namespace ftstack::hal::spi {
 
 Spidev::~Spidev() {
@@ -18,8 +20,9 @@ Spidev::~Spidev() {
 }
 
 Status Spidev::Fail(const char* what, int err) {
-  std::snprintf(error_.data(), error_.size(), "SPI device %s: %s: %s", path_.data(), what,
-                err == ENOTTY || err == EINVAL ? "not an spidev device" : std::strerror(err));
+  std::snprintf(
+      error_.data(), error_.size(), "SPI device %s: %s: %s", path_.data(), what,
+      err == ENOTTY || err == EINVAL ? "not an spidev device" : hal::ErrnoText(err).c_str());
   if (fd_ >= 0) close(fd_);
   fd_ = -1;
   return Status::kUnavailable;
@@ -40,8 +43,9 @@ Status Spidev::Open(const char* path, std::uint8_t mode, std::uint32_t speed_hz)
   const std::uint8_t m = mode;
   const std::uint8_t bits = 8;
   if (ioctl(fd_, SPI_IOC_WR_MODE, &m) != 0) return Fail("cannot set the SPI mode", errno);
-  if (ioctl(fd_, SPI_IOC_WR_BITS_PER_WORD, &bits) != 0)
+  if (ioctl(fd_, SPI_IOC_WR_BITS_PER_WORD, &bits) != 0) {
     return Fail("cannot set 8-bit words", errno);
+  }
   if (ioctl(fd_, SPI_IOC_WR_MAX_SPEED_HZ, &speed_hz) != 0) {
     return Fail("cannot set the clock rate", errno);
   }

@@ -110,7 +110,7 @@ struct Ads131mCounters {
 };
 
 /// Largest frame: response + 8 channels + CRC, 24-bit words; WREG frames are never longer.
-inline constexpr std::size_t kAds131mMaxFrameBytes = (8 + 2) * 3;
+inline constexpr std::size_t kAds131mMaxFrameBytes = std::size_t{8 + 2} * 3;
 
 /// ADS131M06/08 as a hal::Adc. Uses 24-bit words, CCITT CRC, all channels enabled, high-resolution
 /// power mode; /DRDY (active low) on a GPIO input with falling-edge events.
