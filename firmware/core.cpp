@@ -25,6 +25,22 @@ void WrenchCore::ClearTare() {
   tare_remaining_ = 0;
   tare_counts_ = {};
   tare_extra_ = {};
+  tare_offset_ = {};
+}
+
+void WrenchCore::ComputeTareOffset() {
+  // Untared y = Σ coef·x + Σ coef·f + bias; tared y = Σ coef·(x − tare) + Σ coef·(f − f_tare).
+  // Their difference is Σ coef·tare + Σ coef·f_tare + bias, a constant of the tare. The loader
+  // bounds every such sum below 2^62 for counts between the rails (tare counts are averages of
+  // such counts), so the accumulation cannot overflow. Rounding each separately: ≤ 1 LSB apart.
+  const std::size_t n = cal_.channel_count;
+  bool clipped = false;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    std::int64_t acc = cal_.bias[r];
+    for (std::size_t c = 0; c < n; ++c) acc += cal_.coef[r][c] * tare_counts_[c];
+    for (std::size_t k = 0; k < cal_.extra_count; ++k) acc += cal_.coef[r][n + k] * tare_extra_[k];
+    tare_offset_[r] = SatToI32(RoundShift(acc, cal_.shift[r]), &clipped);
+  }
 }
 
 bool WrenchCore::SetFilterLength(std::uint16_t length) {
@@ -131,16 +147,30 @@ void WrenchCore::Process(const hal::AdcSample& in, bool simulated, CoreOutput& o
   bool any_error = false;
   bool bridge_fault = false;
   bool all_same = n > 0;
+  bool jumped = false;  // a channel reached saturation by a jump: a broken gauge, not a load
   for (std::size_t c = 0; c < n && c < kMaxChannels; ++c) {
     const std::int32_t v = in.counts[c];
-    if ((in.flags[c] & hal::kChannelSaturated) != 0) any_saturated = true;
+    const bool at_rail = cal_.valid && (v >= cal_.max_counts || v <= cal_.min_counts);
+    const bool flagged = (in.flags[c] & hal::kChannelSaturated) != 0;
+    const bool sat = at_rail || flagged;
+    if (sat && !was_saturated_[c]) {
+      // Entering saturation from inside the middle half of the range in one sample: a jump.
+      const std::int64_t mid = (std::int64_t{cal_.max_counts} + cal_.min_counts) / 2;
+      const std::int64_t quarter = (std::int64_t{cal_.max_counts} - cal_.min_counts) / 4;
+      const std::int64_t prev = last_counts_[c];
+      rail_jump_[c] = prev - mid < quarter && mid - prev < quarter;
+    }
+    was_saturated_[c] = sat;
+    if (flagged) any_saturated = true;  // the backend's saturation flag (within 1 % of a rail)
+    if (sat && rail_jump_[c]) jumped = true;
     if ((in.flags[c] & (hal::kChannelReadError | hal::kChannelTimeout)) != 0) any_error = true;
     if (v != last_counts_[c]) all_same = false;
-    const bool at_rail = cal_.valid && (v >= cal_.max_counts || v <= cal_.min_counts);
     rail_run_[c] = at_rail ? static_cast<std::uint16_t>(rail_run_[c] < 0xFFFF ? rail_run_[c] + 1
                                                                               : rail_run_[c])
                            : 0;
-    if (limits_.rail_samples > 0 && rail_run_[c] >= limits_.rail_samples) bridge_fault = true;
+    if (limits_.rail_samples > 0 && rail_run_[c] >= limits_.rail_samples && rail_jump_[c]) {
+      bridge_fault = true;
+    }
     last_counts_[c] = v;
   }
   same_count_run_ = all_same ? static_cast<std::uint16_t>(
@@ -156,6 +186,9 @@ void WrenchCore::Process(const hal::AdcSample& in, bool simulated, CoreOutput& o
     out.status |= kStatusCalInvalid;
     out.wrench = {};
     out.unfiltered = {};
+    out.structural = {};
+    out.structural_valid = false;
+    out.saturated_by_load = false;
     return;
   }
 
@@ -177,19 +210,33 @@ void WrenchCore::Process(const hal::AdcSample& in, bool simulated, CoreOutput& o
                       tare_extra_);
       }
       tare_active_ = true;
+      ComputeTareOffset();
       ResetFilter();
     }
   }
   if (tare_active_) out.status |= kStatusTareActive;
 
-  if (!usable) {  // hold the last valid wrench
+  // The load on the body (untared, unfiltered). While a bridge is saturated its counts are
+  // clamped at the rails by Apply, so this is a lower bound of the load — still the evidence the
+  // overload rule needs. Not on read errors or a broken bridge: those counts mean nothing.
+  WrenchLsb y{};
+  out.structural_valid = !any_error && !bridge_fault && !jumped;
+  out.saturated_by_load = any_saturated && !jumped;
+  if (out.structural_valid) {
+    bool clipped = false;
+    Apply(in.counts, in.temperature_mdegc, in.has_temperature, y, &clipped, &temp_range);
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      out.structural[r] = SatToI32(std::int64_t{y[r]} + tare_offset_[r], &clipped);
+    }
+    if (usable) out.arithmetic_saturated = out.arithmetic_saturated || clipped;
+  } else {
+    out.structural = {};
+  }
+
+  if (!usable) {  // hold the last valid wrench (the publication marks it invalid)
     out.wrench = last_valid_;
     return;
   }
-
-  WrenchLsb y{};
-  Apply(in.counts, in.temperature_mdegc, in.has_temperature, y, &out.arithmetic_saturated,
-        &temp_range);
   out.unfiltered = y;
 
   // Moving average over the last filter_length_ samples (shorter while filling).

@@ -18,8 +18,16 @@ inline constexpr std::uint16_t kMaxTareSamples = 4096;
 
 /// Result of one processed sample.
 struct CoreOutput {
-  WrenchLsb wrench{};                 ///< filtered wrench, LSB (mN, 10 µN·m); held on saturation
-  WrenchLsb unfiltered{};             ///< this sample's wrench before the moving average, LSB
+  WrenchLsb wrench{};      ///< filtered wrench, LSB (mN, 10 µN·m); held on saturation
+  WrenchLsb unfiltered{};  ///< this sample's wrench before the moving average, LSB
+  /// The load the sensor body carries: this sample's wrench before the moving average and without
+  /// the tare (the calibration's own zero), LSB. Computed also while a bridge is saturated (from
+  /// the counts clamped at the rails: then a lower bound of the true load). Overload and peaks use
+  /// it. Valid when `structural_valid`.
+  WrenchLsb structural{};
+  bool structural_valid = false;
+  /// A bridge is saturated and got there by ramping through its range: the load drove it there.
+  bool saturated_by_load = false;
   std::uint16_t status = 0;           ///< StatusBit set that the core decides (0, 2, 3, 4, 5, 7)
   bool arithmetic_saturated = false;  ///< an intermediate value was clamped this sample
   bool updated = false;               ///< the wrench was recomputed (false while holding)
@@ -77,6 +85,8 @@ class WrenchCore {
   /// Fills the derived features (ΔT, products) for clamped counts and a clamped temperature.
   void ExtraFeatures(const std::array<std::int32_t, kMaxChannels>& counts, std::int32_t dt_mdegc,
                      std::array<std::int64_t, kMaxFeatures - kMaxChannels>& f) const;
+  /// The wrench of the tare itself (what the tare removes), LSB: computed once per tare.
+  void ComputeTareOffset();
   /// Clamps a temperature into the compensated range and returns ΔT, m°C.
   std::int32_t DeltaT(std::int32_t temperature_mdegc, bool has_temperature,
                       bool* out_of_range) const;
@@ -90,7 +100,8 @@ class WrenchCore {
   std::array<std::int64_t, kMaxChannels> tare_sum_{};
   std::int64_t tare_temp_sum_ = 0;  ///< Σ clamped ΔT over the tare, m°C
   std::array<std::int64_t, kMaxFeatures - kMaxChannels>
-      tare_extra_{};  ///< derived features at the tare
+      tare_extra_{};         ///< derived features at the tare
+  WrenchLsb tare_offset_{};  ///< untared − tared wrench while a tare is active, LSB
 
   std::uint16_t filter_length_ = 1;
   std::uint16_t filter_fill_ = 0;
@@ -102,6 +113,10 @@ class WrenchCore {
   std::array<std::int32_t, kMaxChannels> last_counts_{};
   std::uint16_t same_count_run_ = 0;
   std::array<std::uint16_t, kMaxChannels> rail_run_{};
+  /// The channel reached its rail in one step from inside half its range: an open or shorted
+  /// gauge, not a load (a load ramps through the range; an open gauge jumps).
+  std::array<bool, kMaxChannels> rail_jump_{};
+  std::array<bool, kMaxChannels> was_saturated_{};  ///< saturated in the previous sample
 };
 
 }  // namespace ftstack::fw

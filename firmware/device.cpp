@@ -89,9 +89,14 @@ hal::Status Device::Step(bool* published) {
   }
   ++samples_;
   const CoreOutput& core = sampler_.core_output();
-  if (core.updated && overload_.configured()) {
-    if (overload_.Update(core.unfiltered)) sticky_status_ |= kStatusOverload;
+  // Overload and peaks judge the load the body carries: untared, also while a bridge saturates.
+  if (core.structural_valid && overload_.configured()) {
+    if (overload_.Update(core.structural, core.saturated_by_load)) {
+      sticky_status_ |= kStatusOverload;
+    }
   }
+  // A wrench clipped by the arithmetic is not a measurement: flag it like a saturated bridge.
+  if (core.arithmetic_saturated) sticky_status_ |= kStatusSaturated;
   if (++since_publish_ < active_.decimation) return s;
   since_publish_ = 0;
 
@@ -103,6 +108,7 @@ hal::Status Device::Step(bool* published) {
   if ((status & kStatusCalInvalid) == 0) {
     bool sat = false;
     ApplyToolTransform(active_.transform, p.wrench, &d.sample.wrench, &sat);
+    if (sat) status |= kStatusSaturated;  // the tool-frame wrench was clipped
   }
   if (p.has_temperature && (p.temperature_mdegc < config_.temp_min_mdegc ||
                             p.temperature_mdegc > config_.temp_max_mdegc)) {

@@ -53,7 +53,7 @@ LoadShares OverloadMonitor::Shares(const WrenchLsb& w) const {
   return s;
 }
 
-bool OverloadMonitor::Update(const WrenchLsb& w) {
+bool OverloadMonitor::Update(const WrenchLsb& w, bool saturated) {
   for (std::size_t i = 0; i < kAxes; ++i) {
     const std::int32_t a = w[i] == std::numeric_limits<std::int32_t>::min()
                                ? std::numeric_limits<std::int32_t>::max()
@@ -61,9 +61,10 @@ bool OverloadMonitor::Update(const WrenchLsb& w) {
     if (a > peaks_[i]) peaks_[i] = a;
   }
   const LoadShares s = Shares(w);
-  const std::uint64_t limit = kOverloadShareNum * kShareOne;
-  const bool over = configured_ && (std::uint64_t{s.fxy_mz} * kOverloadShareDen > limit ||
-                                    std::uint64_t{s.fz_mxy} * kOverloadShareDen > limit);
+  const std::uint64_t worst = s.fxy_mz > s.fz_mxy ? s.fxy_mz : s.fz_mxy;
+  const bool above = worst * kOverloadShareDen > kOverloadShareNum * kShareOne;
+  const bool released = worst * kReleaseShareDen <= kReleaseShareNum * kShareOne;
+  const bool over = configured_ && (saturated || above || (overloaded_ && !released));
   if (over && !overloaded_ && events_ != std::numeric_limits<std::uint32_t>::max()) ++events_;
   overloaded_ = over;
   return over;

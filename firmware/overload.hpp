@@ -15,6 +15,10 @@ inline constexpr std::uint32_t kShareOne = 1u << 24;
 /// Overload threshold: 105 % of the rated range, Q24 (rounded up: > 1.05 strictly).
 inline constexpr std::uint64_t kOverloadShareNum = 21;  ///< 1.05 = 21 / 20
 inline constexpr std::uint64_t kOverloadShareDen = 20;
+/// Release threshold: an overload event ends only when both shares are at or below 100 % of the
+/// rated range (hysteresis: noise around 105 % does not count one event per crossing).
+inline constexpr std::uint64_t kReleaseShareNum = 1;
+inline constexpr std::uint64_t kReleaseShareDen = 1;
 
 /// floor(sqrt(n)) for any 64-bit n (bit-by-bit, integer only).
 [[nodiscard]] std::uint32_t ISqrt64(std::uint64_t n);
@@ -40,9 +44,12 @@ class OverloadMonitor {
   /// The two load shares of `w` (sensor frame, LSB). Zero shares before Configure.
   [[nodiscard]] LoadShares Shares(const WrenchLsb& w) const;
 
-  /// Evaluates one sample: updates the peaks and, on a transition into overload, the event
-  /// counter. Returns true while overloaded.
-  bool Update(const WrenchLsb& w);
+  /// Evaluates one sample of the load on the body (sensor frame, untared): updates the peaks and,
+  /// on a transition into overload, the event counter. An event starts when either share exceeds
+  /// 105 % (or `saturated`: a bridge at its rail under load is overload evidence by itself) and
+  /// ends when both shares are back at or below 100 % without saturation. Returns true while
+  /// overloaded.
+  bool Update(const WrenchLsb& w, bool saturated = false);
 
   /// Clears the event counter and the peaks (Modbus command 3).
   void Clear();

@@ -12,8 +12,12 @@ namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
-[[nodiscard]] bool HoldingMapped(std::uint32_t a) {
-  return a <= kHoldUnlock || (a >= kHoldTransform && a < kHoldTransform + 12u);
+[[nodiscard]] bool HoldingMapped(std::uint32_t a) { return a < kHoldTransform + 12u; }
+
+/// Holding registers 5 … 9: reserved. They read 0 and accept 0 (so that a PLC's block read or
+/// write of 0 … 21 works); any other value is refused with 03.
+[[nodiscard]] bool HoldingReserved(std::uint32_t a) {
+  return a > kHoldUnlock && a < kHoldTransform;
 }
 
 [[nodiscard]] float LsbToSi(std::int32_t v, std::size_t axis) {
@@ -50,7 +54,9 @@ void BuildInputRegisters(const DeviceSample& d, const hal::AdcInfo& adc, std::ui
   r[kInStatus] = status;
   PackU32(s.sequence, &r[kInSequence]);
   PackU32(s.timestamp_us, &r[kInTimestampUs]);
-  const bool cal_ok = (status & kStatusCalInvalid) == 0;
+  // No valid calibration, or no valid measurement (a bridge at its rail, clipped arithmetic):
+  // the wrench registers read NaN and 0, never a held or clipped value.
+  const bool cal_ok = (status & (kStatusCalInvalid | kStatusSaturated)) == 0;
   for (std::size_t i = 0; i < kAxes; ++i) {
     PackFloat32(cal_ok ? LsbToSi(s.wrench[i], i) : kNaN, &r[kInWrenchFloat + 2 * i]);
     // Forces are already mN; moments go from 10 µN·m to mN·m, rounded to nearest.
@@ -136,7 +142,7 @@ ModbusException RegisterMap::ReadHolding(std::uint16_t addr, std::uint16_t count
         v = unlocked ? 1 : 0;
         break;
       default:
-        v = transform_regs_[a - kHoldTransform];
+        v = HoldingReserved(a) ? 0 : transform_regs_[a - kHoldTransform];
         break;
     }
     out[i] = v;
@@ -167,7 +173,7 @@ ModbusException RegisterMap::WriteHolding(std::uint16_t addr, const std::uint16_
           next.tare_kind = static_cast<std::uint8_t>(v);
         } else if (v == kCmdClearPeaks) {
           ++next.clear_generation;
-        } else {
+        } else if (v != kCmdNone) {
           return ModbusException::kIllegalDataValue;
         }
         break;
@@ -186,10 +192,15 @@ ModbusException RegisterMap::WriteHolding(std::uint16_t addr, const std::uint16_
         next.cal_slot = static_cast<std::uint8_t>(v);
         break;
       case kHoldUnlock:
+        if (v == 0) break;  // what the register reads while locked: no operation
         if (v != kUnlockKey) return ModbusException::kIllegalDataValue;
         unlock_written = true;
         break;
-      default:  // 10 … 21
+      default:  // 5 … 9 reserved, 10 … 21 tool transform
+        if (HoldingReserved(a)) {
+          if (v != 0) return ModbusException::kIllegalDataValue;
+          break;
+        }
         if (!unlocked) return ModbusException::kIllegalDataValue;
         next_transform[a - kHoldTransform] = v;
         transform_written = true;

@@ -11,7 +11,7 @@ namespace ftstack::fw {
 
 inline constexpr std::uint16_t kMapVersion = 1;
 inline constexpr std::uint16_t kInputRegisterCount = 74;   ///< input registers 0 … 73
-inline constexpr std::uint16_t kHoldingRegisterSpan = 22;  ///< holding 0 … 4 and 10 … 21
+inline constexpr std::uint16_t kHoldingRegisterSpan = 22;  ///< holding 0 … 21 (5 … 9 reserved)
 
 /// Input register addresses (0-based protocol addresses).
 enum InputRegister : std::uint16_t {
@@ -42,7 +42,8 @@ enum HoldingRegister : std::uint16_t {
 };
 
 /// Values of the command register.
-enum Command : std::uint16_t { kCmdTare = 1, kCmdClearTare = 2, kCmdClearPeaks = 3 };
+/// Values of the command register (0: no command, what the register reads back).
+enum Command : std::uint16_t { kCmdNone = 0, kCmdTare = 1, kCmdClearTare = 2, kCmdClearPeaks = 3 };
 
 inline constexpr std::uint16_t kUnlockKey = 0xA5C3;
 inline constexpr std::uint64_t kUnlockDurationUs = 10'000'000;
@@ -81,12 +82,13 @@ class RegisterMap {
   /// Function 04. 02 when [addr, addr+count) leaves 0 … 73.
   [[nodiscard]] ModbusException ReadInput(std::uint16_t addr, std::uint16_t count,
                                           std::uint16_t* out);
-  /// Function 03. 02 when any address is outside 0 … 4 and 10 … 21.
+  /// Function 03. 02 when any address is outside 0 … 21; reserved 5 … 9 read 0.
   [[nodiscard]] ModbusException ReadHolding(std::uint16_t addr, std::uint16_t count,
                                             std::uint16_t* out);
   /// Functions 06 and 16. 02 for an address outside the map; 03 for a value out of range, an
-  /// unknown command, a protected register (3, 10–21) while locked, or a write covering only one
-  /// half of a tool-transform float. On any exception nothing changes.
+  /// unknown command, a non-zero value in a reserved register (5–9), a protected register (3,
+  /// 10–21) while locked, or a write covering only one half of a tool-transform float. On any
+  /// exception nothing changes.
   [[nodiscard]] ModbusException WriteHolding(std::uint16_t addr, const std::uint16_t* values,
                                              std::uint16_t count);
 

@@ -1,7 +1,7 @@
 // errno as text for error messages, thread-safe (strerror_r, whichever variant the C library has).
 #pragma once
 
-#include <string.h>
+#include <cstring>
 
 #include <cstddef>
 

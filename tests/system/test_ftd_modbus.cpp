@@ -19,8 +19,9 @@
 #include "calibration/ideal.hpp"
 #include "firmware/modbus_server.hpp"
 #include "firmware/register_map.hpp"
-#include "sim/default_sensor.hpp"
 #include "measurement/recording.hpp"
+#include "sim/default_sensor.hpp"
+#include "tests/support/temp_dir.hpp"
 #include "tests/system/builtin_adc.hpp"
 #include "tests/system/ftd_process.hpp"
 
@@ -183,10 +184,15 @@ TEST(FtdModbus, ExceptionsAndProtectedWritesOverTheWire) {
   EXPECT_EQ(err, EMBXILADD);
   EXPECT_EQ(c.Input(70, 5, r.data(), &err), -1);
   EXPECT_EQ(err, EMBXILADD);
-  EXPECT_EQ(c.Holding(5, 1, r.data(), &err), -1);
+  EXPECT_EQ(c.Holding(22, 1, r.data(), &err), -1);
   EXPECT_EQ(err, EMBXILADD);
+  EXPECT_EQ(c.Write(22, 0, &err), -1);
+  EXPECT_EQ(err, EMBXILADD);
+  // Reserved 5 … 9: read 0, accept only 0.
+  EXPECT_EQ(c.Holding(5, 5, r.data(), &err), 5);
   EXPECT_EQ(c.Write(9, 1, &err), -1);
-  EXPECT_EQ(err, EMBXILADD);
+  EXPECT_EQ(err, EMBXILVAL);
+  EXPECT_EQ(c.Write(9, 0, &err), 1);
   // Unknown function (read coils) → 01.
   std::uint8_t bits[8];
   EXPECT_EQ(modbus_read_bits(c.ctx(), 0, 1, bits), -1);
@@ -600,6 +606,53 @@ TEST(FtdModbus, LogWritesTheRecordingFormatAndDurationEndsCleanly) {
     EXPECT_DOUBLE_EQ(rec.Column("temp_C")[i], 20.0);
   }
   std::remove(path);
+}
+
+/// Issue 17, from outside: a tool of 380 N tared, then 460 N on a 400 N sensor. The reader sees
+/// 80 N; the overload bit, the event counter and the peak see the 460 N the body carries.
+TEST(FtdModbus, OverloadUnderTareSeesTheLoadOnTheBody) {
+  const test::TempDir tmp("ftd_tare");
+  const std::string path = tmp / "tool.csv";
+  Recording rec;
+  rec.SetColumn("t", {0.0, 3.0, 3.2, 30.0});
+  for (const std::string& n : WrenchColumns()) {
+    rec.SetColumn(n, n == "Fz" ? std::vector<double>{380.0, 380.0, 460.0, 460.0}
+                               : std::vector<double>(4, 0.0));
+  }
+  WriteRecording(path, rec);
+  test::FtdProcess ftd({"--replay", path, "--rate-hz", "1000", "--modbus-tcp", "127.0.0.1:0"});
+  ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
+  Client c(ftd.port());
+  auto sequence = [&] {
+    std::array<std::uint16_t, 2> r{};
+    return c.Input(fw::kInSequence, 2, r.data()) == 2 ? UnpackU32(r.data()) : 0u;
+  };
+  auto wait_sample = [&](std::uint32_t n) {
+    for (int i = 0; i < 20000 && sequence() < n; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    return sequence() >= n;
+  };
+  ASSERT_TRUE(wait_sample(1000));  // 1 s into the 380 N hold
+  // A PLC's block read of the holding registers 0 … 15 (5 … 9 reserved) works.
+  std::array<std::uint16_t, 16> hold{};
+  ASSERT_EQ(c.Holding(0, 16, hold.data()), 16);
+  for (int a = 5; a < 10; ++a) EXPECT_EQ(hold[static_cast<std::size_t>(a)], 0) << a;
+  ASSERT_EQ(c.Write(fw::kHoldCommand, fw::kCmdTare), 1);
+  ASSERT_TRUE(wait_sample(2500));
+  std::array<std::uint16_t, fw::kInputRegisterCount> r{};
+  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
+  ASSERT_NE(r[fw::kInStatus] & fw::kStatusTareActive, 0);
+  EXPECT_NEAR(UnpackFloat32(&r[fw::kInWrenchFloat + 4]), 0.0, 1.0);
+  EXPECT_EQ(r[fw::kInStatus] & fw::kStatusOverload, 0);  // 95 % of rated
+  EXPECT_EQ(UnpackU32(&r[fw::kInOverloadEvents]), 0u);
+  ASSERT_TRUE(wait_sample(5000));  // 460 N since 3.2 s
+  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
+  EXPECT_NEAR(UnpackFloat32(&r[fw::kInWrenchFloat + 4]), 80.0, 1.0);
+  EXPECT_NE(r[fw::kInStatus] & fw::kStatusOverload, 0);
+  EXPECT_EQ(r[fw::kInStatus] & fw::kStatusBridgeFault, 0);
+  EXPECT_EQ(UnpackU32(&r[fw::kInOverloadEvents]), 1u);
+  EXPECT_GE(UnpackFloat32(&r[fw::kInPeaks + 4]), 455.0f);
+  EXPECT_EQ(ftd.Stop(), 0);
 }
 
 }  // namespace
