@@ -47,9 +47,14 @@ DeviceStatus Device::Start(const DeviceConfig& config) {
 }
 
 void Device::ApplySettings() {
+  // The generation is taken before the copy: a write landing in between is either in the copy
+  // (and applied again, harmlessly, next time: every field is idempotent, commands carry
+  // generations) or after it (and seen next time). Taking it after the copy would mark a write
+  // as seen that the copy does not hold — an acknowledged write lost.
+  const std::uint32_t generation = settings_.writes();
   DeviceSettings s{};
   if (!settings_.Read(&s)) return;  // retried on the next sample
-  settings_seen_ = settings_.writes();
+  settings_seen_ = generation;
   if (s.cal_slot != active_.cal_slot && s.cal_slot < kCalSlots &&
       config_.slots[s.cal_slot].present) {
     core_.SetCalibration(config_.slots[s.cal_slot].fixed);  // also clears tare and filter

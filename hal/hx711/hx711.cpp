@@ -183,6 +183,16 @@ Hx711Adc::ReadResult Hx711Adc::ReadGroup(std::size_t g, std::uint8_t& stuck_mask
   return stuck_mask != 0 ? ReadResult::kStuck : ReadResult::kOk;
 }
 
+void Hx711Adc::Resynchronise(Group& grp) {
+  // Power-cycle the group on purpose (clock high beyond the power-down time): a known state
+  // (reset, A128), then drop the conversions of the settling time, the first of which selects
+  // the configured input again.
+  (void)grp.clock->Set(true);
+  clock_.SleepNs(kPowerDownHoldNs);
+  (void)grp.clock->Set(false);
+  grp.discard_left = params_.discard_after_reset;
+}
+
 Status Hx711Adc::DoRead(AdcSample& out) {
   if (!configured_) return Status::kNotConfigured;
   if (!ready_) return Status::kTimeout;
@@ -210,10 +220,7 @@ Status Hx711Adc::DoRead(AdcSample& out) {
         // Power-cycle them on purpose (a stretched pulse that stayed just under the chip's real
         // limit leaves them mid-read), which gives a known state: reset, A128.
         ++counters_.long_pulses;
-        (void)grp.clock->Set(true);
-        clock_.SleepNs(kPowerDownHoldNs);
-        (void)grp.clock->Set(false);
-        grp.discard_left = params_.discard_after_reset;
+        Resynchronise(grp);
         bad = grp.chip_mask;
         break;
       case ReadResult::kStuck:
@@ -221,8 +228,10 @@ Status Hx711Adc::DoRead(AdcSample& out) {
         bad = stuck;
         break;
       case ReadResult::kLineError:
+        // A GPIO call failed mid-read: the chips saw an unknown number of pulses, so the input
+        // and gain of their next conversion are unknown too. Resynchronise as after a long pulse.
         ++counters_.line_errors;
-        (void)grp.clock->Set(false);
+        Resynchronise(grp);
         bad = grp.chip_mask;
         break;
     }

@@ -111,6 +111,8 @@ class Hx711Adc final : public Adc {
   /// One PD_SCK pulse with its width bound measured; false when the GPIO call failed.
   bool Pulse(gpio::OutputLine& clock, std::int64_t& width_ns);
   void ResetGroups();
+  /// After a read whose pulse count is unknown: power-cycle the group, re-arm the discard.
+  void Resynchronise(Group& grp);
 
   Hx711Params params_;
   gpio::Clock& clock_;

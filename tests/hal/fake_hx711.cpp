@@ -130,6 +130,7 @@ void FakeHx711::OnClock(bool high) {
 }
 
 Status FakeHx711::DoGet(bool& high) {
+  if (fail_gets_at_ >= 0 && gets_++ == fail_gets_at_) return Status::kReadError;
   time_.now_ns += get_cost_ns_;
   Update();
   high = Level();

@@ -81,6 +81,11 @@ class FakeHx711 final : public hal::gpio::InputLine {
   }
   void SetStuckHigh(bool on) { stuck_high_ = on; }
   void SetStuckLow(bool on) { stuck_low_ = on; }
+  /// The `n`-th DOUT read from now fails (a GPIO error), once.
+  void FailGetAfter(int n) {
+    gets_ = 0;
+    fail_gets_at_ = n;
+  }
 
   [[nodiscard]] const std::vector<Record>& log() const { return log_; }
   [[nodiscard]] int power_downs() const { return power_downs_; }
@@ -115,6 +120,8 @@ class FakeHx711 final : public hal::gpio::InputLine {
   bool last_level_ = true;
   bool stuck_high_ = false;
   bool stuck_low_ = false;
+  int gets_ = 0;
+  int fail_gets_at_ = -1;
   bool powered_ = true;
   bool clock_high_ = false;
   std::int64_t rise_ns_ = 0;

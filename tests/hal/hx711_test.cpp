@@ -236,6 +236,32 @@ TEST(Hx711, OverlongPulseIsDetectedCountedAndTheChipResynchronised) {
   EXPECT_FALSE(log[kDiscard + 1].shifted_out);  // the corrupted read never got its 24 bits
 }
 
+/// Issue 17 item 13: a GPIO error mid-read leaves the chip's pulse count, hence the input and
+/// gain of its next conversion, unknown: the driver resynchronises and drops the settling
+/// conversions, so no value of the wrong input or gain is delivered.
+TEST(Hx711, LineErrorMidReadResynchronisesAndDropsTheNextConversions) {
+  Bench b({0});
+  b.PushSettling();
+  for (int k = 0; k < 12; ++k) b.chips[0]->Push(1000 + k);
+  ASSERT_EQ(b.Configure(64), Status::kOk);
+  AdcSample s;
+  ASSERT_EQ(b.Next(s), Status::kOk);
+  EXPECT_EQ(s.counts[0], 1000);
+  const int resets_before = b.chips[0]->resets();
+  b.chips[0]->FailGetAfter(10);  // the 11th DOUT read of the next conversion fails
+  ASSERT_EQ(b.Next(s), Status::kReadError);
+  EXPECT_NE(s.flags[0] & hal::kChannelReadError, 0);
+  EXPECT_EQ(b.adc->counters().line_errors, 1u);
+  EXPECT_EQ(b.chips[0]->resets(), resets_before + 1);  // power-cycled to a known state
+  for (int i = 0; i < kDiscard; ++i) {
+    ASSERT_EQ(b.Next(s), Status::kReadError) << i;  // settling conversions: dropped
+    EXPECT_NE(s.flags[0] & hal::kChannelReadError, 0);
+  }
+  ASSERT_EQ(b.Next(s), Status::kOk);
+  EXPECT_EQ(s.counts[0], 1000 + 2 + kDiscard);
+  EXPECT_EQ(b.chips[0]->log().back().input, Input::kA64);  // the configured input again
+}
+
 TEST(Hx711, PulseBoundsAroundTheSixtyMicrosecondLimit) {
   // A set costs 1 µs: a stall of s gives a real high time of s + 1 µs and a measured bound of
   // s + 2 µs. 58 µs: bound 60 µs, accepted, and the chip indeed stays up. 59 µs: bound 61 µs,
