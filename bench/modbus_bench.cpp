@@ -50,7 +50,7 @@ ftstack::tools::Ftd& Daemon(unsigned rate_hz, bool paced) {
 }
 
 /// A plain libmodbus TCP server (select loop, modbus_receive + modbus_reply) over a mapping with
-/// the same 74 input registers, in its own thread: the reference the daemon is compared with.
+/// the same input registers (all of the map), in its own thread: the reference the daemon is compared with.
 class PlainServer {
  public:
   PlainServer() {
@@ -131,7 +131,7 @@ struct LoadResult {
   double p99_us = 0;
 };
 
-/// `clients` libmodbus clients, each reading all 74 input registers back to back for `seconds`.
+/// `clients` libmodbus clients, each reading all input registers back to back for `seconds`.
 LoadResult Hammer(int port, int clients, double seconds) {
   std::vector<std::vector<float>> lat(static_cast<std::size_t>(clients));
   std::atomic<std::uint64_t> errors{0};

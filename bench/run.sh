@@ -20,9 +20,9 @@ if [ -x "$B/bench_core" ]; then
       }'
 fi
 
-# --- Modbus TCP (issue 5): ftd vs a plain libmodbus server, same 74 registers, same run -------
+# --- Modbus TCP (issue 5): ftd vs a plain libmodbus server, same registers, same run -------
 if [ -x "$B/bench_modbus" ]; then
-  section "Modbus TCP, read 74 input registers: ftd (sampling at 8 kHz) vs plain libmodbus server"
+  section "Modbus TCP, read all input registers: ftd (sampling at 8 kHz) vs plain libmodbus server"
   FTSTACK_BENCH_SECONDS=${BENCH_MODBUS_SECONDS:-1} "$B/bench_modbus" --benchmark_format=csv 2>/dev/null |
     awk -F, 'NR==1 { for (i = 1; i <= NF; ++i) { h=$i; gsub(/"/,"",h); col[h]=i }; next }
       { n=$1; gsub(/"/,"",n); split(n, p, "/"); k=p[1] "/" p[2];

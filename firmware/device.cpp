@@ -40,7 +40,11 @@ DeviceStatus Device::Start(const DeviceConfig& config) {
   last_.cal_slot = active_.cal_slot;
   last_.cal_crc = config.slots[active_.cal_slot].crc32;
   last_.publish_period_us = sample_period_us_;
+  last_.sample_period_us = sample_period_us_;
   last_.publish_time_us = clock_();
+  last_sample_us_.store(last_.publish_time_us, std::memory_order_release);
+  previous_read_us_ = 0;
+  late_samples_ = 0;
   last_.sample.status = kStatusStale;  // nothing sampled yet
   published_.Write(last_);
   return DeviceStatus::kOk;
@@ -86,6 +90,8 @@ hal::Status Device::Step(bool* published) {
   const hal::Status s = sampler_.Step(p);
   if (s == hal::Status::kEndOfData) return s;
   if (s != hal::Status::kOk) {
+    // The gap a backend fault leaves is that fault's (bits 3 and 8), not a late sampler.
+    previous_read_us_ = 0;
     // Publish the fault bits at once; the wrench and sequence stay those of the last sample.
     last_.sample.status = p.status;
     published_.Write(last_);
@@ -93,6 +99,20 @@ hal::Status Device::Step(bool* published) {
     return s;
   }
   ++samples_;
+  const std::uint64_t now_us = clock_();
+  last_sample_us_.store(now_us, std::memory_order_release);
+  if (previous_read_us_ != 0 && now_us - previous_read_us_ > 3ull * sample_period_us_ / 2) {
+    // Read late: the periods skipped (rounded) are deadlines missed. The status bit says so in
+    // the next publication; the counter keeps them.
+    const std::uint64_t periods =
+        (now_us - previous_read_us_ + sample_period_us_ / 2) / sample_period_us_;
+    const std::uint64_t missed = periods - 1;
+    late_samples_ = missed > 0xFFFFFFFFull - late_samples_
+                        ? 0xFFFFFFFFu
+                        : late_samples_ + static_cast<std::uint32_t>(missed);
+    sticky_status_ |= kStatusLate;
+  }
+  previous_read_us_ = now_us;
   const CoreOutput& core = sampler_.core_output();
   // Overload and peaks judge the load the body carries: untared, also while a bridge saturates.
   if (core.structural_valid && overload_.configured()) {
@@ -125,7 +145,9 @@ hal::Status Device::Step(bool* published) {
   d.cal_slot = active_.cal_slot;
   d.cal_crc = config_.slots[active_.cal_slot].crc32;
   d.publish_period_us = sample_period_us_ * active_.decimation;
-  d.publish_time_us = clock_();
+  d.sample_period_us = sample_period_us_;
+  d.late_samples = late_samples_;
+  d.publish_time_us = now_us;
   last_ = d;
   published_.Write(d);
   *published = true;

@@ -26,6 +26,8 @@ struct DeviceSample {
   std::uint8_t cal_slot = 0;            ///< active calibration slot
   std::uint64_t publish_time_us = 0;    ///< device clock at the last successful publication
   std::uint32_t publish_period_us = 0;  ///< expected time between publications
+  std::uint32_t sample_period_us = 0;   ///< expected time between samples (the stale limit's unit)
+  std::uint32_t late_samples = 0;       ///< samples read late since start (missed deadlines)
 };
 
 /// One calibration slot as the device holds it.
@@ -96,6 +98,13 @@ class Device {
   [[nodiscard]] std::uint32_t sample_period_us() const { return sample_period_us_; }
   /// Samples processed by Step (successful reads).
   [[nodiscard]] std::uint64_t samples() const { return samples_; }
+  /// Device clock when the latest sample was read (any thread): what "stale" is judged on.
+  [[nodiscard]] std::uint64_t last_sample_us() const {
+    return last_sample_us_.load(std::memory_order_acquire);
+  }
+  /// Missed sampling deadlines since start: a read more than 1.5 periods after the previous one
+  /// counts the periods it skipped.
+  [[nodiscard]] std::uint32_t late_samples() const { return late_samples_; }
 
  private:
   void ApplySettings();
@@ -118,6 +127,9 @@ class Device {
   std::uint16_t sticky_status_ = 0;
   std::uint32_t publish_sequence_ = 0;
   std::uint64_t samples_ = 0;
+  std::atomic<std::uint64_t> last_sample_us_{0};
+  std::uint64_t previous_read_us_ = 0;  ///< 0 until the first sample
+  std::uint32_t late_samples_ = 0;
 };
 
 }  // namespace ftstack::fw

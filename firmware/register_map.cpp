@@ -41,13 +41,14 @@ std::int32_t UnpackI32(const std::uint16_t* regs) {
 float UnpackFloat32(const std::uint16_t* regs) { return std::bit_cast<float>(UnpackU32(regs)); }
 
 void BuildInputRegisters(const DeviceSample& d, const hal::AdcInfo& adc, std::uint64_t now_us,
+                         std::uint64_t last_sample_us,
                          std::array<std::uint16_t, kInputRegisterCount>* regs) {
   auto& r = *regs;
   r = {};
   const PublishedSample& s = d.sample;
   std::uint16_t status = s.status;
-  if (now_us > d.publish_time_us &&
-      now_us - d.publish_time_us > 2ull * static_cast<std::uint64_t>(d.publish_period_us)) {
+  if (now_us > last_sample_us &&
+      now_us - last_sample_us > 2ull * static_cast<std::uint64_t>(d.sample_period_us)) {
     status |= kStatusStale;
   }
   r[kInMapVersion] = kMapVersion;
@@ -81,6 +82,8 @@ void BuildInputRegisters(const DeviceSample& d, const hal::AdcInfo& adc, std::ui
   r[kInCalSlot] = d.cal_slot;
   PackU32(d.overload_events, &r[kInOverloadEvents]);
   PackU32(d.cal_crc, &r[kInCalCrc]);
+  PackU32(d.late_samples, &r[kInLateSamples]);
+  r[kInTimestampWraps] = s.timestamp_wraps;
 }
 
 RegisterMap::RegisterMap(Device& device) : device_(device), settings_(device.initial_settings()) {}
@@ -109,7 +112,8 @@ ModbusException RegisterMap::ReadInput(std::uint16_t addr, std::uint16_t count,
   }
   if (!got) return ModbusException::kDeviceFailure;
   std::array<std::uint16_t, kInputRegisterCount> image{};
-  BuildInputRegisters(d, device_.adc_info(), device_.NowUs(), &image);
+  const std::uint64_t last_sample_us = device_.last_sample_us();
+  BuildInputRegisters(d, device_.adc_info(), device_.NowUs(), last_sample_us, &image);
   for (std::uint16_t i = 0; i < count; ++i) out[i] = image[addr + i];
   return ModbusException::kNone;
 }

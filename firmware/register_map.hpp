@@ -10,7 +10,7 @@
 namespace ftstack::fw {
 
 inline constexpr std::uint16_t kMapVersion = 1;
-inline constexpr std::uint16_t kInputRegisterCount = 74;   ///< input registers 0 … 73
+inline constexpr std::uint16_t kInputRegisterCount = 77;   ///< input registers 0 … 76
 inline constexpr std::uint16_t kHoldingRegisterSpan = 22;  ///< holding 0 … 21 (5 … 9 reserved)
 
 /// Input register addresses (0-based protocol addresses).
@@ -29,6 +29,8 @@ enum InputRegister : std::uint16_t {
   kInOverloadEvents = 58,  ///< uint32
   kInPeaks = 60,           ///< float32 × 6, N and N·m
   kInCalCrc = 72,          ///< uint32
+  kInLateSamples = 74,     ///< uint32, missed sampling deadlines since start
+  kInTimestampWraps = 76,  ///< uint16, wraps of the 32-bit µs timestamp (its bits 32–47)
 };
 
 /// Holding register addresses.
@@ -68,9 +70,11 @@ void PackFloat32(float v, std::uint16_t* regs);
 [[nodiscard]] std::int32_t UnpackI32(const std::uint16_t* regs);
 [[nodiscard]] float UnpackFloat32(const std::uint16_t* regs);
 
-/// Fills the whole input image from one published sample. `now_us` (device clock) decides the
-/// stale bit: set when the sample is older than two publication periods.
+/// Fills the whole input image from one published sample. The stale bit is set when the latest
+/// sample read (`last_sample_us`, device clock, also samples not published because of
+/// decimation) is more than two sample periods older than `now_us`.
 void BuildInputRegisters(const DeviceSample& d, const hal::AdcInfo& adc, std::uint64_t now_us,
+                         std::uint64_t last_sample_us,
                          std::array<std::uint16_t, kInputRegisterCount>* regs);
 
 /// The slave's view of one Device: reads build replies from one published sample; writes are

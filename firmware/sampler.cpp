@@ -30,6 +30,7 @@ hal::Status Sampler::Step(PublishedSample& out) {
   PublishedSample p{};
   p.sequence = ++sequence_;
   p.timestamp_us = static_cast<std::uint32_t>(sample_.timestamp_us);
+  p.timestamp_wraps = static_cast<std::uint16_t>(sample_.timestamp_us >> 32);
   p.wrench = core_out_.wrench;
   p.channel_count = sample_.channel_count;
   p.raw_counts = sample_.counts;

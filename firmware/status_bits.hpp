@@ -16,6 +16,7 @@ enum StatusBit : std::uint16_t {
   kStatusTempRange = 1u << 6,    ///< temperature outside the compensated range
   kStatusSimulated = 1u << 7,    ///< simulated ADC backend
   kStatusStale = 1u << 8,        ///< no new sample within 2 sample periods
+  kStatusLate = 1u << 9,         ///< a sample was read > 1.5 periods after the previous one
 };
 
 }  // namespace ftstack::fw

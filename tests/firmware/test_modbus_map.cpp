@@ -350,9 +350,9 @@ TEST_F(RegisterMapTest, StaleBitAfterTwoPeriodsWithoutSample) {
 TEST_F(RegisterMapTest, AddressesOutsideTheMapGiveException02) {
   StartDevice();
   std::array<std::uint16_t, 125> buf{};
-  EXPECT_EQ(map_->ReadInput(73, 1, buf.data()), ModbusException::kNone);
-  EXPECT_EQ(map_->ReadInput(73, 2, buf.data()), ModbusException::kIllegalDataAddress);
-  EXPECT_EQ(map_->ReadInput(74, 1, buf.data()), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(map_->ReadInput(76, 1, buf.data()), ModbusException::kNone);
+  EXPECT_EQ(map_->ReadInput(76, 2, buf.data()), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(map_->ReadInput(77, 1, buf.data()), ModbusException::kIllegalDataAddress);
   EXPECT_EQ(map_->ReadHolding(0, 5, buf.data()), ModbusException::kNone);
   EXPECT_EQ(map_->ReadHolding(10, 12, buf.data()), ModbusException::kNone);
   // 5 … 9 are reserved, not a hole: a PLC's block read of 0 … 15 or 0 … 21 works.
@@ -492,9 +492,34 @@ TEST_F(RegisterMapTest, DecimationPublishesEveryNthSample) {
   auto r = Input();
   EXPECT_EQ(UnpackU32(&r[kInSequence]), 3u);
   EXPECT_EQ(UnpackU32(&r[kInTimestampUs]), 11000u);
-  // The stale limit follows the publication period: 2 × 4 ms.
-  g_now_us += 6000;
+  // Stale is judged on samples read, not on publications: between publications of a large
+  // decimation nothing is stale while samples keep coming; 2 sample periods without one is.
+  Step(2);  // samples 13 and 14: not published
   EXPECT_EQ(Input()[kInStatus] & kStatusStale, 0);
+  g_now_us += 1000;  // the last sample is 2 periods old
+  EXPECT_EQ(Input()[kInStatus] & kStatusStale, 0);
+  g_now_us += 1;
+  EXPECT_NE(Input()[kInStatus] & kStatusStale, 0);
+}
+
+TEST_F(RegisterMapTest, LateSamplesAreCountedAndFlagged) {
+  StartDevice();
+  Step(5);
+  auto r = Input();
+  EXPECT_EQ(r[kInStatus] & kStatusLate, 0);
+  EXPECT_EQ(UnpackU32(&r[kInLateSamples]), 0u);
+  g_now_us += 3000;  // the sampling thread was descheduled: read 4 periods after the previous
+  Step();
+  r = Input();
+  EXPECT_NE(r[kInStatus] & kStatusLate, 0);
+  EXPECT_EQ(UnpackU32(&r[kInLateSamples]), 3u);  // three deadlines missed
+  Step();
+  r = Input();
+  EXPECT_EQ(r[kInStatus] & kStatusLate, 0);  // on time again; the counter keeps the history
+  EXPECT_EQ(UnpackU32(&r[kInLateSamples]), 3u);
+  g_now_us += 400;  // 1.4 periods: jitter, not late
+  Step();
+  EXPECT_EQ(Input()[kInStatus] & kStatusLate, 0);
 }
 
 TEST_F(RegisterMapTest, FaultsSaturationInvalidatesTheWrenchAndAdcTimeoutFlags) {

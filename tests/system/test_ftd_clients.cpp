@@ -137,7 +137,7 @@ TEST(FtdClients, ReadmeMbpollExamplesWork) {
   modbus_free(c);
   // An illegal address: mbpoll exits 1 and names the exception.
   std::string out;
-  EXPECT_EQ(RunShell("mbpoll -m tcp " + port + " -a 1 -t 3 -r 75 -c 1 -1 127.0.0.1", &out), 1);
+  EXPECT_EQ(RunShell("mbpoll -m tcp " + port + " -a 1 -t 3 -r 78 -c 1 -1 127.0.0.1", &out), 1);
   EXPECT_NE(out.find("Illegal data address"), std::string::npos) << out;
   EXPECT_EQ(RunShell("mbpoll -m tcp " + port + " -a 1 -t 4 -r 2 127.0.0.1 0", &out), 1);
   EXPECT_NE(out.find("Illegal data value"), std::string::npos) << out;
@@ -214,15 +214,15 @@ TEST(FtdClients, RtuOverPtyPairServesTheMapAndSurvivesGarbage) {
   modbus_set_slave(c, 3);
   modbus_set_response_timeout(c, 1, 0);
   ASSERT_EQ(modbus_connect(c), 0);
-  std::uint16_t r[74] = {};
-  ASSERT_EQ(modbus_read_input_registers(c, 0, 74, r), 74);
+  std::uint16_t r[fw::kInputRegisterCount] = {};
+  ASSERT_EQ(modbus_read_input_registers(c, 0, fw::kInputRegisterCount, r), fw::kInputRegisterCount);
   EXPECT_EQ(r[fw::kInMapVersion], 1);
   EXPECT_EQ(r[fw::kInBridgeCount], 6);
   for (std::size_t a = 0; a < 6; ++a) {
     EXPECT_NEAR(fw::UnpackFloat32(&r[fw::kInWrenchFloat + 2 * a]), applied[a], 5 * sigma[a] + 1e-3)
         << "axis " << a;
   }
-  EXPECT_EQ(modbus_read_input_registers(c, 74, 1, r), -1);
+  EXPECT_EQ(modbus_read_input_registers(c, fw::kInputRegisterCount, 1, r), -1);
   EXPECT_EQ(errno, EMBXILADD);
   EXPECT_EQ(modbus_write_register(c, fw::kHoldCalSlot, 1), -1);
   EXPECT_EQ(errno, EMBXILVAL);

@@ -180,9 +180,9 @@ TEST(FtdModbus, ExceptionsAndProtectedWritesOverTheWire) {
   ASSERT_TRUE(c.connected());
   std::array<std::uint16_t, 130> r{};
   int err = 0;
-  EXPECT_EQ(c.Input(74, 1, r.data(), &err), -1);
+  EXPECT_EQ(c.Input(fw::kInputRegisterCount, 1, r.data(), &err), -1);
   EXPECT_EQ(err, EMBXILADD);
-  EXPECT_EQ(c.Input(70, 5, r.data(), &err), -1);
+  EXPECT_EQ(c.Input(fw::kInputRegisterCount - 4, 5, r.data(), &err), -1);
   EXPECT_EQ(err, EMBXILADD);
   EXPECT_EQ(c.Holding(22, 1, r.data(), &err), -1);
   EXPECT_EQ(err, EMBXILADD);
@@ -244,8 +244,8 @@ TEST(FtdModbus, OverloadPeaksAndToolTransformEndToEnd) {
   ASSERT_TRUE(c.connected());
   const Expected e = DeriveExpected();
   ASSERT_TRUE(c.WaitSamples(200));
-  std::array<std::uint16_t, 74> r{};
-  ASSERT_EQ(c.Input(0, 74, r.data()), 74);
+  std::array<std::uint16_t, fw::kInputRegisterCount> r{};
+  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
   EXPECT_NE(r[fw::kInStatus] & fw::kStatusOverload, 0);
   // One continuing overload is one event, not one per sample.
   EXPECT_EQ(UnpackU32(&r[fw::kInOverloadEvents]), 1u);
@@ -257,7 +257,7 @@ TEST(FtdModbus, OverloadPeaksAndToolTransformEndToEnd) {
   // Clearing while the overload continues: the counter restarts at the ongoing event.
   ASSERT_EQ(c.Write(fw::kHoldCommand, fw::kCmdClearPeaks), 1);
   ASSERT_TRUE(c.WaitSamples(5));
-  ASSERT_EQ(c.Input(0, 74, r.data()), 74);
+  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
   EXPECT_EQ(UnpackU32(&r[fw::kInOverloadEvents]), 1u);
   EXPECT_LT(UnpackFloat32(&r[fw::kInPeaks + 4]),
             450.0 + kSigmas * e.sigma_si[2] + e.fixed_error_si[2]);
@@ -348,8 +348,8 @@ TEST(FtdModbus, CalibrationSlotsAndTheirCrc) {
   const Expected e = DeriveExpected();
   ASSERT_EQ(c.Write(fw::kHoldFilterLength, 256), 1);
   ASSERT_TRUE(c.WaitSamples(300));
-  std::array<std::uint16_t, 74> r{};
-  ASSERT_EQ(c.Input(0, 74, r.data()), 74);
+  std::array<std::uint16_t, fw::kInputRegisterCount> r{};
+  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
   EXPECT_EQ(r[fw::kInCalSlot], 0);
   EXPECT_EQ(UnpackU32(&r[fw::kInCalCrc]), FileCrcField(a));
   const double tol = kSigmas * e.sigma_si[2] / 16.0 + e.fixed_error_si[2];
@@ -357,7 +357,7 @@ TEST(FtdModbus, CalibrationSlotsAndTheirCrc) {
   ASSERT_EQ(c.Write(fw::kHoldUnlock, fw::kUnlockKey), 1);
   ASSERT_EQ(c.Write(fw::kHoldCalSlot, 1), 1);
   ASSERT_TRUE(c.WaitSamples(300));  // the switch restarts the filter
-  ASSERT_EQ(c.Input(0, 74, r.data()), 74);
+  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
   EXPECT_EQ(r[fw::kInCalSlot], 1);
   EXPECT_EQ(UnpackU32(&r[fw::kInCalCrc]), FileCrcField(b));
   EXPECT_NE(FileCrcField(a), FileCrcField(b));
