@@ -63,7 +63,7 @@ class PhysicalSensorModel final : public SensorModel {
   [[nodiscard]] std::string name() const override { return spec_.name; }
 
   /// Writes the bridge outputs (mV/V) into out[0 … channel_count) without allocating.
-  void BridgeOutputsInto(const Wrench& w, double temperature_c, double* out) const;
+  void BridgeOutputsInto(const Wrench& w, double temperature_c, double* out) const override;
   /// Grid (axial) strain of every gauge under w at 20 °C.
   [[nodiscard]] Eigen::VectorXd GaugeStrains(const Wrench& w) const;
 

@@ -38,4 +38,16 @@ Eigen::VectorXd LinearSensorModel::BridgeOutputs(const Wrench& w, double /*tempe
   return s_ * w + zero_;
 }
 
+void LinearSensorModel::BridgeOutputsInto(const Wrench& w, double /*temperature_c*/,
+                                          double* out) const {
+  Eigen::Map<Eigen::VectorXd> dst(out, s_.rows());
+  dst.noalias() = s_ * w;
+  dst += zero_;
+}
+
+void SensorModel::BridgeOutputsInto(const Wrench& w, double temperature_c, double* out) const {
+  const Eigen::VectorXd b = BridgeOutputs(w, temperature_c);
+  for (Eigen::Index i = 0; i < b.size(); ++i) out[i] = b(i);
+}
+
 }  // namespace ftstack::sim

@@ -18,6 +18,9 @@ class SensorModel {
   /// Bridge outputs in mV/V for wrench `w` at body temperature `temperature_c` (°C).
   [[nodiscard]] virtual Eigen::VectorXd BridgeOutputs(const Wrench& w,
                                                       double temperature_c) const = 0;
+  /// The same into out[0 … channel_count). Models on a sampling path (the simulated ADC's)
+  /// override it without allocating; the default goes through BridgeOutputs.
+  virtual void BridgeOutputsInto(const Wrench& w, double temperature_c, double* out) const;
   /// Rated range per axis (N, N·m), positive.
   [[nodiscard]] virtual Wrench rated() const = 0;
   /// Small-signal sensitivity d(mV/V)/d(wrench) at zero load and 20 °C (N × 6).
@@ -33,6 +36,7 @@ class LinearSensorModel final : public SensorModel {
                     Eigen::VectorXd zero_mvv = Eigen::VectorXd());
   [[nodiscard]] int channel_count() const override { return static_cast<int>(s_.rows()); }
   [[nodiscard]] Eigen::VectorXd BridgeOutputs(const Wrench& w, double temperature_c) const override;
+  void BridgeOutputsInto(const Wrench& w, double temperature_c, double* out) const override;
   [[nodiscard]] Wrench rated() const override { return rated_; }
   [[nodiscard]] Eigen::MatrixXd Sensitivity() const override { return s_; }
   [[nodiscard]] std::string name() const override { return name_; }

@@ -7,8 +7,7 @@ bool SimulatedSensor::Sample(double t_s, double* bridge_mvv, double* temperature
   double temp = 20.0;
   if (!source_.At(t_s, &w, &temp)) return false;
   last_wrench_ = w;
-  const Eigen::VectorXd b = model_.BridgeOutputs(w, temp);
-  for (Eigen::Index i = 0; i < b.size(); ++i) bridge_mvv[i] = b(i);
+  model_.BridgeOutputsInto(w, temp, bridge_mvv);  // no allocation: runs in the sampling thread
   *temperature_c = temp;
   return true;
 }
