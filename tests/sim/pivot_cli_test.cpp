@@ -14,6 +14,7 @@
 #include <tuple>
 
 #include "sim/pivot/pivot.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace ftstack::sim::pivot {
 namespace {
@@ -98,7 +99,7 @@ TEST(PivotCli, ShapeCsvIsRegisteredOntoTheModelStrip) {
   const PivotResult model =
       SolvePivot(PivotGeometry{}, {15 * std::numbers::pi / 180, 5.0, -3.0}, PivotMethod::kExact, o);
   ASSERT_TRUE(model.valid);
-  const std::string path = ::testing::TempDir() + "pivot_shape_points.csv";
+  const std::string path = ftstack::test::ProcessTempDir() + "pivot_shape_points.csv";
   {
     std::mt19937_64 rng(3);
     std::normal_distribution<double> noise(0.0, 0.3);
@@ -126,7 +127,7 @@ TEST(PivotCli, ShapeCsvIsRegisteredOntoTheModelStrip) {
   EXPECT_GT(other["shape"]["rms_residual_px"].get<double>(), 5 * 0.3);
 
   // A bad file: one line naming file, line and column.
-  const std::string bad = ::testing::TempDir() + "pivot_shape_bad.csv";
+  const std::string bad = ftstack::test::ProcessTempDir() + "pivot_shape_bad.csv";
   {
     std::ofstream f(bad);
     f << "x,y\n1,2\n3,4\n5,zz\n";

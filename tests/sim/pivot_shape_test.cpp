@@ -10,6 +10,7 @@
 
 #include "sim/pivot/pivot.hpp"
 #include "sim/pivot/shape_registration.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace ftstack::sim::pivot {
 namespace {
@@ -133,7 +134,7 @@ TEST(PivotShape, BadInputIsRejected) {
 }
 
 TEST(PivotShape, ReadPointsCsvAcceptsCommonLayoutsAndNamesTheFaultyPlace) {
-  const std::string path = ::testing::TempDir() + "pivot_points.csv";
+  const std::string path = ftstack::test::ProcessTempDir() + "pivot_points.csv";
   {
     std::ofstream f(path);
     f << "# edge points\nx y\n1.5, 2\n3;4\r\n  5\t6\n\n";

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "record_test_util.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace ftstack::sim {
 namespace {
@@ -111,7 +112,7 @@ TEST(RecordProfiles, DurationCutsOrRepeats) {
 }
 
 TEST(RecordProfiles, FromCsvAndJsonFiles) {
-  const std::string csv = ::testing::TempDir() + "/prof.csv";
+  const std::string csv = ftstack::test::ProcessTempDir() + "/prof.csv";
   {
     std::ofstream out(csv);
     out << "# "
@@ -139,7 +140,7 @@ std::string ErrorOf(const std::string& spec) {
 }
 
 TEST(RecordProfiles, BadFilesNameTheFaultyPlace) {
-  const std::string dir = ::testing::TempDir();
+  const std::string dir = ftstack::test::ProcessTempDir();
   {
     std::ofstream(dir + "/bad.json")
         << "{\"schema\": \"ftstack-profile/1\",\n \"keyframes\": [ {\"t_s\": 0,, } ]}";

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sim/record.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace ftstack::sim::testing_util {
 
@@ -94,7 +95,7 @@ inline Wrench WrenchAt(const Recording& rec, std::size_t i) {
 inline std::string WriteProfile(const std::string& name, const std::vector<double>& t,
                                 const std::vector<Wrench>& w, double rate_hz,
                                 const std::vector<double>& temp_c = {}) {
-  const std::string path = ::testing::TempDir() + "/" + name + ".json";
+  const std::string path = ftstack::test::ProcessTempDir() + "/" + name + ".json";
   std::ofstream out(path);
   out.precision(17);
   out << "{\"schema\": \"ftstack-profile/1\", \"rate_hz\": " << rate_hz << ", \"keyframes\": [";

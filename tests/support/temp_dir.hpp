@@ -39,6 +39,14 @@ class TempDir {
   std::filesystem::path path_;
 };
 
+/// A folder of this test process's own, with a trailing '/', removed at exit: what
+/// ::testing::TempDir() (one folder shared by every process) would be if it were private.
+inline const std::string& ProcessTempDir() {
+  static const TempDir dir("ftstack_proc");
+  static const std::string path = dir.path().string() + "/";
+  return path;
+}
+
 /// A file of the repository's test data (tests/data/, sources in tests/data/README.md).
 inline std::string TestDataPath(const std::string& rel) {
   return std::string(FTSTACK_SOURCE_DIR) + "/tests/data/" + rel;

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "measurement/recording.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace {
 
@@ -20,7 +21,7 @@ struct ProgramRun {
 };
 
 ProgramRun Ftsim(const std::string& args) {
-  const std::string err_path = ::testing::TempDir() + "/ftsim_record_stderr.txt";
+  const std::string err_path = ftstack::test::ProcessTempDir() + "/ftsim_record_stderr.txt";
   const std::string cmd = std::string(FTSTACK_BIN_DIR) + "/ftsim record " + args + " 2>" + err_path;
   ProgramRun r;
   const int raw = std::system(cmd.c_str());
@@ -33,7 +34,7 @@ ProgramRun Ftsim(const std::string& args) {
 }
 
 TEST(FtsimRecordCli, WritesRealSimAndTruth) {
-  const std::string d = ::testing::TempDir();
+  const std::string d = ftstack::test::ProcessTempDir();
   const ProgramRun r = Ftsim("--profile taps --duration-s 3 --seed 2 --out " + d +
                              "/r.csv --sim-out " + d + "/s.csv --truth " + d +
                              "/t.json --effect creep:tau_s=5 --effect 'zero_offset:channels=[1]'");
@@ -59,7 +60,7 @@ TEST(FtsimRecordCli, WritesRealSimAndTruth) {
 }
 
 TEST(FtsimRecordCli, BadInputGivesOneLineReason) {
-  const std::string out = " --duration-s 1 --out " + ::testing::TempDir() + "/x.csv";
+  const std::string out = " --duration-s 1 --out " + ftstack::test::ProcessTempDir() + "/x.csv";
   const struct {
     std::string args;
     std::string message;

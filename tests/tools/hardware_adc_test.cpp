@@ -1,5 +1,6 @@
 // ftd's hardware ADC factory on a machine without GPIO or SPI: clear one-line refusals.
 #include "tools/ftd/hardware_adc.hpp"
+#include "tests/support/temp_dir.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -67,7 +68,7 @@ TEST(HardwareAdc, BadEnvironmentValueIsReported) {
 }
 
 TEST(HardwareAdc, FtdRefusesWithOneLineAndNonZeroExit) {
-  const std::string err_path = ::testing::TempDir() + "ftd_hw_err.txt";
+  const std::string err_path = ftstack::test::ProcessTempDir() + "ftd_hw_err.txt";
   for (const std::string args :
        {"--adc hx711 --gpiochip /dev/gpiochip-absent-3 --rate-hz 80",
         "--adc spi --spidev /dev/spidev-absent-1.0 --gpiochip /dev/gpiochip0"}) {
