@@ -123,6 +123,10 @@ class Scanner {
       while (k < gt && std::isspace(static_cast<unsigned char>(text_[k]))) ++k;
       if (k >= gt || text_[k] != '"') Fail(k, "attribute '" + name + "' value is not quoted");
       const std::size_t close = text_.find('"', k + 1);
+      // A quote swallowed by a malformed attribute name leaves this value open up to the tag's end
+      // (found by fuzzing: the scan then restarted at 0 and never ended).
+      if (close == std::string::npos || close >= gt)
+        Fail(k, "attribute '" + name + "' value is not closed");
       el.attrs[name] = text_.substr(k + 1, close - k - 1);
       k = close + 1;
     }

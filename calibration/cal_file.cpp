@@ -318,7 +318,10 @@ CalFile LoadCalFile(const std::string& path) {
   if (!in) throw CalFileError(path + ": cannot open: " + std::strerror(errno));
   std::stringstream ss;
   ss << in.rdbuf();
-  const std::string text = ss.str();
+  return ParseCalFile(ss.str(), path);
+}
+
+CalFile ParseCalFile(const std::string& text, const std::string& path) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);

@@ -19,6 +19,14 @@ endif()
 if(FTSTACK_WERROR)
   target_compile_options(ftstack_warnings INTERFACE -Werror)
 endif()
+if(FTSTACK_FUZZ)
+  # Coverage for libFuzzer everywhere, ASan+UBSan (fail on the first finding); exceptions stay on
+  # for host code, embedded code keeps -fno-exceptions.
+  add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize=vptr
+                      -fno-sanitize-recover=all
+                      -fno-omit-frame-pointer -g)
+  add_link_options(-fsanitize=address,undefined)
+endif()
 if(FTSTACK_SANITIZE)
   # vptr checks need RTTI, which embedded code (-fno-rtti) does not have.
   add_compile_options(-fsanitize=address,undefined -fno-sanitize=vptr -fno-sanitize-recover=all

@@ -295,8 +295,11 @@ LoadProfile FromJson(const std::string& path, double duration_s) {
     j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     throw ProfileError(path + ":" + LineColumn(text, e.byte) + ": not valid JSON");
+  } catch (const nlohmann::json::exception& e) {  // e.g. a number beyond double (found by fuzzing)
+    throw ProfileError(path + ": not valid JSON: " + e.what());
   }
-  if (!j.is_object() || j.value("schema", "") != "ftstack-profile/1") {
+  if (!j.is_object() || !j.contains("schema") || !j["schema"].is_string() ||
+      j["schema"].get<std::string>() != "ftstack-profile/1") {
     throw ProfileError(path + ": schema is not 'ftstack-profile/1'");
   }
   if (!j.contains("keyframes") || !j["keyframes"].is_array() || j["keyframes"].empty()) {
@@ -466,7 +469,13 @@ LoadProfile MakeProfile(const std::string& spec, const Wrench& rated, std::uint6
   if (spec == "hold") return Generated("hold", HoldCycle, 100.0, rated, seed, duration_s, false);
   std::string path = spec;
   if (path.rfind("file:", 0) == 0) path = path.substr(5);
-  if (EndsWith(path, ".json")) return FromJson(path, duration_s);
+  if (EndsWith(path, ".json")) {
+    try {
+      return FromJson(path, duration_s);
+    } catch (const nlohmann::json::exception& e) {  // a value of the wrong JSON type anywhere
+      throw ProfileError(path + ": " + e.what());
+    }
+  }
   if (EndsWith(path, ".csv")) return FromCsv(path, duration_s);
   throw ProfileError("unknown profile '" + spec +
                      "' (rig, taps, thermal, hold, or a .json keyframe / .csv recording file)");

@@ -275,6 +275,9 @@ TEST(AtiImport, MalformedFilesAreRefusedWithPosition) {
   unit.replace(unit.find("\"N-m\""), 5, "\"N-x\"");
   refused(unit, "unknown TorqueUnits");
   refused("hello", "no XML elements");
+  // Found by fuzzing (fuzz/corpus/ati/regression_unclosed_value): a quote swallowed by a
+  // malformed attribute name left the next value open; the scanner restarted at 0 forever.
+  refused(ReadText(test::TestDataPath("regression/ati_unclosed_value.cal")), "value is not closed");
 }
 
 TEST(AtiImport, AppliedToVoltsThroughTheFixedPointCore) {

@@ -167,6 +167,14 @@ TEST(RecordProfiles, BadFilesNameTheFaultyPlace) {
   { std::ofstream(dir + "/bad.csv") << "t,Fx,Fy,Fz,Mx,My,Mz\n0,0,0,0,0,0,0\n1,0,nan,0,0,0,0\n"; }
   EXPECT_NE(ErrorOf(dir + "/bad.csv").find("bad.csv:3:"), std::string::npos)
       << ErrorOf(dir + "/bad.csv");
+  // Found by fuzzing (fuzz/corpus/profile/regression_number_overflow.json): a number beyond
+  // double, or a schema of the wrong JSON type, escaped as a JSON library exception.
+  { std::ofstream(dir + "/big.json") << "{\"schema\": \"ftstack-profile/1\", \"rate_hz\": 11e308}"; }
+  EXPECT_NE(ErrorOf(dir + "/big.json").find("big.json: not valid JSON"), std::string::npos)
+      << ErrorOf(dir + "/big.json");
+  { std::ofstream(dir + "/type.json") << "{\"schema\": 1, \"keyframes\": []}"; }
+  EXPECT_NE(ErrorOf(dir + "/type.json").find("schema is not"), std::string::npos)
+      << ErrorOf(dir + "/type.json");
   EXPECT_NE(ErrorOf("sinewave").find("unknown profile 'sinewave'"), std::string::npos);
   EXPECT_NE(ErrorOf(dir + "/missing.json").find("cannot open"), std::string::npos);
 }
