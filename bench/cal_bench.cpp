@@ -5,7 +5,7 @@
 #include <cstdio>
 
 #include "calibration/fit.hpp"
-#include "calibration/rig.hpp"
+#include "sim/rig.hpp"
 #include "sim/sensor_description.hpp"
 
 namespace {
@@ -15,13 +15,13 @@ using namespace ftstack;
 const cal::RigData& Data() {
   static const cal::RigData data = [] {
     const sim::SensorDescription d = sim::DefaultSensorDescription();
-    cal::RigDesignOptions ro;
+    sim::RigDesignOptions ro;
     ro.hold_s = 5.0;
     ro.ramp_s = 1.0;
-    const auto keys = cal::RigKeys(cal::DesignRig(d.model->rated(), ro), ro);
+    const auto keys = sim::RigKeys(sim::DesignRig(d.model->rated(), ro), ro);
     // Rate chosen so the sequence gives at least 1e6 rows; then exactly 1e6 are kept.
     const double rate = 1e6 / keys.back().t_s * 1.001;
-    Recording rec = cal::SimulateRig(d, keys, rate, 1);
+    Recording rec = sim::SimulateRig(d, keys, rate, 1);
     for (auto& c : rec.columns) c.resize(1000000);
     cal::BlockOptions bo;
     for (int a = 0; a < 6; ++a) bo.scale[static_cast<std::size_t>(a)] = d.model->rated()(a);

@@ -328,8 +328,8 @@ RigData RigDataFromRecording(const Recording& rec, const BlockOptions& options) 
   d.path = rec.path;
   const std::size_t n = rec.BridgeCount();
   if (n < 1 || n > fw::kMaxChannels) {
-    throw RecordingError(
-        rec.path + ": needs bridge columns b0 … b{N-1} with 1 <= N <= 8, has " + std::to_string(n));
+    throw RecordingError(rec.path + ": needs bridge columns b0 … b{N-1} with 1 <= N <= 8, has " +
+                         std::to_string(n));
   }
   const std::size_t rows = rec.rows();
   d.bridges.resize(static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(n));
@@ -698,6 +698,15 @@ FitResult FitCalibration(const RigData& d, const FitOptions& options) {
     }
   }
   return res;
+}
+
+double LoadSetCondition(const std::vector<Wrench>& loads, const Wrench& rated) {
+  Eigen::MatrixXd w(static_cast<Eigen::Index>(loads.size()), 6);
+  for (std::size_t i = 0; i < loads.size(); ++i)
+    w.row(static_cast<Eigen::Index>(i)) = loads[i].transpose();
+  std::array<double, 6> r{};
+  for (int a = 0; a < 6; ++a) r[static_cast<std::size_t>(a)] = rated(a);
+  return LoadSetCondition(w, r);
 }
 
 }  // namespace ftstack::cal

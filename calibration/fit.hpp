@@ -10,6 +10,7 @@
 
 #include "firmware/fixed_calibration.hpp"
 #include "measurement/recording.hpp"
+#include "measurement/wrench.hpp"
 
 namespace ftstack::cal {
 
@@ -119,5 +120,7 @@ struct FitResult {
 /// Condition number (σmax/σmin) of [1, wrench ./ rated] — how well a load set excites all axes.
 [[nodiscard]] double LoadSetCondition(const Eigen::MatrixXd& wrench,
                                       const std::array<double, 6>& rated);
+/// The same for a list of loads (N, N·m) and a rated range.
+[[nodiscard]] double LoadSetCondition(const std::vector<Wrench>& loads, const Wrench& rated);
 
 }  // namespace ftstack::cal

@@ -1,10 +1,12 @@
-# Fails when embedded code (hal/, firmware/) includes host-only code (sim/, calibration/, tools/)
-# or when any library includes tests/ or tools/. Run as: cmake -DROOT=<repo> -P CheckIncludes.cmake
+# Fails when embedded code (hal/, firmware/) includes host-only code (measurement/, sim/,
+# calibration/, diagnosis/, numerics/, tools/), when calibration/ includes the simulator, or when any
+# library includes tests/ or tools/. Run as: cmake -DROOT=<repo> -P CheckIncludes.cmake
 file(GLOB_RECURSE embedded "${ROOT}/hal/*.hpp" "${ROOT}/hal/*.cpp" "${ROOT}/firmware/*.hpp" "${ROOT}/firmware/*.cpp")
-file(GLOB_RECURSE host "${ROOT}/sim/*.hpp" "${ROOT}/sim/*.cpp" "${ROOT}/calibration/*.hpp" "${ROOT}/calibration/*.cpp")
+file(GLOB_RECURSE host "${ROOT}/sim/*.hpp" "${ROOT}/sim/*.cpp" "${ROOT}/calibration/*.hpp"
+     "${ROOT}/calibration/*.cpp" "${ROOT}/measurement/*.hpp" "${ROOT}/measurement/*.cpp")
 set(bad "")
 foreach(f IN LISTS embedded)
-  file(STRINGS "${f}" lines REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"](sim|calibration|tools|tests)/")
+  file(STRINGS "${f}" lines REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"](measurement|sim|calibration|diagnosis|numerics|tools|tests)/")
   if(lines)
     list(APPEND bad "${f}: ${lines}")
   endif()
@@ -17,6 +19,14 @@ foreach(f IN LISTS host)
   file(STRINGS "${f}" lines REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"](tools|tests)/")
   if(lines)
     list(APPEND bad "${f}: ${lines}")
+  endif()
+endforeach()
+# Calibration (fitting and files) stands below the simulator: it never includes it.
+file(GLOB_RECURSE calibration "${ROOT}/calibration/*.hpp" "${ROOT}/calibration/*.cpp")
+foreach(f IN LISTS calibration)
+  file(STRINGS "${f}" lines REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"](sim|diagnosis)/")
+  if(lines)
+    list(APPEND bad "${f} (calibration includes the simulator): ${lines}")
   endif()
 endforeach()
 if(bad)

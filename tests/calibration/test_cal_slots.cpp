@@ -8,12 +8,14 @@
 #include <sstream>
 
 #include "calibration/cal_file.hpp"
-#include "calibration/ideal.hpp"
 #include "calibration/slots.hpp"
 #include "sim/default_sensor.hpp"
+#include "sim/ideal_calibration.hpp"
 
 namespace ftstack::cal {
 namespace {
+
+using sim::IdealCalibration;
 
 namespace fs = std::filesystem;
 

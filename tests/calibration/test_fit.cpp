@@ -6,11 +6,17 @@
 #include "calibration/apply.hpp"
 #include "calibration/fit.hpp"
 #include "calibration/fit_report.hpp"
-#include "calibration/rig.hpp"
+#include "sim/rig.hpp"
 #include "tests/calibration/test_models.hpp"
 
 namespace ftstack::cal {
 namespace {
+
+using sim::DesignRig;
+using sim::RigDesignOptions;
+using sim::RigKeys;
+using sim::RigStep;
+using sim::SimulateRig;
 
 constexpr double kRateHz = 200.0;
 
@@ -265,14 +271,15 @@ TEST(Blocks, PoseColumnWins) {
 TEST(Design, ProposedLoadSetIsWellConditioned) {
   const Wrench rated = sim::DefaultRated();
   const auto steps = DesignRig(rated, RigDesignOptions{});
-  const double kappa = RigCondition(steps, rated);
+  const double kappa = LoadSetCondition(sim::RigLoads(steps), rated);
   EXPECT_LT(kappa, 10.0);
   // Single-axis loads only along Fz would be singular.
   std::vector<RigStep> bad(steps.begin(), steps.begin() + 1);
   RigStep fz;
   fz.wrench(2) = 400;
   bad.push_back(fz);
-  EXPECT_FALSE(std::isfinite(RigCondition(bad, rated)) && RigCondition(bad, rated) < 1e6);
+  EXPECT_FALSE(std::isfinite(LoadSetCondition(sim::RigLoads(bad), rated)) &&
+               LoadSetCondition(sim::RigLoads(bad), rated) < 1e6);
   // Combined axial preload × moment loads are in the sequence, and every sweep comes back down.
   bool preload_moment = false;
   for (const RigStep& s : steps) preload_moment |= s.wrench(2) != 0 && s.wrench(3) != 0;

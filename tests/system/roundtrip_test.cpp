@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "calibration/ideal.hpp"
+#include "sim/ideal_calibration.hpp"
 #include "firmware/sampler.hpp"
 #include "hal/sim/sim_adc.hpp"
 #include "sim/sensor_description.hpp"
@@ -35,7 +35,7 @@ RoundTrip RunChain(const sim::SensorDescription& desc, const Wrench& applied, in
   cfg.gain = desc.adc_gain;
   cfg.rate_hz = 1000;
   EXPECT_EQ(sampler.Start(cfg), hal::Status::kOk);
-  const cal::CalFile cal = cal::IdealCalibration(*desc.model, sampler.info());
+  const cal::CalFile cal = sim::IdealCalibration(*desc.model, sampler.info());
   fw::LoadReport rep{};
   core.SetCalibration(cal::ToFixed(cal, sampler.info(), &rep));
 

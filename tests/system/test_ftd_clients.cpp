@@ -9,7 +9,7 @@
 #include <random>
 
 #include "calibration/cal_file.hpp"
-#include "calibration/ideal.hpp"
+#include "sim/ideal_calibration.hpp"
 #include "firmware/register_map.hpp"
 #include "sim/default_sensor.hpp"
 #include "tests/system/builtin_adc.hpp"
@@ -69,7 +69,7 @@ std::array<double, 6> SampleSigma() {
   const auto model = sim::MakeDefaultSensor();
   const test::BuiltinAdc builtin = test::BuiltinSimAdc();
   const hal::AdcInfo adc = builtin.info;
-  const cal::CalFile c = cal::IdealCalibration(*model, adc);
+  const cal::CalFile c = sim::IdealCalibration(*model, adc);
   const double q = adc.full_scale_nvv * 1e-6 / adc.max_counts;
   const double var = builtin.noise_rms_mvv * builtin.noise_rms_mvv + q * q / 12.0;
   std::array<double, 6> s{};

@@ -16,7 +16,7 @@
 #include <thread>
 
 #include "calibration/cal_file.hpp"
-#include "calibration/ideal.hpp"
+#include "sim/ideal_calibration.hpp"
 #include "firmware/modbus_server.hpp"
 #include "firmware/register_map.hpp"
 #include "measurement/recording.hpp"
@@ -43,7 +43,7 @@ Expected DeriveExpected() {
   const auto model = sim::MakeDefaultSensor();
   const test::BuiltinAdc builtin = test::BuiltinSimAdc();
   const hal::AdcInfo adc = builtin.info;
-  const cal::CalFile c = cal::IdealCalibration(*model, adc);
+  const cal::CalFile c = sim::IdealCalibration(*model, adc);
   const double q_mvv = adc.full_scale_nvv * 1e-6 / adc.max_counts;
   const double var = builtin.noise_rms_mvv * builtin.noise_rms_mvv + q_mvv * q_mvv / 12.0;
   Expected e;
@@ -306,7 +306,7 @@ TEST(FtdModbus, CalibrationSlotsAndTheirCrc) {
   const hal::AdcInfo adc = builtin.info;
   // Built-in calibration: registers 72–73 hold the CRC-32 of the documented fixed-point layout.
   {
-    const fw::FixedCalibration fixed = cal::ToFixed(cal::IdealCalibration(*model, adc), adc);
+    const fw::FixedCalibration fixed = cal::ToFixed(sim::IdealCalibration(*model, adc), adc);
     std::vector<std::uint8_t> bytes;
     auto le = [&](std::uint64_t v, int n) {
       for (int i = 0; i < n; ++i) bytes.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
@@ -333,7 +333,7 @@ TEST(FtdModbus, CalibrationSlotsAndTheirCrc) {
   char dir[] = "/tmp/ftd_cal_XXXXXX";
   const std::string base = mkdtemp(dir);
   const std::string a = base + "/a.json", b = base + "/b.json";
-  cal::CalFile fa = cal::IdealCalibration(*model, adc);
+  cal::CalFile fa = sim::IdealCalibration(*model, adc);
   cal::SaveCalFile(a, fa);
   cal::CalFile fb = fa;
   for (auto& row : fb.cal.matrix) {

@@ -11,7 +11,7 @@
 #include <fstream>
 #include <random>
 
-#include "calibration/ideal.hpp"
+#include "sim/ideal_calibration.hpp"
 #include "sim/default_sensor.hpp"
 #include "measurement/recording.hpp"
 
@@ -41,7 +41,7 @@ std::string Slurp(const std::string& path) {
 TEST(FtcalApply, MatchesDoublePrecisionWithinInputQuantisationAndFixedPointBound) {
   Tmp tmp;
   const auto model = sim::MakeDefaultSensor();
-  const cal::CalFile cal = cal::IdealCalibration(*model, cal::DefaultAdc(6));
+  const cal::CalFile cal = sim::IdealCalibration(*model, cal::DefaultAdc(6));
   cal::SaveCalFile(tmp / "cal.json", cal);
 
   // A recording of random wrenches inside the rated range, noise-free bridge outputs.
@@ -94,7 +94,7 @@ TEST(FtcalApply, MatchesDoublePrecisionWithinInputQuantisationAndFixedPointBound
 TEST(FtcalApply, BadInputGivesOneLineErrorWithPosition) {
   Tmp tmp;
   const auto model = sim::MakeDefaultSensor();
-  cal::SaveCalFile(tmp / "cal.json", cal::IdealCalibration(*model, cal::DefaultAdc(6)));
+  cal::SaveCalFile(tmp / "cal.json", sim::IdealCalibration(*model, cal::DefaultAdc(6)));
   {
     std::ofstream f(tmp / "bad.csv");
     f << "t,b0,b1,b2,b3,b4,b5\n0,0,0,0,0,0,0\n0.001,0,0,nan,0,0,0\n";

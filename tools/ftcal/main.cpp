@@ -9,9 +9,9 @@
 #include "calibration/cal_file.hpp"
 #include "calibration/fit.hpp"
 #include "calibration/fit_report.hpp"
-#include "calibration/rig.hpp"
 #include "calibration/slots.hpp"
 #include "measurement/recording.hpp"
+#include "sim/rig.hpp"
 #include "sim/sensor_description.hpp"
 #include "tools/common.hpp"
 
@@ -196,10 +196,10 @@ int main(int argc, char** argv) {
       PrintWorstCase(rep);
     } else if (*design) {
       const sim::SensorDescription s = sim::LoadSensorDescription(sensor_path);
-      cal::RigDesignOptions ro;
+      sim::RigDesignOptions ro;
       ro.temperatures_c = temps;
-      const auto steps = cal::DesignRig(s.model->rated(), ro);
-      const auto keys = cal::RigKeys(steps, ro);
+      const auto steps = sim::DesignRig(s.model->rated(), ro);
+      const auto keys = sim::RigKeys(steps, ro);
       for (std::size_t i = 0; i < steps.size(); ++i) {
         std::printf("%4zu  %-28s  %8.2f %8.2f %8.2f %7.3f %7.3f %7.3f  %5.1f C\n", i,
                     steps[i].label.c_str(), steps[i].wrench(0), steps[i].wrench(1),
@@ -207,7 +207,7 @@ int main(int argc, char** argv) {
                     steps[i].temperature_c);
       }
       std::printf("%zu loads, %.1f s; condition number of the load set: %.3g\n", steps.size(),
-                  keys.back().t_s, cal::RigCondition(steps, s.model->rated()));
+                  keys.back().t_s, cal::LoadSetCondition(sim::RigLoads(steps), s.model->rated()));
       if (!profile_out.empty()) {
         Recording prof;
         prof.names = {"t", "Fx", "Fy", "Fz", "Mx", "My", "Mz", "temp_C"};
@@ -223,7 +223,7 @@ int main(int argc, char** argv) {
         std::printf("wrote %s\n", profile_out.c_str());
       }
       if (!simulate_out.empty()) {
-        WriteRecording(simulate_out, cal::SimulateRig(s, keys, rate_hz, 1));
+        WriteRecording(simulate_out, sim::SimulateRig(s, keys, rate_hz, 1));
         std::printf("wrote %s\n", simulate_out.c_str());
       }
     }

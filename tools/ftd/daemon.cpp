@@ -8,7 +8,7 @@
 #include <system_error>
 
 #include "calibration/cal_file.hpp"
-#include "calibration/ideal.hpp"
+#include "sim/ideal_calibration.hpp"
 #include "hal/sim/sim_adc.hpp"
 #include "sim/default_sensor.hpp"
 #include "measurement/recording.hpp"
@@ -140,7 +140,7 @@ void Ftd::Start() {
   std::array<double, 6> rated{};
   try {
     if (opt_.cal.empty()) {
-      const cal::CalFile ideal = cal::IdealCalibration(*model_, info);
+      const cal::CalFile ideal = sim::IdealCalibration(*model_, info);
       cfg.slots[0].fixed = cal::ToFixed(ideal, info);
       cfg.slots[0].crc32 = FixedFormCrc(cfg.slots[0].fixed);
       cfg.slots[0].present = true;

@@ -1,12 +1,12 @@
-#include "calibration/ideal.hpp"
+#include "sim/ideal_calibration.hpp"
 
-namespace ftstack::cal {
+namespace ftstack::sim {
 
-CalFile IdealCalibration(const sim::SensorModel& model, const hal::AdcInfo& adc) {
+cal::CalFile IdealCalibration(const SensorModel& model, const hal::AdcInfo& adc) {
   const Eigen::MatrixXd s = model.Sensitivity();
   const Eigen::MatrixXd m = s.completeOrthogonalDecomposition().pseudoInverse();  // 6 × N
   const Eigen::VectorXd zero = model.BridgeOutputs(Wrench::Zero(), 20.0);
-  CalFile f;
+  cal::CalFile f;
   f.serial = model.name();
   f.source = "ideal";
   f.cal.channel_count = static_cast<std::uint8_t>(model.channel_count());
@@ -24,4 +24,4 @@ CalFile IdealCalibration(const sim::SensorModel& model, const hal::AdcInfo& adc)
   return f;
 }
 
-}  // namespace ftstack::cal
+}  // namespace ftstack::sim

@@ -9,7 +9,7 @@
 #include "sim/sensor_description.hpp"
 #include "sim/wrench_source.hpp"
 
-namespace ftstack::cal {
+namespace ftstack::sim {
 
 /// What the proposed rig sequence contains.
 struct RigDesignOptions {
@@ -33,22 +33,20 @@ struct RigStep {
 };
 
 /// Proposes a rig sequence for a sensor of rated range `rated` (N, N·m).
-[[nodiscard]] std::vector<RigStep> DesignRig(const Wrench& rated,
-                                             const RigDesignOptions& options);
+[[nodiscard]] std::vector<RigStep> DesignRig(const Wrench& rated, const RigDesignOptions& options);
+
+/// The loads of the sequence, in order (for cal::LoadSetCondition).
+[[nodiscard]] std::vector<Wrench> RigLoads(const std::vector<RigStep>& steps);
 
 /// Keyframes of the sequence: each step held hold_s after a ramp_s transition.
-[[nodiscard]] std::vector<sim::ProfileWrench::Key> RigKeys(const std::vector<RigStep>& steps,
-                                                           const RigDesignOptions& options);
+[[nodiscard]] std::vector<ProfileWrench::Key> RigKeys(const std::vector<RigStep>& steps,
+                                                      const RigDesignOptions& options);
 
-/// Condition number of the sequence's loads (cal::LoadSetCondition over the steps).
-[[nodiscard]] double RigCondition(const std::vector<RigStep>& steps, const Wrench& rated);
-
-/// Runs the keyframes through the sensor: sim::SimulatedSensor → hal::sim::SimAdc (its noise,
+/// Runs the keyframes through the sensor: SimulatedSensor → hal::sim::SimAdc (its noise,
 /// resolution and seed) → counts → mV/V. Columns t, Fx…Mz (the applied reference), b0…, temp_C,
 /// and `pose` (index of the step being held or approached) when `with_pose`.
-[[nodiscard]] Recording SimulateRig(const sim::SensorDescription& sensor,
-                                         const std::vector<sim::ProfileWrench::Key>& keys,
-                                         double rate_hz, std::uint64_t seed,
-                                         bool with_pose = false);
+[[nodiscard]] Recording SimulateRig(const SensorDescription& sensor,
+                                    const std::vector<ProfileWrench::Key>& keys, double rate_hz,
+                                    std::uint64_t seed, bool with_pose = false);
 
-}  // namespace ftstack::cal
+}  // namespace ftstack::sim

@@ -4,10 +4,10 @@
 #include "calibration/cal_file.hpp"
 #include "sim/sensor_model.hpp"
 
-namespace ftstack::cal {
+namespace ftstack::sim {
 
 /// The calibration a perfect rig would find for `model` read by `adc`: matrix = pinv(S) at zero
 /// load and 20 °C, zero offsets = the model's unloaded outputs.
-[[nodiscard]] CalFile IdealCalibration(const sim::SensorModel& model, const hal::AdcInfo& adc);
+[[nodiscard]] cal::CalFile IdealCalibration(const SensorModel& model, const hal::AdcInfo& adc);
 
-}  // namespace ftstack::cal
+}  // namespace ftstack::sim

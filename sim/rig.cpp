@@ -1,15 +1,14 @@
-#include "calibration/rig.hpp"
+#include "sim/rig.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <random>
 #include <stdexcept>
 
-#include "calibration/fit.hpp"
 #include "hal/sim/sim_adc.hpp"
 #include "sim/simulated_sensor.hpp"
 
-namespace ftstack::cal {
+namespace ftstack::sim {
 namespace {
 
 const char* const kAxisNames[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
@@ -105,18 +104,9 @@ std::vector<sim::ProfileWrench::Key> RigKeys(const std::vector<RigStep>& steps,
   return keys;
 }
 
-double RigCondition(const std::vector<RigStep>& steps, const Wrench& rated) {
-  Eigen::MatrixXd w(static_cast<Eigen::Index>(steps.size()), 6);
-  for (std::size_t i = 0; i < steps.size(); ++i)
-    w.row(static_cast<Eigen::Index>(i)) = steps[i].wrench.transpose();
-  std::array<double, 6> r{};
-  for (int a = 0; a < 6; ++a) r[static_cast<std::size_t>(a)] = rated(a);
-  return LoadSetCondition(w, r);
-}
-
 Recording SimulateRig(const sim::SensorDescription& sensor,
-                           const std::vector<sim::ProfileWrench::Key>& keys, double rate_hz,
-                           std::uint64_t seed, bool with_pose) {
+                      const std::vector<sim::ProfileWrench::Key>& keys, double rate_hz,
+                      std::uint64_t seed, bool with_pose) {
   if (keys.empty()) throw std::invalid_argument("empty rig sequence");
   const sim::ProfileWrench profile(keys, true);
   sim::SimulatedSensor source(*sensor.model, profile);
@@ -167,4 +157,11 @@ Recording SimulateRig(const sim::SensorDescription& sensor,
   return rec;
 }
 
-}  // namespace ftstack::cal
+std::vector<Wrench> RigLoads(const std::vector<RigStep>& steps) {
+  std::vector<Wrench> loads;
+  loads.reserve(steps.size());
+  for (const RigStep& s : steps) loads.push_back(s.wrench);
+  return loads;
+}
+
+}  // namespace ftstack::sim
