@@ -16,8 +16,9 @@
 #include <thread>
 #include <vector>
 
+#include "daemon/daemon.hpp"
+#include "daemon/sim_backend.hpp"
 #include "firmware/register_map.hpp"
-#include "tools/ftd/daemon.hpp"
 
 namespace {
 
@@ -30,18 +31,18 @@ double RunSeconds() {
 }
 
 /// The daemon as `./ftstack.sh run` starts it, sampling the simulated sensor at `rate_hz`.
-ftstack::tools::Ftd& Daemon(unsigned rate_hz, bool paced) {
-  static std::unique_ptr<ftstack::tools::Ftd> d;
+ftstack::daemon::Ftd& Daemon(unsigned rate_hz, bool paced) {
+  static std::unique_ptr<ftstack::daemon::Ftd> d;
   static unsigned d_rate = 0;
   static bool d_paced = true;
   if (!d || d_rate != rate_hz || d_paced != paced) {
     d.reset();
-    ftstack::tools::FtdOptions o;
+    ftstack::daemon::FtdOptions o;
     o.rate_hz = rate_hz;
     o.paced = paced;
     o.sim_wrench = std::array<double, 6>{10, 0, -50, 0, 0.5, 0};
     o.modbus_tcp = "127.0.0.1:0";
-    d = std::make_unique<ftstack::tools::Ftd>(o);
+    d = std::make_unique<ftstack::daemon::Ftd>(o, &ftstack::daemon::MakeSimulatedBackend);
     d->Start();
     d_rate = rate_hz;
     d_paced = paced;
@@ -50,7 +51,8 @@ ftstack::tools::Ftd& Daemon(unsigned rate_hz, bool paced) {
 }
 
 /// A plain libmodbus TCP server (select loop, modbus_receive + modbus_reply) over a mapping with
-/// the same input registers (all of the map), in its own thread: the reference the daemon is compared with.
+/// the same input registers (all of the map), in its own thread: the reference the daemon is
+/// compared with.
 class PlainServer {
  public:
   PlainServer() {
@@ -199,7 +201,7 @@ void Report(benchmark::State& state, const LoadResult& r) {
 /// ftd sampling the simulated sensor at 8 kHz while `clients` poll it; also reports the sample
 /// rate the sampling thread sustained during the run.
 void BM_FtdTcp(benchmark::State& state) {
-  ftstack::tools::Ftd& d = Daemon(8000, true);
+  ftstack::daemon::Ftd& d = Daemon(8000, true);
   const double seconds = RunSeconds();
   LoadResult r;
   double rate = 0;
@@ -228,7 +230,7 @@ void BM_PlainTcp(benchmark::State& state) {
 /// The highest sample rate the host reaches: the simulated ADC unpaced (sensor model, noise,
 /// counts, core, transform, overload, publication) while `clients` poll over Modbus.
 void BM_FtdUnpacedSampleRate(benchmark::State& state) {
-  ftstack::tools::Ftd& d = Daemon(8000, false);
+  ftstack::daemon::Ftd& d = Daemon(8000, false);
   double rate = 0;
   LoadResult r;
   for (auto _ : state) {

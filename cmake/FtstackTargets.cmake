@@ -1,14 +1,18 @@
 # Target helpers: warning flags, embedded flags and the layer rules that keep the architecture honest.
 #
-# Layers (by target-name prefix) and what each may link:
-#   ftstack_hal        the HAL interface (header-only)            -> nothing of ours
-#   ftstack_hal_*      HAL backends (sim ADC, HX711, SPI ADC)     -> ftstack_hal
-#   ftstack_fw_*       firmware (integer core, sampler, Modbus)   -> ftstack_hal, ftstack_fw_*
-#   ftstack_sim*       physics simulator, recordings (host)       -> ftstack_hal*, ftstack_sim*
-#   ftstack_cal*       calibration fitting and files (host)       -> ftstack_fw_*, ftstack_hal, ftstack_sim*, ftstack_cal*
-#   ftstack_tool_*     logic behind the command-line tools        -> anything above
-# Executables (tools, tests, benchmarks) may link anything; no library may link ftstack_tool_*
-# (except another tool library) and nothing links a test.
+# Layers (by target name) and what each may link (ftstack_check_layers below enforces it; CMake
+# configuration fails on a violation, and tests/CMakeLists.txt proves it with injected ones):
+#   ftstack_hal          the HAL interface (header-only)              -> nothing of ours
+#   ftstack_hal_*        HAL backends (sim ADC, HX711, SPI ADC, GPIO) -> hal_if
+#   ftstack_fw_*         firmware: integer core, device, Modbus       -> hal_if, fw
+#   ftstack_measurement  host types: wrench, units, recording format  -> nothing of ours
+#   ftstack_cal_file     what a board loads: calibration file, slots  -> hal_if, fw
+#   ftstack_cal_fit      fitting, fit reports, ATI import             -> hal_if, fw, meas, calfile
+#   ftstack_sim*         physics simulator, rigs, recordings          -> hal_if, hal, meas, calfile, sim
+#   ftstack_daemon       ftd's daemon (board and host)                -> hal_if, hal, fw, meas, calfile
+#   ftstack_daemon_sim   ftd's simulated backend (host only)          -> the daemon's + sim, daemon
+#   ftstack_tool_*       logic behind the command-line tools          -> anything above
+# Executables (tools, tests, benchmarks, fuzzers) may link anything; nothing links a test.
 
 add_library(ftstack_warnings INTERFACE)
 target_compile_options(ftstack_warnings INTERFACE -Wall -Wextra -Wshadow -Wnon-virtual-dtor)
@@ -74,6 +78,10 @@ function(_ftstack_layer_of target out)
     set(${out} "calfile" PARENT_SCOPE)
   elseif(target STREQUAL "ftstack_cal_fit")
     set(${out} "calfit" PARENT_SCOPE)
+  elseif(target STREQUAL "ftstack_daemon")
+    set(${out} "daemon" PARENT_SCOPE)
+  elseif(target STREQUAL "ftstack_daemon_sim")
+    set(${out} "daemon_sim" PARENT_SCOPE)
   elseif(target MATCHES "^ftstack_tool_")
     set(${out} "tool" PARENT_SCOPE)
   elseif(target MATCHES "^ftstack_test|^test_")
@@ -91,7 +99,9 @@ function(ftstack_check_layers)
   set(allowed_calfile "hal_if;fw")
   set(allowed_calfit "hal_if;fw;meas;calfile")
   set(allowed_sim "hal_if;hal;meas;calfile;sim")
-  set(allowed_tool "hal_if;hal;fw;meas;calfile;calfit;sim;tool")
+  set(allowed_daemon "hal_if;hal;fw;meas;calfile")
+  set(allowed_daemon_sim "hal_if;hal;fw;meas;calfile;sim;daemon")
+  set(allowed_tool "hal_if;hal;fw;meas;calfile;calfit;sim;daemon;daemon_sim;tool")
   get_property(libs GLOBAL PROPERTY FTSTACK_LIBRARIES)
   foreach(lib IN LISTS libs)
     _ftstack_layer_of(${lib} layer)

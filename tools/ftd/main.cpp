@@ -8,8 +8,11 @@
 #include <cstdio>
 #include <thread>
 
+#include "daemon/daemon.hpp"
 #include "tools/common.hpp"
-#include "tools/ftd/daemon.hpp"
+#if FTSTACK_FTD_SIMULATOR
+#include "daemon/sim_backend.hpp"
+#endif
 
 namespace {
 
@@ -22,7 +25,7 @@ namespace {
 int Run(int argc, char** argv) {
   using namespace ftstack;
   CLI::App app{"ftd — force/torque sensor daemon (firmware main loop on a board or host)"};
-  tools::FtdOptions opt;
+  daemon::FtdOptions opt;
   std::string sim_wrench;
   std::string parity = "N";
   double duration_s = 0;
@@ -68,7 +71,11 @@ int Run(int argc, char** argv) {
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
   std::signal(SIGPIPE, SIG_IGN);
-  tools::Ftd ftd(opt);
+#if FTSTACK_FTD_SIMULATOR
+  daemon::Ftd ftd(opt, &daemon::MakeSimulatedBackend);
+#else
+  daemon::Ftd ftd(opt);  // a board build: --adc sim is refused with a clear message
+#endif
   try {
     ftd.Start();
   } catch (const std::exception& e) {
@@ -116,7 +123,7 @@ int Run(int argc, char** argv) {
     if (duration_s > 0 && std::chrono::duration<double>(now - t0).count() >= duration_s) break;
   }
   ftd.Stop();
-  const tools::FtdStats st = ftd.stats();
+  const daemon::FtdStats st = ftd.stats();
   if (status_line) std::fprintf(stderr, "\n");
   std::fprintf(stderr, "ftd: %llu samples in %.2f s (%.0f Hz)%s\n",
                static_cast<unsigned long long>(st.samples), st.elapsed_s,

@@ -1,5 +1,5 @@
 // ftd's hardware ADC factory on a machine without GPIO or SPI: clear one-line refusals.
-#include "tools/ftd/hardware_adc.hpp"
+#include "daemon/hardware_adc.hpp"
 #include "tests/support/temp_dir.hpp"
 
 #include <gtest/gtest.h>
@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace ftstack::tools {
+namespace ftstack::daemon {
 namespace {
 
 std::unique_ptr<hal::Adc> Make(const std::string& kind, const std::string& chip,
@@ -88,4 +88,4 @@ TEST(HardwareAdc, FtdRefusesWithOneLineAndNonZeroExit) {
 }
 
 }  // namespace
-}  // namespace ftstack::tools
+}  // namespace ftstack::daemon

@@ -12,23 +12,16 @@
 #include <thread>
 #include <vector>
 
+#include "daemon/backend.hpp"
 #include "firmware/device.hpp"
 #include "firmware/modbus_server.hpp"
 #include "firmware/register_map.hpp"
 
-namespace ftstack::sim {
-class SensorModel;
-class WrenchSource;
-class SimulatedSensor;
-}  // namespace ftstack::sim
 namespace ftstack {
 class RecordingWriter;
 }  // namespace ftstack
-namespace ftstack::hal::sim {
-class SimAdc;
-}
 
-namespace ftstack::tools {
+namespace ftstack::daemon {
 
 /// A start-up failure of the daemon; what() is the one-line reason.
 class FtdError : public std::runtime_error {
@@ -76,7 +69,8 @@ struct FtdStats {
 /// The running daemon. Start() spawns the threads; Stop() (or the destructor) joins them.
 class Ftd {
  public:
-  explicit Ftd(FtdOptions options);
+  /// `simulator` makes the backend of `--adc sim` (nullptr in a board build: refused).
+  explicit Ftd(FtdOptions options, SimulatorFactory simulator = nullptr);
   ~Ftd();
   Ftd(const Ftd&) = delete;
   Ftd& operator=(const Ftd&) = delete;
@@ -100,11 +94,8 @@ class Ftd {
   void SamplingLoop();
 
   FtdOptions opt_;
-  std::shared_ptr<const sim::SensorModel> model_;
-  std::uint16_t sim_gain_ = 128;  ///< PGA gain of the built-in sensor's converter
-  std::unique_ptr<sim::WrenchSource> source_;
-  std::unique_ptr<sim::SimulatedSensor> sensor_;
-  std::unique_ptr<hal::Adc> adc_;
+  SimulatorFactory simulator_ = nullptr;
+  std::unique_ptr<AdcBackend> backend_;
   std::unique_ptr<fw::WrenchCore> core_;
   std::unique_ptr<fw::Device> device_;
   std::unique_ptr<fw::RegisterMap> map_;
@@ -132,4 +123,4 @@ class Ftd {
   bool running_ = false;
 };
 
-}  // namespace ftstack::tools
+}  // namespace ftstack::daemon

@@ -1,4 +1,4 @@
-#include "tools/ftd/hardware_adc.hpp"
+#include "daemon/hardware_adc.hpp"
 
 #include <cstdio>
 #include <cstdlib>
@@ -11,7 +11,7 @@
 #include "hal/spi/spidev.hpp"
 #include "hal/spi_adc/ads131m.hpp"
 
-namespace ftstack::tools {
+namespace ftstack::daemon {
 namespace {
 
 unsigned ParseUnsigned(const std::string& text, const std::string& what) {
@@ -227,4 +227,4 @@ std::unique_ptr<hal::Adc> MakeHardwareAdc(const HardwareAdcOptions& given, std::
   return nullptr;
 }
 
-}  // namespace ftstack::tools
+}  // namespace ftstack::daemon

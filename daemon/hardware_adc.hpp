@@ -9,7 +9,7 @@
 
 #include "hal/adc.hpp"
 
-namespace ftstack::tools {
+namespace ftstack::daemon {
 
 /// Options of ftd that select and wire a hardware ADC. Fields after `channels` have board
 /// defaults (Raspberry Pi 40-pin header, gpiochip0 offsets = BCM numbers) and can be overridden
@@ -42,4 +42,4 @@ void ApplyHardwareEnvironment(HardwareAdcOptions& options);
 /// permission, missing --gpiochip/--spidev, bad environment value).
 std::unique_ptr<hal::Adc> MakeHardwareAdc(const HardwareAdcOptions& options, std::string* error);
 
-}  // namespace ftstack::tools
+}  // namespace ftstack::daemon

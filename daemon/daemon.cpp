@@ -1,4 +1,4 @@
-#include "tools/ftd/daemon.hpp"
+#include "daemon/daemon.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -8,16 +8,10 @@
 #include <system_error>
 
 #include "calibration/cal_file.hpp"
-#include "sim/ideal_calibration.hpp"
-#include "hal/sim/sim_adc.hpp"
-#include "sim/default_sensor.hpp"
+#include "daemon/hardware_adc.hpp"
 #include "measurement/recording.hpp"
-#include "sim/sensor_description.hpp"
-#include "sim/simulated_sensor.hpp"
-#include "sim/wrench_source.hpp"
-#include "tools/ftd/hardware_adc.hpp"
 
-namespace ftstack::tools {
+namespace ftstack::daemon {
 namespace {
 
 constexpr std::size_t kLogRingCapacity = std::size_t{1} << 15;
@@ -38,6 +32,28 @@ fw::CalSlot SlotFromFile(const std::string& path, const hal::AdcInfo& adc,
   slot.present = true;
   if (rated != nullptr) *rated = file.rated;
   return slot;
+}
+
+/// A hardware converter (HX711 over GPIO, ADS131M over SPI); needs a calibration file.
+class HardwareBackend final : public AdcBackend {
+ public:
+  HardwareBackend(std::unique_ptr<hal::Adc> adc, std::uint8_t channels)
+      : adc_(std::move(adc)), channels_(channels) {}
+  hal::Adc& adc() override { return *adc_; }
+  [[nodiscard]] std::uint8_t channel_count() const override { return channels_; }
+
+ private:
+  std::unique_ptr<hal::Adc> adc_;
+  std::uint8_t channels_;
+};
+
+std::unique_ptr<AdcBackend> MakeHardwareBackend(const FtdOptions& opt) {
+  constexpr std::uint8_t kChannels = 6;
+  std::string error;
+  HardwareAdcOptions hw{opt.adc, opt.gpiochip, opt.spidev, kChannels};
+  std::unique_ptr<hal::Adc> adc = MakeHardwareAdc(hw, &error);
+  if (adc == nullptr) throw FtdError(error);
+  return std::make_unique<HardwareBackend>(std::move(adc), kChannels);
 }
 
 }  // namespace
@@ -77,49 +93,21 @@ std::uint32_t FixedFormCrc(const fw::FixedCalibration& cal) {
   return cal::Crc32(bytes);
 }
 
-Ftd::Ftd(FtdOptions options) : opt_(std::move(options)) {}
+Ftd::Ftd(FtdOptions options, SimulatorFactory simulator)
+    : opt_(std::move(options)), simulator_(simulator) {}
 
 Ftd::~Ftd() { Stop(); }
 
 void Ftd::Start() {
   if (running_) return;
-  std::uint8_t channels = 6;
   try {
     if (opt_.adc == "sim") {
-      const sim::SensorDescription desc = sim::DefaultSensorDescription();
-      model_ = desc.model;
-      sim_gain_ = desc.adc_gain;
-      channels = static_cast<std::uint8_t>(model_->channel_count());
-      if (!opt_.replay.empty()) {
-        ReadOptions ro;
-        ro.required = {"t"};
-        ro.require_wrench = true;
-        source_ = sim::ReplayWrench(ReadRecording(opt_.replay, ro));
-      } else {
-        Wrench w = Wrench::Zero();
-        if (opt_.sim_wrench) {
-          for (int i = 0; i < 6; ++i) w(i) = (*opt_.sim_wrench)[static_cast<std::size_t>(i)];
-        }
-        source_ = std::make_unique<sim::ConstantWrench>(w);
+      if (simulator_ == nullptr) {
+        throw FtdError("this ftd was built for a board without the simulator; use --adc hx711|spi");
       }
-      sensor_ = std::make_unique<sim::SimulatedSensor>(*model_, *source_);
-      // The built-in sensor's converter at the requested rate (its datasheet noise); a rate the
-      // converter cannot run keeps the nominal operating point's noise.
-      hal::sim::SimAdcParams params;
-      try {
-        params = sim::AdcParamsAt(desc, opt_.rate_hz);
-      } catch (const std::invalid_argument&) {
-        params = desc.adc;
-        params.required_rate_hz = 0;
-      }
-      params.seed = opt_.seed;
-      params.realtime = opt_.paced;
-      adc_ = std::make_unique<hal::sim::SimAdc>(*sensor_, params);
+      backend_ = simulator_(opt_);
     } else {
-      std::string error;
-      HardwareAdcOptions hw{opt_.adc, opt_.gpiochip, opt_.spidev, channels};
-      adc_ = MakeHardwareAdc(hw, &error);
-      if (adc_ == nullptr) throw FtdError(error);
+      backend_ = MakeHardwareBackend(opt_);
       if (opt_.cal.empty()) throw FtdError("--adc " + opt_.adc + " needs --cal CAL.json");
     }
   } catch (const FtdError&) {
@@ -127,20 +115,23 @@ void Ftd::Start() {
   } catch (const std::exception& e) {
     throw FtdError(e.what());
   }
+  hal::Adc& adc = backend_->adc();
 
   fw::DeviceConfig cfg;
-  cfg.adc.channel_count = channels;
+  cfg.adc.channel_count = backend_->channel_count();
   cfg.adc.rate_hz = opt_.rate_hz;
-  if (opt_.adc == "sim") cfg.adc.gain = sim_gain_;
+  cfg.adc.gain = backend_->gain();
   // Configure once to learn the ADC's scaling, which the fixed-point calibration is made for.
-  if (const hal::Status s = adc_->Configure(cfg.adc); s != hal::Status::kOk) {
+  if (const hal::Status s = adc.Configure(cfg.adc); s != hal::Status::kOk) {
     throw FtdError(std::string("ADC configuration failed: ") + hal::ToString(s));
   }
-  const hal::AdcInfo info = adc_->Info();
+  const hal::AdcInfo info = adc.Info();
   std::array<double, 6> rated{};
   try {
     if (opt_.cal.empty()) {
-      const cal::CalFile ideal = sim::IdealCalibration(*model_, info);
+      const std::optional<cal::CalFile> builtin = backend_->BuiltinCalibration(info);
+      if (!builtin) throw FtdError("--adc " + opt_.adc + " needs --cal CAL.json");
+      const cal::CalFile& ideal = *builtin;
       cfg.slots[0].fixed = cal::ToFixed(ideal, info);
       cfg.slots[0].crc32 = FixedFormCrc(cfg.slots[0].fixed);
       cfg.slots[0].present = true;
@@ -164,7 +155,7 @@ void Ftd::Start() {
   if (any_zero) cfg.rated_lsb = {};  // no complete rating: overload rule off
 
   core_ = std::make_unique<fw::WrenchCore>();
-  device_ = std::make_unique<fw::Device>(*adc_, *core_);
+  device_ = std::make_unique<fw::Device>(adc, *core_);
   switch (device_->Start(cfg)) {
     case fw::DeviceStatus::kOk:
       break;
@@ -328,4 +319,4 @@ std::string Ftd::StatusLine() const {
   return line;
 }
 
-}  // namespace ftstack::tools
+}  // namespace ftstack::daemon

@@ -1,0 +1,67 @@
+#include "daemon/sim_backend.hpp"
+
+#include <stdexcept>
+
+#include "hal/sim/sim_adc.hpp"
+#include "measurement/recording.hpp"
+#include "sim/ideal_calibration.hpp"
+#include "sim/sensor_description.hpp"
+#include "sim/simulated_sensor.hpp"
+#include "sim/wrench_source.hpp"
+
+namespace ftstack::daemon {
+namespace {
+
+class SimulatedBackend final : public AdcBackend {
+ public:
+  explicit SimulatedBackend(const FtdOptions& opt) : desc_(sim::DefaultSensorDescription()) {
+    if (!opt.replay.empty()) {
+      ReadOptions ro;
+      ro.required = {"t"};
+      ro.require_wrench = true;
+      source_ = sim::ReplayWrench(ReadRecording(opt.replay, ro));
+    } else {
+      Wrench w = Wrench::Zero();
+      if (opt.sim_wrench) {
+        for (int i = 0; i < 6; ++i) w(i) = (*opt.sim_wrench)[static_cast<std::size_t>(i)];
+      }
+      source_ = std::make_unique<sim::ConstantWrench>(w);
+    }
+    sensor_ = std::make_unique<sim::SimulatedSensor>(*desc_.model, *source_);
+    // The built-in sensor's converter at the requested rate (its datasheet noise); a rate the
+    // converter cannot run keeps the nominal operating point's noise.
+    hal::sim::SimAdcParams params;
+    try {
+      params = sim::AdcParamsAt(desc_, opt.rate_hz);
+    } catch (const std::invalid_argument&) {
+      params = desc_.adc;
+      params.required_rate_hz = 0;
+    }
+    params.seed = opt.seed;
+    params.realtime = opt.paced;
+    adc_ = std::make_unique<hal::sim::SimAdc>(*sensor_, params);
+  }
+  hal::Adc& adc() override { return *adc_; }
+  [[nodiscard]] std::uint8_t channel_count() const override {
+    return static_cast<std::uint8_t>(desc_.model->channel_count());
+  }
+  [[nodiscard]] std::uint16_t gain() const override { return desc_.adc_gain; }
+  [[nodiscard]] std::optional<cal::CalFile> BuiltinCalibration(
+      const hal::AdcInfo& adc) const override {
+    return sim::IdealCalibration(*desc_.model, adc);
+  }
+
+ private:
+  sim::SensorDescription desc_;
+  std::unique_ptr<sim::WrenchSource> source_;
+  std::unique_ptr<sim::SimulatedSensor> sensor_;
+  std::unique_ptr<hal::sim::SimAdc> adc_;
+};
+
+}  // namespace
+
+std::unique_ptr<AdcBackend> MakeSimulatedBackend(const FtdOptions& options) {
+  return std::make_unique<SimulatedBackend>(options);
+}
+
+}  // namespace ftstack::daemon
