@@ -2,7 +2,7 @@
 #include <benchmark/benchmark.h>
 
 #include "sim/record.hpp"
-#include "tools/diag/diagnose.hpp"
+#include "diagnosis/diagnose.hpp"
 
 namespace {
 

@@ -29,6 +29,16 @@ foreach(f IN LISTS calibration)
     list(APPEND bad "${f} (calibration includes the simulator): ${lines}")
   endif()
 endforeach()
+# The diagnosis engine and its reports know recordings and numbers, not the simulator or a CLI.
+file(GLOB engine "${ROOT}/diagnosis/*.hpp" "${ROOT}/diagnosis/*.cpp" "${ROOT}/diagnosis/report/*.hpp"
+     "${ROOT}/diagnosis/report/*.cpp")
+foreach(f IN LISTS engine)
+  file(STRINGS "${f}" lines REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"](sim|calibration|daemon|tools|tests|CLI)/")
+  if(lines)
+    list(APPEND bad "${f} (the diagnosis engine includes the simulator, a tool or a CLI): ${lines}")
+  endif()
+endforeach()
+
 if(bad)
   list(JOIN bad "\n" msg)
   message(FATAL_ERROR "Architecture violation (see docs/architecture.md):\n${msg}")

@@ -11,6 +11,9 @@
 #   ftstack_sim*         physics simulator, rigs, recordings          -> hal_if, hal, meas, calfile, sim
 #   ftstack_daemon       ftd's daemon (board and host)                -> hal_if, hal, fw, meas, calfile
 #   ftstack_daemon_sim   ftd's simulated backend (host only)          -> the daemon's + sim, daemon
+#   ftstack_diagnosis    sim-vs-real diagnosis engine                 -> meas
+#   ftstack_diagnosis_report  its HTML/JSON reports                   -> meas, diag
+#   ftstack_diagnosis_eval    scorecard, demo, model prediction       -> diag, sim (and below)
 #   ftstack_tool_*       logic behind the command-line tools          -> anything above
 # Executables (tools, tests, benchmarks, fuzzers) may link anything; nothing links a test.
 
@@ -82,6 +85,12 @@ function(_ftstack_layer_of target out)
     set(${out} "daemon" PARENT_SCOPE)
   elseif(target STREQUAL "ftstack_daemon_sim")
     set(${out} "daemon_sim" PARENT_SCOPE)
+  elseif(target STREQUAL "ftstack_diagnosis")
+    set(${out} "diag" PARENT_SCOPE)
+  elseif(target STREQUAL "ftstack_diagnosis_report")
+    set(${out} "diag_report" PARENT_SCOPE)
+  elseif(target STREQUAL "ftstack_diagnosis_eval")
+    set(${out} "diag_eval" PARENT_SCOPE)
   elseif(target MATCHES "^ftstack_tool_")
     set(${out} "tool" PARENT_SCOPE)
   elseif(target MATCHES "^ftstack_test|^test_")
@@ -101,7 +110,10 @@ function(ftstack_check_layers)
   set(allowed_sim "hal_if;hal;meas;calfile;sim")
   set(allowed_daemon "hal_if;hal;fw;meas;calfile")
   set(allowed_daemon_sim "hal_if;hal;fw;meas;calfile;sim;daemon")
-  set(allowed_tool "hal_if;hal;fw;meas;calfile;calfit;sim;daemon;daemon_sim;tool")
+  set(allowed_diag "meas")
+  set(allowed_diag_report "meas;diag")
+  set(allowed_diag_eval "hal_if;hal;meas;calfile;sim;diag")
+  set(allowed_tool "hal_if;hal;fw;meas;calfile;calfit;sim;daemon;daemon_sim;diag;diag_report;diag_eval;tool")
   get_property(libs GLOBAL PROPERTY FTSTACK_LIBRARIES)
   foreach(lib IN LISTS libs)
     _ftstack_layer_of(${lib} layer)

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <random>
 
-#include "tests/tools/diag_fixture.hpp"
-#include "tools/diag/diagnose.hpp"
-#include "tools/diag/signal.hpp"
+#include "diagnosis/diagnose.hpp"
+#include "diagnosis/signal.hpp"
+#include "tests/diagnosis/diag_fixture.hpp"
 
 namespace ftstack::diag {
 namespace {

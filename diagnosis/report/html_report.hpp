@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "tools/diag/diagnose.hpp"
+#include "diagnosis/diagnose.hpp"
 
 namespace ftstack::diag {
 
@@ -35,5 +35,9 @@ struct PlotSpec {
 [[nodiscard]] std::string HtmlReport(const DiagData& data, const Report& report);
 /// Writes HtmlReport to `path`; throws std::runtime_error naming the file on failure.
 void WriteHtml(const std::string& path, const DiagData& data, const Report& report);
+/// Writes the JSON report (ToJson) to `path`; throws std::runtime_error naming the file on failure.
+void WriteJson(const std::string& path, const nlohmann::json& j);
+/// The verdict and each effect's evidence, one line each (what ftdiag prints).
+[[nodiscard]] std::string SummaryText(const Report& report);
 
 }  // namespace ftstack::diag

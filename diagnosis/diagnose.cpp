@@ -1,4 +1,4 @@
-#include "tools/diag/diagnose.hpp"
+#include "diagnosis/diagnose.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <limits>
 
-#include "tools/diag/signal.hpp"
+#include "diagnosis/signal.hpp"
 
 namespace ftstack::diag {
 namespace {

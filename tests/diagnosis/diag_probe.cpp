@@ -3,8 +3,8 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "tests/tools/diag_fixture.hpp"
-#include "tools/diag/diagnose.hpp"
+#include "diagnosis/diagnose.hpp"
+#include "tests/diagnosis/diag_fixture.hpp"
 
 int main(int argc, char** argv) {
   using namespace ftstack::diag;

@@ -7,8 +7,8 @@
 #include <utility>
 #include <vector>
 
-#include "tools/diag/diag_data.hpp"
-#include "tools/diag/effects.hpp"
+#include "diagnosis/data.hpp"
+#include "diagnosis/effects.hpp"
 
 namespace ftstack::diag {
 

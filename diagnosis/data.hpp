@@ -4,11 +4,13 @@
 
 #include <Eigen/Dense>
 #include <cstddef>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "measurement/recording.hpp"
+#include "measurement/wrench.hpp"
 
 namespace ftstack::diag {
 
@@ -45,9 +47,13 @@ using ProgressFn = void (*)(double fraction, const char* stage, void* user);
 /// Reads SIM.csv and REAL.csv (recording-format.md) and aligns them.
 [[nodiscard]] DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path,
                                    ProgressFn progress = nullptr, void* user = nullptr);
-/// Reads REAL.csv and predicts its bridges with the sensor description's model from the real
-/// wrench and temp_C (20 °C where absent).
-[[nodiscard]] DiagData LoadModelReal(const std::string& sensor_path, const std::string& real_path,
-                                     ProgressFn progress = nullptr, void* user = nullptr);
+/// Predicts the outputs (mV/V) of every bridge for a wrench (N, N·m) and a temperature (°C).
+using BridgePredictor = std::function<void(const Wrench& w, double temperature_c, double* out_mvv)>;
+/// Reads REAL.csv and predicts its bridges with `predict` (a model of `channels` bridges named
+/// `model_name`) from the real wrench and temp_C (20 °C where absent).
+[[nodiscard]] DiagData LoadPredictedReal(const std::string& real_path,
+                                         const std::string& model_name, int channels,
+                                         const BridgePredictor& predict,
+                                         ProgressFn progress = nullptr, void* user = nullptr);
 
 }  // namespace ftstack::diag

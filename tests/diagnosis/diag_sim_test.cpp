@@ -3,8 +3,8 @@
 // `none` recordings, pairs — named, located, key parameter recovered, ≥ 70 % of the excess removed.
 #include <gtest/gtest.h>
 
+#include "diagnosis/evaluation/scorecard.hpp"
 #include "sim/effects.hpp"
-#include "tools/diag/scorecard.hpp"
 
 namespace ftstack::diag {
 namespace {

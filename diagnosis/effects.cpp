@@ -1,4 +1,4 @@
-#include "tools/diag/effects.hpp"
+#include "diagnosis/effects.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <limits>
 
-#include "tools/diag/signal.hpp"
+#include "diagnosis/signal.hpp"
 
 namespace ftstack::diag {
 namespace {

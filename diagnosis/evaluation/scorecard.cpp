@@ -1,4 +1,4 @@
-#include "tools/diag/scorecard.hpp"
+#include "diagnosis/evaluation/scorecard.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <map>
 
+#include "diagnosis/diagnose.hpp"
 #include "sim/record.hpp"
-#include "tools/diag/diagnose.hpp"
 
 namespace ftstack::diag {
 namespace {

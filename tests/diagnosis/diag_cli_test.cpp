@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "measurement/recording.hpp"
-#include "tests/tools/diag_fixture.hpp"
+#include "tests/diagnosis/diag_fixture.hpp"
 
 namespace ftstack::diag {
 namespace {

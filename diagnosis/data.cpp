@@ -1,8 +1,6 @@
-#include "tools/diag/diag_data.hpp"
+#include "diagnosis/data.hpp"
 
 #include <algorithm>
-
-#include "sim/sensor_description.hpp"
 
 namespace ftstack::diag {
 namespace {
@@ -119,14 +117,9 @@ DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path, 
   }
 }
 
-DiagData LoadModelReal(const std::string& sensor_path, const std::string& real_path,
-                       ProgressFn progress, void* user) {
-  sim::SensorDescription desc;
-  try {
-    desc = sim::LoadSensorDescription(sensor_path);
-  } catch (const std::exception& e) {
-    throw DiagInputError(e.what());
-  }
+DiagData LoadPredictedReal(const std::string& real_path, const std::string& model_name,
+                           int channels, const BridgePredictor& predict, ProgressFn progress,
+                           void* user) {
   ProgressRelay r1{progress, user, 0.0, 0.8, "reading real"};
   Recording real;
   try {
@@ -143,13 +136,13 @@ DiagData LoadModelReal(const std::string& sensor_path, const std::string& real_p
     throw DiagInputError(e.what());
   }
   const std::size_t nr = real.BridgeCount();
-  if (static_cast<int>(nr) != desc.model->channel_count()) {
+  if (static_cast<int>(nr) != channels) {
     throw DiagInputError(real_path + ": has " + std::to_string(nr) +
-                         " bridge columns but the model " + sensor_path + " has " +
-                         std::to_string(desc.model->channel_count()));
+                         " bridge columns but the model " + model_name + " has " +
+                         std::to_string(channels));
   }
   DiagData d;
-  d.sim_name = sensor_path.empty() ? "builtin" : sensor_path;
+  d.sim_name = model_name;
   d.real_name = real_path;
   d.t_s = real.Column("t");
   d.real_mvv = Bridges(real, nr);
@@ -160,7 +153,8 @@ DiagData LoadModelReal(const std::string& sensor_path, const std::string& real_p
   for (Eigen::Index i = 0; i < n; ++i) {
     const Wrench w = d.wrench.row(i).transpose();
     const double temp = d.temp_c.empty() ? 20.0 : d.temp_c[static_cast<std::size_t>(i)];
-    const Eigen::VectorXd b = desc.model->BridgeOutputs(w, temp);
+    Eigen::VectorXd b(static_cast<Eigen::Index>(nr));
+    predict(w, temp, b.data());
     d.sim_mvv.row(i) = b.transpose();
     if (progress != nullptr && (i % 20000) == 0) {
       progress(0.8 + 0.2 * static_cast<double>(i) / static_cast<double>(n), "simulating", user);

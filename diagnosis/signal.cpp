@@ -1,4 +1,4 @@
-#include "tools/diag/signal.hpp"
+#include "diagnosis/signal.hpp"
 
 #include <algorithm>
 #include <cmath>

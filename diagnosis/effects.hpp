@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "tools/diag/diag_data.hpp"
+#include "diagnosis/data.hpp"
 
 namespace ftstack::diag {
 

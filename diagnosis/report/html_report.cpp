@@ -1,4 +1,4 @@
-#include "tools/diag/html_report.hpp"
+#include "diagnosis/report/html_report.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -343,6 +343,24 @@ void WriteHtml(const std::string& path, const DiagData& data, const Report& repo
   if (!out) throw std::runtime_error(path + ": cannot write");
   out << HtmlReport(data, report);
   if (!out) throw std::runtime_error(path + ": write failed");
+}
+
+void WriteJson(const std::string& path, const nlohmann::json& j) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot write");
+  out << j.dump(2) << "\n";
+  if (!out) throw std::runtime_error(path + ": write failed");
+}
+
+std::string SummaryText(const Report& report) {
+  char buf[160];
+  std::string s = "verdict: " + report.verdict;
+  for (std::size_t i = 1; i < report.effects.size(); ++i) s += " + " + report.effects[i].fit.name;
+  std::snprintf(buf, sizeof buf, "  (held-out RMS %.4g -> %.4g mV/V)\n", report.hold_rms_before,
+                report.hold_rms_after);
+  s += buf;
+  for (const auto& e : report.effects) s += "  " + e.fit.name + ": " + e.fit.evidence + "\n";
+  return s;
 }
 
 }  // namespace ftstack::diag

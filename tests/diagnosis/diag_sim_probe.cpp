@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "diagnosis/diagnose.hpp"
 #include "sim/record.hpp"
-#include "tools/diag/diagnose.hpp"
 
 int main(int argc, char** argv) {
   using namespace ftstack;

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "diagnosis/data.hpp"
 #include "sim/default_sensor.hpp"
-#include "tools/diag/diag_data.hpp"
 
 namespace ftstack::diag::testing {
 
