@@ -1,8 +1,8 @@
 // ftdiag: time to diagnose a 60 000-row × 6-channel simulator recording (issue 7 asks < 2 s).
 #include <benchmark/benchmark.h>
 
-#include "sim/record.hpp"
 #include "diagnosis/diagnose.hpp"
+#include "sim/record.hpp"
 
 namespace {
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "sim/effects.hpp"
 #include "measurement/recording.hpp"
+#include "sim/effects.hpp"
 #include "sim/sensor_description.hpp"
 
 namespace ftstack::sim {

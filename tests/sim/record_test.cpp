@@ -169,7 +169,9 @@ TEST(RecordProfiles, BadFilesNameTheFaultyPlace) {
       << ErrorOf(dir + "/bad.csv");
   // Found by fuzzing (fuzz/corpus/profile/regression_number_overflow.json): a number beyond
   // double, or a schema of the wrong JSON type, escaped as a JSON library exception.
-  { std::ofstream(dir + "/big.json") << "{\"schema\": \"ftstack-profile/1\", \"rate_hz\": 11e308}"; }
+  {
+    std::ofstream(dir + "/big.json") << "{\"schema\": \"ftstack-profile/1\", \"rate_hz\": 11e308}";
+  }
   EXPECT_NE(ErrorOf(dir + "/big.json").find("big.json: not valid JSON"), std::string::npos)
       << ErrorOf(dir + "/big.json");
   { std::ofstream(dir + "/type.json") << "{\"schema\": 1, \"keyframes\": []}"; }

@@ -4,9 +4,9 @@
 
 #include <cmath>
 
-#include "sim/ideal_calibration.hpp"
 #include "firmware/sampler.hpp"
 #include "hal/sim/sim_adc.hpp"
+#include "sim/ideal_calibration.hpp"
 #include "sim/sensor_description.hpp"
 #include "sim/simulated_sensor.hpp"
 

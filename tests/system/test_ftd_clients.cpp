@@ -9,9 +9,9 @@
 #include <random>
 
 #include "calibration/cal_file.hpp"
-#include "sim/ideal_calibration.hpp"
 #include "firmware/register_map.hpp"
 #include "sim/default_sensor.hpp"
+#include "sim/ideal_calibration.hpp"
 #include "tests/system/builtin_adc.hpp"
 #include "tests/system/ftd_process.hpp"
 

@@ -16,11 +16,11 @@
 #include <thread>
 
 #include "calibration/cal_file.hpp"
-#include "sim/ideal_calibration.hpp"
 #include "firmware/modbus_server.hpp"
 #include "firmware/register_map.hpp"
 #include "measurement/recording.hpp"
 #include "sim/default_sensor.hpp"
+#include "sim/ideal_calibration.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/system/builtin_adc.hpp"
 #include "tests/system/ftd_process.hpp"

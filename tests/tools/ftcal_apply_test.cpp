@@ -11,9 +11,9 @@
 #include <fstream>
 #include <random>
 
-#include "sim/ideal_calibration.hpp"
-#include "sim/default_sensor.hpp"
 #include "measurement/recording.hpp"
+#include "sim/default_sensor.hpp"
+#include "sim/ideal_calibration.hpp"
 
 namespace ftstack {
 namespace {
