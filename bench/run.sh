@@ -68,6 +68,7 @@ if [ -x "$B/bench_record" ]; then
         printf "  %-22s %8.0f rows %8.1f ms CPU\n", $1, $col["rows"], $4 }
       END { if (t["BM_RecordNone/300"] > 0) printf "  300 s: creep / none = %.2f, three effects / none = %.2f\n",
             t["BM_RecordCreep/300"] / t["BM_RecordNone/300"], t["BM_RecordThree/300"] / t["BM_RecordNone/300"] }'
+fi
 
 # --- ftdiag (issue 7): sim-vs-real diagnosis of 60 000 rows × 6 channels (target < 2 s) -------
 if [ -x "$B/bench_diag" ]; then
