@@ -1,6 +1,7 @@
 #include "daemon/daemon.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -32,6 +33,19 @@ fw::CalSlot SlotFromFile(const std::string& path, const hal::AdcInfo& adc,
   slot.present = true;
   if (rated != nullptr) *rated = file.rated;
   return slot;
+}
+
+/// Loads a calibration file into `slot`. A file that cannot be used (missing, corrupt, bad CRC,
+/// refused by the fixed-point loader) leaves the slot empty and is reported on stderr in one line
+/// naming it (file:line:column for syntax errors): the device still comes up.
+void LoadSlot(const std::string& path, const char* name, const hal::AdcInfo& adc, fw::CalSlot* slot,
+              std::array<double, 6>* rated) {
+  try {
+    *slot = SlotFromFile(path, adc, rated);
+  } catch (const std::exception& e) {
+    *slot = fw::CalSlot{};
+    std::fprintf(stderr, "ftd: calibration slot %s refused: %s\n", name, e.what());
+  }
 }
 
 /// A hardware converter (HX711 over GPIO, ADS131M over SPI); needs a calibration file.
@@ -127,21 +141,35 @@ void Ftd::Start() {
   }
   const hal::AdcInfo info = adc.Info();
   std::array<double, 6> rated{};
-  try {
-    if (opt_.cal.empty()) {
+  std::array<double, 6> rated_b{};
+  if (opt_.cal.empty()) {
+    try {
       const std::optional<cal::CalFile> builtin = backend_->BuiltinCalibration(info);
       if (!builtin) throw FtdError("--adc " + opt_.adc + " needs --cal CAL.json");
-      const cal::CalFile& ideal = *builtin;
-      cfg.slots[0].fixed = cal::ToFixed(ideal, info);
+      cfg.slots[0].fixed = cal::ToFixed(*builtin, info);
       cfg.slots[0].crc32 = FixedFormCrc(cfg.slots[0].fixed);
       cfg.slots[0].present = true;
-      rated = ideal.rated;
-    } else {
-      cfg.slots[0] = SlotFromFile(opt_.cal, info, &rated);
+      rated = builtin->rated;
+    } catch (const FtdError&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw FtdError(e.what());
     }
-    if (!opt_.cal_b.empty()) cfg.slots[1] = SlotFromFile(opt_.cal_b, info, nullptr);
-  } catch (const std::exception& e) {
-    throw FtdError(e.what());
+  } else {
+    LoadSlot(opt_.cal, "A", info, &cfg.slots[0], &rated);
+  }
+  if (!opt_.cal_b.empty()) LoadSlot(opt_.cal_b, "B", info, &cfg.slots[1], &rated_b);
+  // A field device comes up whatever its calibration files hold: on slot A if it is valid, else
+  // on a valid slot B (and says so), else without calibration (status bit 4, wrench invalid).
+  cfg.allow_uncalibrated = true;
+  if (!cfg.slots[0].present && cfg.slots[1].present) {
+    cfg.initial_slot = 1;
+    rated = rated_b;
+    std::fprintf(stderr, "ftd: running on calibration slot B (%s)\n", opt_.cal_b.c_str());
+  } else if (!cfg.slots[0].present) {
+    std::fprintf(stderr,
+                 "ftd: no valid calibration: serving with status bit 4 set and the wrench "
+                 "registers invalid\n");
   }
   for (std::size_t i = 0; i < fw::kAxes; ++i) {
     const double lsb = rated[i] / fw::AxisLsb(i);

@@ -14,9 +14,9 @@ std::uint64_t MonotonicUs() {
 DeviceStatus Device::Start(const DeviceConfig& config) {
   config_ = config;
   if (config.clock_us != nullptr) clock_ = config.clock_us;
-  if (config.initial_slot >= kCalSlots || !config.slots[config.initial_slot].present) {
-    return DeviceStatus::kNoCalibration;
-  }
+  if (config.initial_slot >= kCalSlots) return DeviceStatus::kNoCalibration;
+  const bool calibrated = config.slots[config.initial_slot].present;
+  if (!calibrated && !config.allow_uncalibrated) return DeviceStatus::kNoCalibration;
   bool any_rated = false;
   for (const std::int32_t r : config.rated_lsb) any_rated = any_rated || r != 0;
   if (any_rated && !overload_.Configure(config.rated_lsb)) return DeviceStatus::kBadRated;
@@ -29,7 +29,8 @@ DeviceStatus Device::Start(const DeviceConfig& config) {
     tare_samples_ =
         static_cast<std::uint16_t>(n < 1 ? 1 : (n > kMaxTareSamples ? kMaxTareSamples : n));
   }
-  core_.SetCalibration(config.slots[config.initial_slot].fixed);
+  // Without a calibration the core gets an invalid one: bit 4, wrench registers NaN / 0.
+  core_.SetCalibration(calibrated ? config.slots[config.initial_slot].fixed : FixedCalibration{});
   active_ = DeviceSettings{};
   active_.cal_slot = config.initial_slot;
   active_.filter_length = core_.filter_length();

@@ -60,6 +60,9 @@ struct DeviceConfig {
   std::int32_t temp_max_mdegc = 50000;
   std::uint16_t tare_samples = 0;         ///< samples averaged by a tare; 0: rate/10 (0.1 s)
   std::uint64_t (*clock_us)() = nullptr;  ///< monotonic µs; nullptr: CLOCK_MONOTONIC
+  /// Start even when the initial slot holds no calibration: the device then samples and serves
+  /// with kStatusCalInvalid and an invalid wrench (a field device comes up and says why).
+  bool allow_uncalibrated = false;
 };
 
 /// Why Device::Start failed.

@@ -21,6 +21,7 @@
 #include "measurement/recording.hpp"
 #include "sim/default_sensor.hpp"
 #include "sim/ideal_calibration.hpp"
+#include "sim/sensor_description.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/system/builtin_adc.hpp"
 #include "tests/system/ftd_process.hpp"
@@ -653,6 +654,55 @@ TEST(FtdModbus, OverloadUnderTareSeesTheLoadOnTheBody) {
   EXPECT_EQ(UnpackU32(&r[fw::kInOverloadEvents]), 1u);
   EXPECT_GE(UnpackFloat32(&r[fw::kInPeaks + 4]), 455.0f);
   EXPECT_EQ(ftd.Stop(), 0);
+}
+
+/// Issue 17 item 7: a calibration file that cannot be used does not keep a field device down. It
+/// comes up, logs why (file:line:column), runs on a valid slot B if there is one, and otherwise
+/// serves the map with status bit 4 set and the wrench registers invalid.
+TEST(FtdModbus, UnusableCalibrationFilesStillServeAndSayWhy) {
+  const test::TempDir tmp("ftd_badcal");
+  const std::string bad = tmp / "bad.json";
+  {
+    std::ofstream f(bad);
+    f << "{\n  \"schema\": \"ftstack-cal/1\",\n  \"matrix\": [1, 2,\n";  // truncated JSON
+  }
+  const std::string good = tmp / "good.json";
+  {
+    const test::BuiltinAdc builtin = test::BuiltinSimAdc();
+    const sim::SensorDescription desc = sim::DefaultSensorDescription();
+    cal::SaveCalFile(good, sim::IdealCalibration(*desc.model, builtin.info));
+  }
+  auto status_of = [](test::FtdProcess& ftd,
+                      std::array<std::uint16_t, fw::kInputRegisterCount>* r) {
+    Client c(ftd.port());
+    if (!c.WaitSamples(50)) return false;
+    return c.Input(0, fw::kInputRegisterCount, r->data()) == fw::kInputRegisterCount;
+  };
+  std::array<std::uint16_t, fw::kInputRegisterCount> r{};
+  {  // bad A, good B: runs on B and says so
+    test::FtdProcess ftd({"--sim-wrench", "0,0,50,0,0,0", "--cal", bad, "--cal-b", good,
+                          "--modbus-tcp", "127.0.0.1:0"});
+    ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
+    ASSERT_TRUE(status_of(ftd, &r));
+    EXPECT_EQ(r[fw::kInStatus] & fw::kStatusCalInvalid, 0);
+    EXPECT_EQ(r[fw::kInCalSlot], 1);
+    EXPECT_NEAR(UnpackFloat32(&r[fw::kInWrenchFloat + 4]), 50.0, 1.0);
+    EXPECT_EQ(ftd.Stop(), 0);
+    EXPECT_NE(ftd.Stderr().find(bad + ":4:1"), std::string::npos) << ftd.Stderr();
+    EXPECT_NE(ftd.Stderr().find("slot B"), std::string::npos) << ftd.Stderr();
+  }
+  {  // bad A (corrupt) and bad B (missing): serves, bit 4 set, wrench invalid
+    test::FtdProcess ftd(
+        {"--cal", bad, "--cal-b", tmp / "missing.json", "--modbus-tcp", "127.0.0.1:0"});
+    ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
+    ASSERT_TRUE(status_of(ftd, &r));
+    EXPECT_NE(r[fw::kInStatus] & fw::kStatusCalInvalid, 0);
+    EXPECT_TRUE(std::isnan(UnpackFloat32(&r[fw::kInWrenchFloat + 4])));
+    EXPECT_EQ(UnpackI32(&r[fw::kInWrenchInt + 4]), 0);
+    EXPECT_EQ(ftd.Stop(), 0);
+    EXPECT_NE(ftd.Stderr().find("missing.json"), std::string::npos) << ftd.Stderr();
+    EXPECT_NE(ftd.Stderr().find("status bit 4"), std::string::npos) << ftd.Stderr();
+  }
 }
 
 }  // namespace
