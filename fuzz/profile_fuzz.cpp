@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <string>
 
@@ -21,5 +22,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     (void)ftstack::sim::MakeProfile(path, rated, 1, 0.0);
   } catch (const ftstack::sim::ProfileError&) {
   }
+  std::remove(path.c_str());  // libFuzzer may end with _exit: leave nothing behind each time
   return 0;
 }

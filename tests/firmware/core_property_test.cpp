@@ -149,26 +149,33 @@ TEST(CoreProperty, WithinOneLsbOfLongDoubleReferenceOrRefusedForOverflow) {
   EXPECT_LT(max_err_lsb, 0.75L);
 }
 
+/// A core running `k`'s calibration (refused: false) with a tare taken on `samples` identical
+/// samples at random counts (possibly at a rail); *held is that sample, *fixed the loaded form.
+bool TaredCore(const Case& k, std::mt19937_64& rng, int samples, WrenchCore* core,
+               FixedCalibration* fixed, hal::AdcSample* held) {
+  LoadReport rep{};
+  if (LoadCalibration(k.cal, k.adc, fixed, &rep) != LoadStatus::kOk) return false;
+  core->SetCalibration(*fixed);
+  core->SetLimits(CoreLimits{0, 0});
+  *held = hal::AdcSample{};
+  held->channel_count = k.cal.channel_count;
+  held->counts = RandomCounts(rng, k.adc);
+  if (!core->RequestTare(static_cast<std::uint16_t>(samples))) return false;
+  CoreOutput out{};
+  for (int i = 0; i < samples; ++i) core->Process(*held, false, out);  // flags clear: accepted
+  return core->tare_active();
+}
+
 TEST(CoreProperty, TaredPathWithinOneLsbIncludingRailToRail) {
   std::mt19937_64 rng(7);
   int checked = 0;
   for (int trial = 0; trial < 1500; ++trial) {
     const Case k = RandomCase(rng);
     FixedCalibration fixed{};
-    LoadReport rep{};
-    if (LoadCalibration(k.cal, k.adc, &fixed, &rep) != LoadStatus::kOk) continue;
     WrenchCore core;
-    core.SetCalibration(fixed);
-    core.SetLimits(CoreLimits{0, 0});
-    // Tare on a sample held at a random point (possibly a rail): feed identical samples.
-    auto tare = RandomCounts(rng, k.adc);
-    ASSERT_TRUE(core.RequestTare(4));
-    hal::AdcSample s{};
-    s.channel_count = k.cal.channel_count;
-    s.counts = tare;
-    CoreOutput out{};
-    for (int i = 0; i < 4; ++i) core.Process(s, false, out);  // flags clear: the tare accepts it
-    ASSERT_TRUE(core.tare_active());
+    hal::AdcSample held{};
+    if (!TaredCore(k, rng, 4, &core, &fixed, &held)) continue;  // refused calibrations
+    const auto tare = held.counts;
     for (int i = 0; i < 10; ++i) {
       const auto x = RandomCounts(rng, k.adc);
       WrenchLsb y{};
@@ -194,18 +201,10 @@ TEST(CoreProperty, StructuralLoadIgnoresTheTareWithinTwoLsb) {
   for (int trial = 0; trial < 4000; ++trial) {
     const Case k = RandomCase(rng);
     FixedCalibration fixed{};
-    LoadReport rep{};
-    if (LoadCalibration(k.cal, k.adc, &fixed, &rep) != LoadStatus::kOk) continue;
     WrenchCore core;
-    core.SetCalibration(fixed);
-    core.SetLimits(CoreLimits{0, 0});
     hal::AdcSample s{};
-    s.channel_count = k.cal.channel_count;
-    s.counts = RandomCounts(rng, k.adc);
+    if (!TaredCore(k, rng, 2, &core, &fixed, &s)) continue;  // refused calibrations
     CoreOutput out{};
-    ASSERT_TRUE(core.RequestTare(2));
-    for (int i = 0; i < 2; ++i) core.Process(s, false, out);
-    ASSERT_TRUE(core.tare_active());
     for (int i = 0; i < 5; ++i) {
       s.counts = RandomCounts(rng, k.adc);
       core.Process(s, false, out);
