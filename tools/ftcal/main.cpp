@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
   std::string report_path;
   std::string model_name = "auto";
   std::string rated_text;
-  std::string sensor_path;
+  std::string fit_sensor;  // each subcommand its own: design's default is not fit's
   std::string serial = "unknown";
   int folds = 10;
 
@@ -58,9 +58,11 @@ int main(int argc, char** argv) {
   fit->add_option("--model", model_name,
                   "auto (best held-out), linear, linear-temp, quadratic, quadratic-temp");
   fit->add_option("--rated", rated_text,
-                  "rated range FX,FY,FZ,MX,MY,MZ (default: --sensor's, "
-                  "else the largest load in the data)");
-  fit->add_option("--sensor", sensor_path, "sensor description (rated range and ADC), or builtin");
+                  "rated range FX,FY,FZ,MX,MY,MZ (default: --sensor's; one of the two is "
+                  "required)");
+  fit->add_option("--sensor", fit_sensor,
+                  "sensor description (rated range and converter), or builtin; without it the "
+                  "file is made for a generic 24-bit converter of +-3.90625 mV/V");
   fit->add_option("--serial", serial, "serial number written to the file");
   fit->add_option("--folds", folds, "cross-validation folds over whole load blocks")
       ->check(CLI::Range(2, 100));
@@ -91,8 +93,9 @@ int main(int argc, char** argv) {
   std::string simulate_out;
   double rate_hz = 1000.0;
   std::vector<double> temps;
+  std::string design_sensor;
   auto* design = app.add_subcommand("design", "propose a calibration rig load sequence");
-  design->add_option("--sensor", sensor_path, "sensor description or builtin")
+  design->add_option("--sensor", design_sensor, "sensor description or builtin")
       ->default_val("builtin");
   design->add_option("--out", profile_out, "keyframe profile CSV (t, Fx…Mz, temp_C)");
   design->add_option("--simulate", simulate_out, "also simulate the rig into this recording");
@@ -112,8 +115,12 @@ int main(int argc, char** argv) {
       fo.folds = folds;
       hal::AdcInfo adc{};
       bool have_adc = false;
-      if (!sensor_path.empty()) {
-        const sim::SensorDescription s = sim::LoadSensorDescription(sensor_path);
+      if (fit_sensor.empty() && rated_text.empty()) {
+        throw std::invalid_argument(
+            "fit needs the rated range: give --sensor FILE|builtin or --rated FX,FY,FZ,MX,MY,MZ");
+      }
+      if (!fit_sensor.empty()) {
+        const sim::SensorDescription s = sim::LoadSensorDescription(fit_sensor);
         const Wrench r = s.model->rated();
         for (int a = 0; a < 6; ++a) fo.rated[static_cast<std::size_t>(a)] = r(a);
         adc.channel_count = static_cast<std::uint8_t>(s.model->channel_count());
@@ -133,7 +140,10 @@ int main(int argc, char** argv) {
       bo.scale = fo.rated;
       const cal::RigData data = cal::RigDataFromRecording(rec, bo);
       const cal::FitResult result = cal::FitCalibration(data, fo);
-      if (!have_adc) adc = cal::DefaultAdc(static_cast<std::uint8_t>(data.bridges.cols()));
+      if (!have_adc) {
+        adc = cal::DefaultAdc(static_cast<std::uint8_t>(data.bridges.cols()));
+        std::printf("converter: generic 24-bit, +-3.90625 mV/V (no --sensor)\n");
+      }
       const cal::CalFile file = cal::CalFileFromFit(result, adc, serial, Today());
       fw::LoadReport rep{};
       (void)cal::ToFixed(file, file.adc, &rep);
@@ -195,7 +205,7 @@ int main(int argc, char** argv) {
           cal.cal.temperature_compensated ? "compensated" : "not compensated", cal.serial.c_str());
       PrintWorstCase(rep);
     } else if (*design) {
-      const sim::SensorDescription s = sim::LoadSensorDescription(sensor_path);
+      const sim::SensorDescription s = sim::LoadSensorDescription(design_sensor);
       sim::RigDesignOptions ro;
       ro.temperatures_c = temps;
       const auto steps = sim::DesignRig(s.model->rated(), ro);
