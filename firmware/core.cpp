@@ -87,7 +87,7 @@ void WrenchCore::ExtraFeatures(const std::array<std::int32_t, kMaxChannels>& cou
         f[k] = dt_mdegc;
         break;
       case FeatureKind::kProduct: {
-        // |x̃| < 2^32 each: the product fits int64; the loader sized the shift.
+        // The loader proved |x̃_a·x̃_b| + 2^(shift−1) ≤ 2^63 − 1 (RawProductFits): no overflow.
         const std::int64_t xa = static_cast<std::int64_t>(counts[e.a]) - cal_.zero[e.a];
         const std::int64_t xb = static_cast<std::int64_t>(counts[e.b]) - cal_.zero[e.b];
         f[k] = RoundShift(xa * xb, e.shift);

@@ -95,6 +95,9 @@ enum class LoadStatus : std::uint8_t {
   kBadAdcScaling,    ///< ADC info without a usable full scale or rails
   kOutputOverflow,   ///< some input between the rails would drive an axis past int32
   kBadTerms,         ///< product term out of range, or temperature range/reference unusable
+  /// A second-order feature's raw product (x̃_a·x̃_b or x̃·ΔT, plus its rounding half) could pass
+  /// int64 for inputs between the rails (ADC rails too wide for the product terms).
+  kFeatureOverflow,
 };
 
 [[nodiscard]] const char* ToString(LoadStatus s);

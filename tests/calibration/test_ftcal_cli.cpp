@@ -3,6 +3,7 @@
 
 #include <sys/wait.h>
 #include <unistd.h>
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -92,6 +93,34 @@ TEST_F(FtcalCli, DesignFitVerifyApply) {
   const auto& ref = in.Column("Fz");
   const auto& got = out.Column("Fz");
   for (std::size_t i = 0; i < ref.size(); ++i) ASSERT_NEAR(got[i], ref[i], 0.2) << i;
+}
+
+TEST_F(FtcalCli, FitWithoutSensorNeedsTheRatedRangeAndTakesNothingFromDesign) {
+  CliRun r = Ftcal("design --sensor builtin --rate-hz 50 --simulate " + P("rig.csv"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  // Neither --sensor nor --rated: refused in one line naming both (it used to take the built-in
+  // sensor's rating and converter silently, through a variable shared with design's default).
+  r = Ftcal("fit --in " + P("rig.csv") + " --out " + P("cal.json"));
+  EXPECT_NE(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("--rated"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--sensor"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(P("cal.json")));
+  // --rated alone: that rating, and the generic converter the help names (not the built-in
+  // sensor's ADS131M at gain 128), said on stdout.
+  r = Ftcal("fit --in " + P("rig.csv") + " --out " + P("cal.json") +
+            " --rated 400,400,800,20,20,16");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("converter: generic 24-bit"), std::string::npos) << r.out;
+  const ftstack::cal::CalFile cal = ftstack::cal::LoadCalFile(P("cal.json"));
+  const std::array<double, 6> rated = {400, 400, 800, 20, 20, 16};
+  EXPECT_EQ(cal.rated, rated);
+  EXPECT_EQ(cal.adc.full_scale_nvv, 3906250);  // ±3.90625 mV/V
+  EXPECT_EQ(cal.adc.max_counts, (1 << 23) - 1);
+  // --sensor builtin: its converter, not the generic one.
+  r = Ftcal("fit --in " + P("rig.csv") + " --out " + P("cal_b.json") + " --sensor builtin");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(r.out.find("converter: generic"), std::string::npos) << r.out;
+  EXPECT_NE(ftstack::cal::LoadCalFile(P("cal_b.json")).adc.full_scale_nvv, 3906250);
 }
 
 TEST_F(FtcalCli, ImportAtiThenInstallIntoSlots) {
