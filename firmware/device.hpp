@@ -131,6 +131,9 @@ class Device {
   std::uint32_t publish_sequence_ = 0;
   std::uint64_t samples_ = 0;
   std::atomic<std::uint64_t> last_sample_us_{0};
+  std::uint64_t start_us_ = 0;       ///< device clock at Start: the samples' time origin
+  std::uint64_t last_stamp_us_ = 0;  ///< time given to the previous sample, since Start
+  bool stamped_ = false;
   std::uint64_t previous_read_us_ = 0;  ///< 0 until the first sample
   std::uint32_t late_samples_ = 0;
 };

@@ -11,8 +11,10 @@ namespace ftstack::fw {
 
 /// One published sample: everything a Modbus reply or a log row is made of.
 struct PublishedSample {
-  std::uint32_t sequence = 0;         ///< +1 per published sample, wraps
-  std::uint32_t timestamp_us = 0;     ///< conversion time since start, wraps every 2^32 µs
+  std::uint32_t sequence = 0;  ///< +1 per published sample, wraps
+  /// Time since start, wraps every 2^32 µs: the backend's conversion time from Sampler, replaced
+  /// by Device with the monotonic time the sample was read.
+  std::uint32_t timestamp_us = 0;
   std::uint16_t timestamp_wraps = 0;  ///< how often timestamp_us wrapped (bits 32–47 of the time)
   WrenchLsb wrench{};                 ///< mN and 10 µN·m
   std::uint8_t channel_count = 0;
