@@ -45,6 +45,12 @@ void LoadSlot(const std::string& path, const char* name, const hal::AdcInfo& adc
               std::array<double, 6>* rated) {
   try {
     *slot = SlotFromFile(path, adc, rated);
+    if (slot->fixed.invalid_axes != 0) {
+      std::fprintf(stderr,
+                   "ftd: calibration slot %s (%s) flags axis %s invalid (not calibrated): served "
+                   "as NaN / 0 with status bit 10\n",
+                   name, path.c_str(), cal::AxisList(slot->fixed.invalid_axes).c_str());
+    }
   } catch (const std::exception& e) {
     *slot = fw::CalSlot{};
     std::fprintf(stderr, "ftd: calibration slot %s refused: %s\n", name, e.what());

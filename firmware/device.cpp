@@ -148,7 +148,13 @@ hal::Status Device::Step(bool* published) {
     bool sat = false;
     ApplyToolTransform(active_.transform, p.wrench, &d.sample.wrench, &sat);
     if (sat) status |= kStatusSaturated;  // the tool-frame wrench was clipped
+    // An axis the calibration does not determine taints every tool-frame axis it enters.
+    d.sample.invalid_axes = ToolFrameInvalidAxes(active_.transform, p.invalid_axes);
+    for (std::size_t i = 0; i < kAxes; ++i) {
+      if ((d.sample.invalid_axes & (1u << i)) != 0) d.sample.wrench[i] = 0;
+    }
   }
+  d.peaks_invalid_axes = p.invalid_axes;
   if (p.has_temperature && (p.temperature_mdegc < config_.temp_min_mdegc ||
                             p.temperature_mdegc > config_.temp_max_mdegc)) {
     status |= kStatusTempRange;

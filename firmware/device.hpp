@@ -28,6 +28,7 @@ struct DeviceSample {
   std::uint32_t publish_period_us = 0;  ///< expected time between publications
   std::uint32_t sample_period_us = 0;   ///< expected time between samples (the stale limit's unit)
   std::uint32_t late_samples = 0;       ///< samples read late since start (missed deadlines)
+  std::uint8_t peaks_invalid_axes = 0;  ///< bit r: peak r is not a value (sensor frame)
 };
 
 /// One calibration slot as the device holds it.

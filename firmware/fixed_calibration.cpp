@@ -278,6 +278,7 @@ LoadStatus LoadCalibration(const FloatCalibration& cal, const hal::AdcInfo& adc,
     rep.worst_case_error_lsb[r] = err;
     rep.worst_case_error_si[r] = err * lsb;
   }
+  fixed.invalid_axes = static_cast<std::uint8_t>(cal.invalid_axes & ((1u << kAxes) - 1));
   fixed.valid = true;
   *out = fixed;
   return finish(LoadStatus::kOk);

@@ -22,6 +22,9 @@ struct PublishedSample {
   std::int32_t temperature_mdegc = 0;                        ///< m°C, valid if has_temperature
   bool has_temperature = false;
   std::uint16_t status = 0;  ///< StatusBit set
+  /// Bit r: wrench axis r is not a value (the calibration does not determine it; status bit
+  /// 10). Sensor frame from Sampler; the frame of `wrench` once Device published it.
+  std::uint8_t invalid_axes = 0;
 };
 
 /// Drives one ADC through the core. Call Step() in the sampling thread's loop.

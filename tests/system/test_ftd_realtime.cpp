@@ -22,6 +22,7 @@
 #include "measurement/recording.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/system/ftd_process.hpp"
+#include "tests/system/modbus_tcp_client.hpp"
 
 namespace ftstack {
 namespace {
@@ -41,24 +42,15 @@ struct Poll {
   double received_s = 0;
 };
 
-class Client {
+/// Reads the registers that matter here in one request.
+class Client : public test::ModbusTcpClient {
  public:
-  explicit Client(int port) {
-    ctx_ = modbus_new_tcp("127.0.0.1", port);
-    modbus_set_slave(ctx_, 1);
-    modbus_set_response_timeout(ctx_, 2, 0);
-    connected_ = modbus_connect(ctx_) == 0;
-  }
-  ~Client() {
-    modbus_close(ctx_);
-    modbus_free(ctx_);
-  }
-  [[nodiscard]] bool connected() const { return connected_; }
+  using ModbusTcpClient::ModbusTcpClient;
   /// Reads registers 0 … 76 in one request (one sample); false on any failure.
   bool Read(Poll* p, Clock::time_point t0) {
     std::uint16_t r[kRegs] = {};
     p->sent_s = std::chrono::duration<double>(Clock::now() - t0).count();
-    const int rc = modbus_read_input_registers(ctx_, 0, kRegs, r);
+    const int rc = modbus_read_input_registers(ctx(), 0, kRegs, r);
     p->received_s = std::chrono::duration<double>(Clock::now() - t0).count();
     if (rc != kRegs) return false;
     p->seq = UnpackU32(&r[fw::kInSequence]);
@@ -66,10 +58,6 @@ class Client {
     p->late = UnpackU32(&r[fw::kInLateSamples]);
     return true;
   }
-
- private:
-  modbus_t* ctx_ = nullptr;
-  bool connected_ = false;
 };
 
 /// Busy processes loading the CPU, killed by PID when the guard goes.

@@ -7,6 +7,7 @@
 #include "calibration/apply.hpp"
 #include "calibration/ati.hpp"
 #include "calibration/cal_file.hpp"
+#include "calibration/excitation.hpp"
 #include "calibration/fit.hpp"
 #include "calibration/fit_report.hpp"
 #include "calibration/slots.hpp"
@@ -49,6 +50,7 @@ int main(int argc, char** argv) {
   std::string fit_sensor;  // each subcommand its own: design's default is not fit's
   std::string serial = "unknown";
   int folds = 10;
+  bool allow_unexcited = false;
 
   auto* fit = app.add_subcommand("fit", "fit a calibration to rig data (reference wrench + b*)");
   fit->add_option("--in", in_path, "rig recording (t, Fx…Mz, b0…, optional temp_C, block/pose)")
@@ -66,6 +68,9 @@ int main(int argc, char** argv) {
   fit->add_option("--serial", serial, "serial number written to the file");
   fit->add_option("--folds", folds, "cross-validation folds over whole load blocks")
       ->check(CLI::Range(2, 100));
+  fit->add_flag("--allow-unexcited", allow_unexcited,
+                "write axes the rig did not excite flagged invalid (ftd then never serves them) "
+                "instead of refusing");
 
   auto* apply = app.add_subcommand("apply", "run the firmware's fixed-point core on a recording");
   apply->add_option("--cal", cal_path, "calibration file")->required();
@@ -139,16 +144,32 @@ int main(int argc, char** argv) {
       cal::BlockOptions bo;
       bo.scale = fo.rated;
       const cal::RigData data = cal::RigDataFromRecording(rec, bo);
+      // Every axis must be excited (range against rated, independent of the others), or be
+      // written flagged invalid when the user asks: never a row the data could not determine.
+      const cal::ExcitationOptions eo;
+      const cal::ExcitationReport ex = cal::CheckExcitation(data.wrench, fo.rated, eo);
+      if (ex.unexcited != 0 && !allow_unexcited) {
+        throw std::invalid_argument(in_path + ": " + ex.Refusal(fo.rated, eo) +
+                                    ": refused (--allow-unexcited writes it flagged invalid)");
+      }
       const cal::FitResult result = cal::FitCalibration(data, fo);
       if (!have_adc) {
         adc = cal::DefaultAdc(static_cast<std::uint8_t>(data.bridges.cols()));
         std::printf("converter: generic 24-bit, +-3.90625 mV/V (no --sensor)\n");
       }
-      const cal::CalFile file = cal::CalFileFromFit(result, adc, serial, Today());
+      cal::CalFile file = cal::CalFileFromFit(result, adc, serial, Today());
+      file.cal.invalid_axes = ex.unexcited;
       fw::LoadReport rep{};
       (void)cal::ToFixed(file, file.adc, &rep);
       cal::SaveCalFile(out_path, file);
       std::printf("%s", cal::FitSummary(result, rep).c_str());
+      if (ex.unexcited != 0) {
+        std::printf(
+            "warning: %s: flagged invalid in %s — ftd serves no value for %s (NaN / 0, "
+            "status bit 10)\n",
+            ex.Refusal(fo.rated, eo).c_str(), out_path.c_str(),
+            cal::AxisList(ex.unexcited).c_str());
+      }
       if (!report_path.empty()) {
         cal::WriteFitReport(report_path, result, data, rep, in_path);
         std::printf("report: %s\n", report_path.c_str());
@@ -163,9 +184,8 @@ int main(int argc, char** argv) {
                   ati_path.c_str(), imp.version.c_str(), imp.file.serial.c_str(),
                   imp.file.cal.channel_count,
                   imp.used_user_axis ? "UserAxis rows" : "Axis rows / scale + BasicTransform");
-      static const char* const kAxisNames[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
       for (std::size_t a = 0; a < 6; ++a) {
-        std::printf("  %s (%s/V):", kAxisNames[a], a < 3 ? "N" : "N*m");
+        std::printf("  %s (%s/V):", cal::kAxisNames[a], a < 3 ? "N" : "N*m");
         for (std::size_t c = 0; c < imp.file.cal.channel_count; ++c) {
           std::printf(" %10.5f", imp.file.cal.matrix[a][c]);
         }
@@ -189,6 +209,12 @@ int main(int argc, char** argv) {
                   f.date.c_str(), f.source.c_str());
     } else if (*apply) {
       const cal::CalFile cal = cal::LoadCalFile(cal_path);
+      if (cal.cal.invalid_axes != 0) {
+        std::fprintf(stderr,
+                     "ftcal: warning: %s flags axis %s invalid (not calibrated): its column holds "
+                     "0, not a measurement\n",
+                     cal_path.c_str(), cal::AxisList(cal.cal.invalid_axes).c_str());
+      }
       ReadOptions opt;
       opt.require_bridges = true;
       const Recording in = ReadRecording(in_path, opt);
@@ -198,6 +224,16 @@ int main(int argc, char** argv) {
       const cal::CalFile cal = cal::LoadCalFile(cal_path);
       fw::LoadReport rep{};
       (void)cal::ToFixed(cal, cal.adc, &rep);
+      if (cal.cal.invalid_axes != 0) {
+        // Intact, but not a calibration of every axis: never "OK" alone (exit 3).
+        std::printf(
+            "%s: INCOMPLETE: axis %s flagged invalid (not excited on the rig): ftd serves "
+            "no value for it (NaN / 0, status bit 10); the file itself is intact (CRC "
+            "valid)\n",
+            cal_path.c_str(), cal::AxisList(cal.cal.invalid_axes).c_str());
+        PrintWorstCase(rep);
+        return 3;
+      }
       std::printf(
           "%s: OK (schema %s, %d channels, %d second-order terms, temperature %s, "
           "serial %s, CRC valid, fixed-point form matches)\n",
