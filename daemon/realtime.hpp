@@ -7,11 +7,12 @@
 
 namespace ftstack::daemon {
 
-/// SCHED_FIFO priority asked for the sampling thread (capped at RLIMIT_RTPRIO when not root).
+/// SCHED_FIFO priority asked for the sampling thread (capped at RLIMIT_RTPRIO without
+/// CAP_SYS_NICE).
 inline constexpr int kSamplingPriority = 50;
 
-/// Locks the process's memory (mlockall, current and future) where the system permits it: as
-/// root or with an unlimited RLIMIT_MEMLOCK (a limited lock would make later allocations fail).
+/// Locks the process's memory (mlockall, current and future) where the system permits it: with
+/// CAP_IPC_LOCK or an unlimited RLIMIT_MEMLOCK (a limited lock would make later allocations fail).
 /// Returns the clause for the report: "memory locked" or why not.
 [[nodiscard]] std::string LockMemory();
 
