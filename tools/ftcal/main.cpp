@@ -37,6 +37,87 @@ void PrintWorstCase(const ftstack::fw::LoadReport& rep) {
 
 }  // namespace
 
+/// What `ftcal fit` is told.
+struct FitArgs {
+  std::string in_path;
+  std::string out_path;
+  std::string report_path;
+  std::string model_name = "auto";
+  std::string rated_text;
+  std::string fit_sensor;  // fit's own: design's default (builtin) is not fit's
+  std::string serial = "unknown";
+  int folds = 10;
+  bool allow_unexcited = false;
+};
+
+/// `ftcal fit`: reads the rig recording, checks every axis's excitation, fits, writes. Throws.
+void RunFit(const FitArgs& args) {
+  using namespace ftstack;
+  ReadOptions opt;
+  opt.require_bridges = true;
+  opt.require_wrench = true;
+  const Recording rec = ReadRecording(args.in_path, opt);
+  cal::FitOptions fo;
+  fo.folds = args.folds;
+  hal::AdcInfo adc{};
+  bool have_adc = false;
+  if (args.fit_sensor.empty() && args.rated_text.empty()) {
+    throw std::invalid_argument(
+        "fit needs the rated range: give --sensor FILE|builtin or --rated FX,FY,FZ,MX,MY,MZ");
+  }
+  if (!args.fit_sensor.empty()) {
+    const sim::SensorDescription s = sim::LoadSensorDescription(args.fit_sensor);
+    const Wrench r = s.model->rated();
+    for (int a = 0; a < 6; ++a) fo.rated[static_cast<std::size_t>(a)] = r(a);
+    adc.channel_count = static_cast<std::uint8_t>(s.model->channel_count());
+    const std::int64_t half = std::int64_t{1} << (s.adc.resolution_bits - 1);
+    adc.max_counts = static_cast<std::int32_t>(half - 1);
+    adc.min_counts = static_cast<std::int32_t>(-half);
+    adc.full_scale_nvv = std::llround(1000.0 * s.adc.reference_ratio / s.adc_gain * 1e6);
+    have_adc = true;
+  }
+  if (!args.rated_text.empty()) fo.rated = tools::ParseWrench(args.rated_text);
+  if (args.model_name != "auto") {
+    const auto k = cal::ParseModelKind(args.model_name);
+    if (!k) throw std::invalid_argument("unknown --model '" + args.model_name + "'");
+    fo.models = {*k};
+  }
+  cal::BlockOptions bo;
+  bo.scale = fo.rated;
+  const cal::RigData data = cal::RigDataFromRecording(rec, bo);
+  // Every axis must be excited (range against rated, independent of the others), or be
+  // written flagged invalid when the user asks: never a row the data could not determine.
+  const cal::ExcitationOptions eo;
+  const cal::ExcitationReport ex = cal::CheckExcitation(data.wrench, fo.rated, eo);
+  if (ex.unexcited != 0 && !args.allow_unexcited) {
+    throw std::invalid_argument(args.in_path + ": " + ex.Refusal(fo.rated, eo) +
+                                ": refused (--allow-unexcited writes it flagged invalid)");
+  }
+  const cal::FitResult result = cal::FitCalibration(data, fo);
+  if (!have_adc) {
+    adc = cal::DefaultAdc(static_cast<std::uint8_t>(data.bridges.cols()));
+    std::printf("converter: generic 24-bit, +-3.90625 mV/V (no --sensor)\n");
+  }
+  cal::CalFile file = cal::CalFileFromFit(result, adc, args.serial, Today());
+  file.cal.invalid_axes = ex.unexcited;
+  fw::LoadReport rep{};
+  (void)cal::ToFixed(file, file.adc, &rep);
+  cal::SaveCalFile(args.out_path, file);
+  std::printf("%s", cal::FitSummary(result, rep).c_str());
+  if (ex.unexcited != 0) {
+    std::printf(
+        "warning: %s: flagged invalid in %s — ftd serves no value for %s (NaN / 0, "
+        "status bit 10)\n",
+        ex.Refusal(fo.rated, eo).c_str(), args.out_path.c_str(),
+        cal::AxisList(ex.unexcited).c_str());
+  }
+  if (!args.report_path.empty()) {
+    cal::WriteFitReport(args.report_path, result, data, rep, args.in_path);
+    std::printf("report: %s\n", args.report_path.c_str());
+  }
+  std::printf("wrote %s\n", args.out_path.c_str());
+}
+
 int main(int argc, char** argv) {
   using namespace ftstack;
   CLI::App app{"ftcal — fit, apply, import and verify force/torque calibrations"};
@@ -44,31 +125,25 @@ int main(int argc, char** argv) {
   std::string cal_path;
   std::string in_path;
   std::string out_path;
-  std::string report_path;
-  std::string model_name = "auto";
-  std::string rated_text;
-  std::string fit_sensor;  // each subcommand its own: design's default is not fit's
-  std::string serial = "unknown";
-  int folds = 10;
-  bool allow_unexcited = false;
+  FitArgs fa;  // fit's options are its own (design's --sensor default must not reach it)
 
   auto* fit = app.add_subcommand("fit", "fit a calibration to rig data (reference wrench + b*)");
-  fit->add_option("--in", in_path, "rig recording (t, Fx…Mz, b0…, optional temp_C, block/pose)")
+  fit->add_option("--in", fa.in_path, "rig recording (t, Fx…Mz, b0…, optional temp_C, block/pose)")
       ->required();
-  fit->add_option("--out", out_path, "calibration file to write")->required();
-  fit->add_option("--report", report_path, "self-contained HTML report with plots");
-  fit->add_option("--model", model_name,
+  fit->add_option("--out", fa.out_path, "calibration file to write")->required();
+  fit->add_option("--report", fa.report_path, "self-contained HTML report with plots");
+  fit->add_option("--model", fa.model_name,
                   "auto (best held-out), linear, linear-temp, quadratic, quadratic-temp");
-  fit->add_option("--rated", rated_text,
+  fit->add_option("--rated", fa.rated_text,
                   "rated range FX,FY,FZ,MX,MY,MZ (default: --sensor's; one of the two is "
                   "required)");
-  fit->add_option("--sensor", fit_sensor,
+  fit->add_option("--sensor", fa.fit_sensor,
                   "sensor description (rated range and converter), or builtin; without it the "
                   "file is made for a generic 24-bit converter of +-3.90625 mV/V");
-  fit->add_option("--serial", serial, "serial number written to the file");
-  fit->add_option("--folds", folds, "cross-validation folds over whole load blocks")
+  fit->add_option("--serial", fa.serial, "serial number written to the file");
+  fit->add_option("--folds", fa.folds, "cross-validation folds over whole load blocks")
       ->check(CLI::Range(2, 100));
-  fit->add_flag("--allow-unexcited", allow_unexcited,
+  fit->add_flag("--allow-unexcited", fa.allow_unexcited,
                 "write axes the rig did not excite flagged invalid (ftd then never serves them) "
                 "instead of refusing");
 
@@ -112,69 +187,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     if (*fit) {
-      ReadOptions opt;
-      opt.require_bridges = true;
-      opt.require_wrench = true;
-      const Recording rec = ReadRecording(in_path, opt);
-      cal::FitOptions fo;
-      fo.folds = folds;
-      hal::AdcInfo adc{};
-      bool have_adc = false;
-      if (fit_sensor.empty() && rated_text.empty()) {
-        throw std::invalid_argument(
-            "fit needs the rated range: give --sensor FILE|builtin or --rated FX,FY,FZ,MX,MY,MZ");
-      }
-      if (!fit_sensor.empty()) {
-        const sim::SensorDescription s = sim::LoadSensorDescription(fit_sensor);
-        const Wrench r = s.model->rated();
-        for (int a = 0; a < 6; ++a) fo.rated[static_cast<std::size_t>(a)] = r(a);
-        adc.channel_count = static_cast<std::uint8_t>(s.model->channel_count());
-        const std::int64_t half = std::int64_t{1} << (s.adc.resolution_bits - 1);
-        adc.max_counts = static_cast<std::int32_t>(half - 1);
-        adc.min_counts = static_cast<std::int32_t>(-half);
-        adc.full_scale_nvv = std::llround(1000.0 * s.adc.reference_ratio / s.adc_gain * 1e6);
-        have_adc = true;
-      }
-      if (!rated_text.empty()) fo.rated = tools::ParseWrench(rated_text);
-      if (model_name != "auto") {
-        const auto k = cal::ParseModelKind(model_name);
-        if (!k) throw std::invalid_argument("unknown --model '" + model_name + "'");
-        fo.models = {*k};
-      }
-      cal::BlockOptions bo;
-      bo.scale = fo.rated;
-      const cal::RigData data = cal::RigDataFromRecording(rec, bo);
-      // Every axis must be excited (range against rated, independent of the others), or be
-      // written flagged invalid when the user asks: never a row the data could not determine.
-      const cal::ExcitationOptions eo;
-      const cal::ExcitationReport ex = cal::CheckExcitation(data.wrench, fo.rated, eo);
-      if (ex.unexcited != 0 && !allow_unexcited) {
-        throw std::invalid_argument(in_path + ": " + ex.Refusal(fo.rated, eo) +
-                                    ": refused (--allow-unexcited writes it flagged invalid)");
-      }
-      const cal::FitResult result = cal::FitCalibration(data, fo);
-      if (!have_adc) {
-        adc = cal::DefaultAdc(static_cast<std::uint8_t>(data.bridges.cols()));
-        std::printf("converter: generic 24-bit, +-3.90625 mV/V (no --sensor)\n");
-      }
-      cal::CalFile file = cal::CalFileFromFit(result, adc, serial, Today());
-      file.cal.invalid_axes = ex.unexcited;
-      fw::LoadReport rep{};
-      (void)cal::ToFixed(file, file.adc, &rep);
-      cal::SaveCalFile(out_path, file);
-      std::printf("%s", cal::FitSummary(result, rep).c_str());
-      if (ex.unexcited != 0) {
-        std::printf(
-            "warning: %s: flagged invalid in %s — ftd serves no value for %s (NaN / 0, "
-            "status bit 10)\n",
-            ex.Refusal(fo.rated, eo).c_str(), out_path.c_str(),
-            cal::AxisList(ex.unexcited).c_str());
-      }
-      if (!report_path.empty()) {
-        cal::WriteFitReport(report_path, result, data, rep, in_path);
-        std::printf("report: %s\n", report_path.c_str());
-      }
-      std::printf("wrote %s\n", out_path.c_str());
+      RunFit(fa);
     } else if (*import_ati) {
       const cal::AtiImport imp = cal::ImportAtiCal(ati_path);
       for (const std::string& w : imp.warnings)
