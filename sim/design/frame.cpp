@@ -94,8 +94,11 @@ FrameSolution::FrameSolution(FrameModel model) : m_(std::move(model)) {
   f.topRows<6>().setIdentity();
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(k);
   u_ = ldlt.solve(f);
-  if (ldlt.info() != Eigen::Success || !u_.allFinite() || !((k * u_ - f).norm() < 1e-6)) {
-    throw std::invalid_argument("frame: the structure is a mechanism (singular stiffness)");
+  const double scale = k.norm() * u_.norm() + f.norm();
+  if (!u_.allFinite() || !((k * u_ - f).norm() <= 1e-8 * scale)) {
+    throw std::invalid_argument(
+        "frame: the structure is a mechanism (singular stiffness; residual " +
+        std::to_string((k * u_ - f).norm() / scale) + ")");
   }
   c_platform_ = u_.topRows<6>();
   c_platform_ = 0.5 * (c_platform_ + c_platform_.transpose()).eval();
