@@ -181,10 +181,10 @@ std::vector<Candidate> Sweep(const SweepOptions& o, const Requirement* req,
                              std::ostream* progress) {
   std::vector<Candidate> out;
   const int n = std::max(1, o.hub_spoke_steps);
-  for (double hub : Grid(0.015, 0.06, n)) {
-    for (double len : Grid(0.015, 0.05, n)) {
-      for (double w : Grid(0.004, 0.02, n)) {
-        for (double h : Grid(0.004, 0.02, n)) {
+  for (double hub : Grid(0.008, 0.06, n)) {
+    for (double len : Grid(0.008, 0.05, n)) {
+      for (double w : Grid(0.0015, 0.015, n)) {
+        for (double h : Grid(0.0015, 0.015, n)) {
           HubSpokeParams p;
           p.hub_radius_m = hub;
           p.rim_radius_m = hub + len;

@@ -195,10 +195,10 @@ std::vector<const Candidate*> Showcase(const std::vector<Candidate>& ds, const R
     const Candidate* best = nullptr;
     for (const Candidate& c : ds) {
       if (c.model.family != fam) continue;
+      // Requirement: the finest force resolution among designs that meet it, else the closest.
       auto score = [&](const Candidate& x) {
-        return req != nullptr
-                   ? x.check.worst() + (x.check.met() ? x.figures.force_resolution_n : 1e3)
-                   : -x.figures.tilt_capacity_nm;
+        if (req == nullptr) return -x.figures.tilt_capacity_nm;
+        return x.check.met() ? x.figures.force_resolution_n : 1e6 + x.check.worst();
       };
       if (best == nullptr || score(c) < score(*best)) best = &c;
     }
@@ -242,11 +242,22 @@ void WriteDesignReport(std::ostream& o, const std::vector<Candidate>& ds, const 
   o << "</p></div></div>\n<h2>Pareto front: tilt capacity against force resolution</h2>\n";
   ParetoPlot(o, ds);
   o << "<p>Green dashed: 0.1 N resolution and 280 N·m tilting (the goal); green rims: designs "
-       "that meet the requirement.</p>\n<h2>Pareto designs</h2><table><tr><th>id</th><th>family"
+       "that meet the requirement.</p>\n<h2>Pareto designs</h2>\n";
+  std::vector<const Candidate*> front;
+  for (const Candidate& c : ds) {
+    if (c.pareto) front.push_back(&c);
+  }
+  std::sort(front.begin(), front.end(), [](const Candidate* a, const Candidate* b) {
+    return a->figures.force_resolution_n < b->figures.force_resolution_n;
+  });
+  const std::size_t shown = std::min<std::size_t>(front.size(), 30);
+  o << fmt::format("<p>{} designs on the front; the {} with the finest force resolution:</p>",
+                   front.size(), shown);
+  o << "<table><tr><th>id</th><th>family"
        "</th><th>Fxy cap N</th><th>Fz cap N</th><th>Mxy cap N·m</th><th>Mz cap N·m</th><th>force "
        "res N</th><th>min lateral k N/m</th><th>meets</th></tr>\n";
-  for (const Candidate& c : ds) {
-    if (!c.pareto) continue;
+  for (std::size_t i = 0; i < shown; ++i) {
+    const Candidate& c = *front[i];
     const DesignFigures& f = c.figures;
     o << fmt::format(
         "<tr><td>{}</td><td>{}</td><td>{:.4g}</td><td>{:.4g}</td><td>{:.4g}</td>"
