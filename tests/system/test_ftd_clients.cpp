@@ -216,7 +216,7 @@ TEST(FtdClients, RtuOverPtyPairServesTheMapAndSurvivesGarbage) {
   ASSERT_EQ(modbus_connect(c), 0);
   std::uint16_t r[fw::kInputRegisterCount] = {};
   ASSERT_EQ(modbus_read_input_registers(c, 0, fw::kInputRegisterCount, r), fw::kInputRegisterCount);
-  EXPECT_EQ(r[fw::kInMapVersion], 1);
+  EXPECT_EQ(r[fw::kInMapVersion], 2);
   EXPECT_EQ(r[fw::kInBridgeCount], 6);
   for (std::size_t a = 0; a < 6; ++a) {
     EXPECT_NEAR(fw::UnpackFloat32(&r[fw::kInWrenchFloat + 2 * a]), applied[a], 5 * sigma[a] + 1e-3)

@@ -135,7 +135,7 @@ TEST(FtdModbus, SimulatedWrenchArrivesWithinDerivedToleranceAndTareZeroes) {
 
   std::array<std::uint16_t, 30> r{};
   ASSERT_EQ(c.Input(0, 30, r.data()), 30);
-  EXPECT_EQ(r[fw::kInMapVersion], 1);
+  EXPECT_EQ(r[fw::kInMapVersion], 2);
   EXPECT_EQ(r[fw::kInStatus] & ~fw::kStatusStale, fw::kStatusSimulated);
   for (std::size_t a = 0; a < 6; ++a) {
     const double tol = kSigmas * e.sigma_si[a] / std::sqrt(kFilter) + e.fixed_error_si[a] +
