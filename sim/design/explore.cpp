@@ -336,6 +336,9 @@ void PrintDesign(std::ostream& out, const Candidate& c, const DesignOptions& o) 
   out << fmt::format("design {} (family {}, {})\n", c.id, c.model.family, c.model.material.name);
   out << " ";
   for (const auto& [k, v] : c.model.parameters) out << fmt::format(" {}={:.4g}", k, v);
+  if (c.model.family == "hub-spoke" && c.model.parameters.contains("rim_radius_m")) {
+    out << fmt::format(" envelope_radius_m={:.4g}", c.model.parameters.at("rim_radius_m"));
+  }
   out << fmt::format("\n  capacity alone (SF {:.2f}):", o.safety_factor);
   for (int k = 0; k < 6; ++k) {
     out << fmt::format(" {} {:.4g} {} [{}]", kAxis[k], f.capacity(k), kUnit[k],

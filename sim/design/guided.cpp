@@ -100,6 +100,8 @@ DesignModel Guided(const GuidedParams& p, const Readout& r) {
       {"leaf_length_m", p.leaf_length_m},       {"leaf_width_m", p.leaf_width_m},
       {"leaf_thickness_m", p.leaf_thickness_m}, {"leaf_thickness_z_m", p.leaf_thickness_z_m},
       {"separation_m", p.separation_m},         {"inner_radius_m", p.inner_radius_m}};
+  // Envelope of the nested layout (for tables; not a parameter): outermost leaf roots.
+  m.parameters["envelope_radius_m"] = p.inner_radius_m + 3 * p.leaf_length_m + 2 * p.gap_m;
   m.stiffness = sol.Stiffness();
   const auto stages = Stages(p);
   std::vector<Row6> gauges;

@@ -86,6 +86,14 @@ int Run(const DesignArgs& a) {
               << " evaluations)\n";
     met = sim::design::PrintRequirementVerdict(std::cout, cs, *req, a.list);
     sim::design::PrintGoal(std::cout, cs, *req);
+    const sim::design::Candidate* best = nullptr;
+    for (const auto& c : cs) {
+      if (sim::design::MeetsGoal(c, *req) &&
+          (best == nullptr || c.figures.force_resolution_n < best->figures.force_resolution_n)) {
+        best = &c;
+      }
+    }
+    if (best != nullptr) sim::design::PrintDesign(std::cout, *best, so.design);
   }
   std::cout << "Pareto front (tilt capacity, force capacity, force resolution, stiffness):\n";
   int shown = 0;
