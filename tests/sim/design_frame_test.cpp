@@ -122,6 +122,28 @@ TEST(DesignFrame, GuidedFamilyDecouplesForcesFromMoments) {
   EXPECT_GT(f.capacity(3) / f.capacity(0), 0.2);  // hub-spoke bodies reach ~0.05 m
 }
 
+// The guided family against hand formulas (independent of the frame solver): under Fz the four
+// z-stage leaves S-bend as guided beams, each carrying Fz/4: ε(s) = (Fz/4)·(L/2 − s)·(t/2)/(E·I)
+// at distance s from the root; under My the z-stage parallelograms turn it into leaf push–pull,
+// N = My/(2d) per leaf (two parallelograms), ε = N/(E·b·t) at mid-leaf.
+TEST(DesignFrame, GuidedGaugeStrainsMatchHandFormulas) {
+  GuidedParams p;
+  p.leaf_length_m = 0.04;
+  p.leaf_width_m = 0.03;
+  p.leaf_thickness_z_m = 0.0012;
+  p.separation_m = 0.06;
+  const DesignModel m = Guided(p, Readout{});
+  const double e = p.material.e_pa, b = p.leaf_width_m, t = p.leaf_thickness_z_m;
+  const double l = p.leaf_length_m, s = p.gauge_frac * l;
+  const double i = b * t * t * t / 12;
+  const double bend = 0.25 * (0.5 * l - s) * 0.5 * t / (e * i);
+  EXPECT_NEAR(std::abs(m.gauge_strain(0, 2)), bend, 0.02 * bend);  // z-stage root gauge, per N
+  const double push = 1.0 / (2 * p.separation_m) / (e * b * t);
+  EXPECT_NEAR(std::abs(m.gauge_strain(12, 4)), push, 0.05 * push);  // z-stage mid-leaf, per N·m
+  // The lever the family reaches is the ratio of the two: about (L/2 − s)·d·/t, not a radius.
+  EXPECT_GT(std::abs(m.gauge_strain(0, 2)) / std::abs(m.gauge_strain(12, 4)), 0.5);
+}
+
 TEST(DesignFigures, PointMassFrequencyAndResolution) {
   Mat6 k = Mat6::Identity() * 1e6;
   const Vec6 f = NaturalFrequenciesHz(k, 4.0, 0.0, 0.5);
