@@ -177,6 +177,17 @@ void Add(std::vector<Candidate>* out, std::string id, DesignModel m, const Sweep
 
 }  // namespace
 
+namespace {
+
+/// Longest leaf that keeps three nested stages (inner radius, two gaps) inside the envelope.
+double MaxLeafLength(const SweepOptions& o, double cap) {
+  const GuidedParams d;
+  if (!(o.max_radius_m > 0)) return cap;
+  return std::min(cap, (o.max_radius_m - d.inner_radius_m - 2 * d.gap_m) / 3.0);
+}
+
+}  // namespace
+
 std::vector<Candidate> Sweep(const SweepOptions& o, const Requirement* req,
                              std::ostream* progress) {
   std::vector<Candidate> out;
@@ -190,6 +201,7 @@ std::vector<Candidate> Sweep(const SweepOptions& o, const Requirement* req,
           p.rim_radius_m = hub + len;
           p.beam_width_m = w;
           p.beam_height_m = h;
+          if (o.max_radius_m > 0 && p.rim_radius_m > o.max_radius_m) continue;
           Add(&out, fmt::format("H{:03d}", out.size()), HubSpoke(p, o.readout), o, req);
         }
       }
@@ -198,7 +210,9 @@ std::vector<Candidate> Sweep(const SweepOptions& o, const Requirement* req,
   }
   const std::size_t first_guided = out.size();
   const int g = std::max(1, o.guided_steps);
-  for (double len : Grid(0.02, 0.045, g)) {
+  const double l_hi = MaxLeafLength(o, 0.045);
+  for (double len : Grid(std::min(0.02, 0.5 * l_hi), l_hi, g)) {
+    if (l_hi < 0.004) break;  // no nested body fits the envelope
     for (double b : Grid(0.02, 0.05, g)) {
       for (double t : Grid(0.0008, 0.0025, g + 1)) {
         for (double tz : {t, 1.4 * t}) {
@@ -267,7 +281,7 @@ int RefineGuided(std::vector<Candidate>* cs, const Requirement& req, const Sweep
                        &p.leaf_length_m};
     // Bounds of the search (m): about the sweep's ranges widened by half (a bench-size body).
     const double lo[5] = {0.0004, 0.0004, 0.01, 0.015, 0.01};
-    const double hi[5] = {0.004, 0.004, 0.075, 0.12, 0.07};
+    const double hi[5] = {0.004, 0.004, 0.075, 0.12, MaxLeafLength(o, 0.07)};
     for (int phase = 0; phase < 2; ++phase) {
       for (double step = 0.16; step > 0.01; step *= 0.5) {
         bool improved = true;

@@ -50,6 +50,7 @@ struct Candidate {
 struct SweepOptions {
   DesignOptions design;
   Readout readout;
+  double max_radius_m = 0;  ///< body envelope limit (rim / outermost leaf root), 0: none
   int hub_spoke_steps = 6;  ///< values per swept dimension
   int guided_steps = 5;
 };

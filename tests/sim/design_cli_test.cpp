@@ -119,6 +119,21 @@ TEST(DesignCli, SensorDescriptionIsEvaluated) {
   EXPECT_NE(run.out.find("rigid tool 2.00 kg"), std::string::npos);
 }
 
+// --max-radius-m: no swept or refined design leaves the envelope.
+TEST(DesignSweep, EnvelopeLimitHolds) {
+  const Requirement req = LoadRequirement("panda-base");
+  SweepOptions o;
+  o.max_radius_m = 0.09;
+  std::vector<Candidate> cs = Sweep(o, &req, nullptr);
+  (void)RefineGuided(&cs, req, o, 2);
+  ASSERT_GT(cs.size(), 100u);
+  for (const Candidate& c : cs) {
+    const auto& q = c.model.parameters;
+    const double r = c.model.family == "guided" ? q.at("envelope_radius_m") : q.at("rim_radius_m");
+    EXPECT_LE(r, 0.09 + 1e-12) << c.id;
+  }
+}
+
 // The envelope maximum (sum of the groups' maxima) equals a brute-force search over directions.
 TEST(DesignLoads, EnvelopeMaximumMatchesBruteForce) {
   const EnvelopeLoads env(300, 410, 280, 190);

@@ -27,6 +27,7 @@ struct DesignArgs {
   double fatigue_mpa = 0;
   int list = 8;
   int refine_starts = 6;
+  double max_radius_m = 0;
 };
 
 int RunSensor(const DesignArgs& a, const sim::design::DesignOptions& o,
@@ -70,6 +71,7 @@ int Run(const DesignArgs& a) {
   so.design.tool_mass_kg = a.tool_mass_kg;
   so.design.tool_com_z_m = a.tool_com_z_m;
   so.design.tool_gyration_m = a.tool_gyration_m;
+  so.max_radius_m = a.max_radius_m;
   std::unique_ptr<sim::design::Requirement> req;
   if (!a.require.empty()) {
     req = std::make_unique<sim::design::Requirement>(sim::design::LoadRequirement(a.require));
@@ -133,6 +135,8 @@ void AddDesignCommand(CLI::App& app) {
   cmd->add_option("--yield-mpa", a->yield_mpa, "--sensor: yield stress of the body");
   cmd->add_option("--fatigue-mpa", a->fatigue_mpa, "--sensor: endurance limit of the body");
   cmd->add_option("--list", a->list, "designs listed (default 8)");
+  cmd->add_option("--max-radius-m", a->max_radius_m,
+                  "sweep: body envelope radius limit, m (default: none)");
   cmd->add_option("--refine", a->refine_starts, "guided designs refined after the sweep (6)");
   cmd->callback([a] {
     int rc = 2;
