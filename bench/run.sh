@@ -99,3 +99,14 @@ if [ -x "$B/bench_cal" ]; then
         n, $col["real_time"], $col["cpu_time"], $col["rows"], $col["blocks"], l }
       END { if (t["BM_FitLinear1M"] > 0) printf "  auto (linear + quadratic) / linear only = %.2f\n", t["BM_FitAuto1M"] / t["BM_FitLinear1M"] }'
 fi
+
+# --- design explorer (issue 13): us per design, ms per panda-base sweep (acceptance: < 60 s) -----
+if [ -x "$B/bench_design" ]; then
+  section "ftsim design: one design evaluated (CPU us) and the panda-base sweep + refinement (one run)"
+  "$B/bench_design" --benchmark_format=csv 2>/dev/null |
+    awk -F, 'NR==1 { for (i = 1; i <= NF; ++i) { h=$i; gsub(/"/,"",h); col[h]=i }; next }
+      $1 ~ /BM_/ { n=$1; gsub(/"/,"",n); sub(/\/iterations:[0-9]+/,"",n)
+        printf "  %-22s %10.1f %s CPU", n, $col["cpu_time"], $col["time_unit"]
+        if (col["evaluations"] && $col["evaluations"] != "") printf "  (%d designs)", $col["evaluations"]
+        printf "\n" }'
+fi

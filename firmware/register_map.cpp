@@ -12,7 +12,26 @@ namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
-[[nodiscard]] bool HoldingMapped(std::uint32_t a) { return a < kHoldTransform + 12u; }
+[[nodiscard]] bool HoldingMount(std::uint32_t a) { return a >= kHoldMount && a < kHoldMount + 12u; }
+[[nodiscard]] bool HoldingMapped(std::uint32_t a) {
+  return a < kHoldTransform + 12u || HoldingMount(a);
+}
+
+/// A write to a 12-register float block at `first` must cover whole floats.
+[[nodiscard]] bool WholeFloats(std::uint32_t first, std::uint32_t addr, std::uint32_t end) {
+  const std::uint32_t lo = addr > first ? addr : first;
+  const std::uint32_t hi = end < first + 12u ? end : first + 12u;
+  return (lo - first) % 2 == 0 && (hi - first) % 2 == 0;
+}
+
+[[nodiscard]] ToolTransformParams ParamsOf(const std::array<std::uint16_t, 12>& regs) {
+  ToolTransformParams p{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    p.d_m[i] = UnpackFloat32(&regs[2 * i]);
+    p.r_deg[i] = UnpackFloat32(&regs[6 + 2 * i]);
+  }
+  return p;
+}
 
 /// Holding registers 5 … 9: reserved. They read 0 and accept 0 (so that a PLC's block read or
 /// write of 0 … 21 works); any other value is refused with 03.
@@ -149,7 +168,11 @@ ModbusException RegisterMap::ReadHolding(std::uint16_t addr, std::uint16_t count
         v = unlocked ? 1 : 0;
         break;
       default:
-        v = HoldingReserved(a) ? 0 : transform_regs_[a - kHoldTransform];
+        if (HoldingMount(a)) {
+          v = mount_regs_[a - kHoldMount];
+        } else {
+          v = HoldingReserved(a) ? 0 : transform_regs_[a - kHoldTransform];
+        }
         break;
     }
     out[i] = v;
@@ -169,7 +192,9 @@ ModbusException RegisterMap::WriteHolding(std::uint16_t addr, const std::uint16_
   const bool unlocked = UnlockedLocked(now_us);
   DeviceSettings next = settings_;
   std::array<std::uint16_t, 12> next_transform = transform_regs_;
+  std::array<std::uint16_t, 12> next_mount = mount_regs_;
   bool transform_written = false;
+  bool mount_written = false;
   bool unlock_written = false;
   for (std::uint32_t a = addr; a < end; ++a) {
     const std::uint16_t v = values[a - addr];
@@ -203,38 +228,37 @@ ModbusException RegisterMap::WriteHolding(std::uint16_t addr, const std::uint16_
         if (v != kUnlockKey) return ModbusException::kIllegalDataValue;
         unlock_written = true;
         break;
-      default:  // 5 … 9 reserved, 10 … 21 tool transform
+      default:  // 5 … 9 reserved, 10 … 21 tool transform, 30 … 41 mount transform
         if (HoldingReserved(a)) {
           if (v != 0) return ModbusException::kIllegalDataValue;
           break;
         }
         if (!unlocked) return ModbusException::kIllegalDataValue;
-        next_transform[a - kHoldTransform] = v;
-        transform_written = true;
+        if (HoldingMount(a)) {
+          next_mount[a - kHoldMount] = v;
+          mount_written = true;
+        } else {
+          next_transform[a - kHoldTransform] = v;
+          transform_written = true;
+        }
         break;
     }
   }
-  if (transform_written) {
+  if (transform_written || mount_written) {
     // A float is two registers: a write must cover whole floats.
-    constexpr std::uint32_t kFirst = kHoldTransform;
-    constexpr std::uint32_t kEnd = kFirst + 12u;
-    const std::uint32_t first = addr > kFirst ? addr : kFirst;
-    const std::uint32_t last = end < kEnd ? end : kEnd;
-    if ((first - kFirst) % 2 != 0 || (last - kFirst) % 2 != 0) {
+    if ((transform_written && !WholeFloats(kHoldTransform, addr, end)) ||
+        (mount_written && !WholeFloats(kHoldMount, addr, end))) {
       return ModbusException::kIllegalDataValue;
     }
-    ToolTransformParams p{};
-    for (std::size_t i = 0; i < 3; ++i) {
-      p.d_m[i] = UnpackFloat32(&next_transform[2 * i]);
-      p.r_deg[i] = UnpackFloat32(&next_transform[6 + 2 * i]);
-    }
-    if (MakeToolTransform(p, &next.transform) != TransformStatus::kOk) {
+    if (MakeMountedToolTransform(ParamsOf(next_transform), ParamsOf(next_mount), &next.transform) !=
+        TransformStatus::kOk) {
       return ModbusException::kIllegalDataValue;
     }
   }
   // Everything validated: commit.
   settings_ = next;
   transform_regs_ = next_transform;
+  mount_regs_ = next_mount;
   if (unlock_written) {
     unlock_armed_ = true;
     unlock_until_us_ = now_us + kUnlockDurationUs;

@@ -1,4 +1,4 @@
-// The Modbus register map, version 1 (docs/spec/modbus-map.md): input image, holding registers.
+// The Modbus register map, version 2 (docs/spec/modbus-map.md): input image, holding registers.
 #pragma once
 
 #include <array>
@@ -9,9 +9,10 @@
 
 namespace ftstack::fw {
 
-inline constexpr std::uint16_t kMapVersion = 1;
-inline constexpr std::uint16_t kInputRegisterCount = 77;   ///< input registers 0 … 76
-inline constexpr std::uint16_t kHoldingRegisterSpan = 22;  ///< holding 0 … 21 (5 … 9 reserved)
+inline constexpr std::uint16_t kMapVersion = 2;
+inline constexpr std::uint16_t kInputRegisterCount = 77;  ///< input registers 0 … 76
+/// Holding 0 … 41: 5 … 9 reserved, 22 … 29 not served by this build (gravity compensation).
+inline constexpr std::uint16_t kHoldingRegisterSpan = 42;
 
 /// Input register addresses (0-based protocol addresses).
 enum InputRegister : std::uint16_t {
@@ -41,6 +42,7 @@ enum HoldingRegister : std::uint16_t {
   kHoldCalSlot = 3,  ///< protected
   kHoldUnlock = 4,
   kHoldTransform = 10,  ///< float32 × 6 (Dx Dy Dz m, Rx Ry Rz deg), protected, 10 … 21
+  kHoldMount = 30,      ///< float32 × 6 mount transform (same layout), protected, 30 … 41
 };
 
 /// Values of the command register.
@@ -86,12 +88,12 @@ class RegisterMap {
   /// Function 04. 02 when [addr, addr+count) leaves 0 … 73.
   [[nodiscard]] ModbusException ReadInput(std::uint16_t addr, std::uint16_t count,
                                           std::uint16_t* out);
-  /// Function 03. 02 when any address is outside 0 … 21; reserved 5 … 9 read 0.
+  /// Function 03. 02 when any address is outside 0 … 21 and 30 … 41; reserved 5 … 9 read 0.
   [[nodiscard]] ModbusException ReadHolding(std::uint16_t addr, std::uint16_t count,
                                             std::uint16_t* out);
   /// Functions 06 and 16. 02 for an address outside the map; 03 for a value out of range, an
   /// unknown command, a non-zero value in a reserved register (5–9), a protected register (3,
-  /// 10–21) while locked, or a write covering only one half of a tool-transform float. On any
+  /// 10–21, 30–41) while locked, or a write covering only one half of a transform float. On any
   /// exception nothing changes.
   [[nodiscard]] ModbusException WriteHolding(std::uint16_t addr, const std::uint16_t* values,
                                              std::uint16_t count);
@@ -107,6 +109,7 @@ class RegisterMap {
   Device& device_;
   DeviceSettings settings_{};
   std::array<std::uint16_t, 12> transform_regs_{};
+  std::array<std::uint16_t, 12> mount_regs_{};
   std::uint64_t unlock_until_us_ = 0;
   bool unlock_armed_ = false;
 };

@@ -311,7 +311,7 @@ TEST_F(RegisterMapTest, InputImageCarriesOneSampleInTheSpecifiedLayout) {
   adc_.counts = {400000, -300000, 1000000, 50000, -60000, 70000};
   Step(3);
   const auto r = Input();
-  EXPECT_EQ(r[kInMapVersion], 1);
+  EXPECT_EQ(r[kInMapVersion], 2);
   EXPECT_EQ(r[kInStatus], 0);  // real (fake) hardware, calibrated, no faults
   EXPECT_EQ(UnpackU32(&r[kInSequence]), 3u);
   EXPECT_EQ(UnpackU32(&r[kInTimestampUs]), 2000u);
