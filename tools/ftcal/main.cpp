@@ -1,4 +1,4 @@
-// ftcal — calibration command line: fit, apply, import-ati, verify, design (logic in calibration/).
+// ftcal — calibration CLI: fit, apply, import-ati, verify, design, payload (logic in calibration/).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <ctime>
@@ -9,6 +9,7 @@
 #include "calibration/cal_file.hpp"
 #include "calibration/fit.hpp"
 #include "calibration/fit_report.hpp"
+#include "calibration/payload.hpp"
 #include "calibration/slots.hpp"
 #include "measurement/recording.hpp"
 #include "sim/rig.hpp"
@@ -101,6 +102,18 @@ int main(int argc, char** argv) {
   design->add_option("--temperatures", temps, "repeat at these body temperatures, °C")
       ->delimiter(',');
 
+  double max_condition = 30.0;
+  auto* payload = app.add_subcommand(
+      "payload", "identify a payload (mass, centre of mass) and the sensor bias from static poses");
+  payload
+      ->add_option("--in", in_path,
+                   "recording: one static reading per row, gx_mps2 gy_mps2 gz_mps2 (gravity in "
+                   "the sensor frame) and Fx…Mz")
+      ->required();
+  payload->add_option("--out", out_path, "payload file to write (JSON, CRC-32)")->required();
+  payload->add_option("--max-condition", max_condition, "refuse a pose set above this condition")
+      ->check(CLI::Range(2.0, 1e6));
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (*fit) {
@@ -144,6 +157,14 @@ int main(int argc, char** argv) {
         std::printf("report: %s\n", report_path.c_str());
       }
       std::printf("wrote %s\n", out_path.c_str());
+    } else if (*payload) {
+      const Recording rec = ReadRecording(in_path);
+      cal::PayloadFitOptions po;
+      po.max_condition = max_condition;
+      cal::PayloadFit pfit = cal::FitPayload(cal::PayloadReadingsFromRecording(rec), po);
+      pfit.file.date = Today();
+      cal::SavePayloadFile(out_path, pfit.file);
+      std::printf("%swrote %s\n", cal::PayloadSummary(pfit).c_str(), out_path.c_str());
     } else if (*import_ati) {
       const cal::AtiImport imp = cal::ImportAtiCal(ati_path);
       for (const std::string& w : imp.warnings)
