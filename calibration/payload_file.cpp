@@ -78,6 +78,7 @@ PayloadFile PayloadFromJson(const nlohmann::json& j, const std::string& path) {
     throw PayloadFileError(path + buf);
   }
   PayloadFile p;
+  p.crc32 = stored;
   p.date = j.value("date", "");
   p.source = j.value("source", "");
   p.mass_kg = Number(j, "mass_kg", path);

@@ -35,6 +35,7 @@ struct PayloadFile {
   std::size_t readings = 0;  ///< static readings the fit used
   double force_rms_n = 0;    ///< RMS residual of the force equations
   double moment_rms_nm = 0;  ///< RMS residual of the moment equations
+  std::uint32_t crc32 = 0;   ///< the file's CRC-32 (set when read; written files get a fresh one)
 };
 
 /// Serialises with "units" and the "crc32" field (CRC-32 of the compact dump without "crc32",

@@ -9,6 +9,7 @@
 #include <system_error>
 
 #include "calibration/cal_file.hpp"
+#include "calibration/payload_file.hpp"
 #include "daemon/hardware_adc.hpp"
 #include "measurement/recording.hpp"
 
@@ -46,6 +47,27 @@ void LoadSlot(const std::string& path, const char* name, const hal::AdcInfo& adc
     *slot = fw::CalSlot{};
     std::fprintf(stderr, "ftd: calibration slot %s refused: %s\n", name, e.what());
   }
+}
+
+/// Loads `path` as gravity compensation's payload into `cfg`; a refused file stops ftd (FtdError):
+/// unlike a calibration, a robot relying on compensation must not run with none.
+void LoadPayload(const std::string& path, fw::DeviceConfig* cfg) {
+  cal::PayloadFile p;
+  try {
+    p = cal::LoadPayloadFile(path);
+  } catch (const std::exception& e) {
+    throw FtdError(std::string("--payload refused: ") + e.what());
+  }
+  if (fw::MakeFixedPayload(p.mass_kg, p.com_m, p.force_bias_n, p.moment_bias_nm, &cfg->payload) !=
+      fw::PayloadStatus::kOk) {
+    throw FtdError("--payload " + path + ": outside what the firmware accepts (0 < mass ≤ " +
+                   std::to_string(fw::kMaxPayloadMassKg) + " kg, |m·c| ≤ 100 kg·m)");
+  }
+  cfg->payload_crc = p.crc32;
+  std::fprintf(stderr,
+               "ftd: payload %s: %.4g kg at (%.1f, %.1f, %.1f) mm; gravity compensation off "
+               "until holding 28 = 1\n",
+               path.c_str(), p.mass_kg, p.com_m[0] * 1e3, p.com_m[1] * 1e3, p.com_m[2] * 1e3);
 }
 
 /// A hardware converter (HX711 over GPIO, ADS131M over SPI); needs a calibration file.
@@ -181,6 +203,8 @@ void Ftd::Start() {
   bool any_zero = false;
   for (const std::int32_t r : cfg.rated_lsb) any_zero = any_zero || r == 0;
   if (any_zero) cfg.rated_lsb = {};  // no complete rating: overload rule off
+
+  if (!opt_.payload.empty()) LoadPayload(opt_.payload, &cfg);
 
   core_ = std::make_unique<fw::WrenchCore>();
   device_ = std::make_unique<fw::Device>(adc, *core_);

@@ -37,6 +37,7 @@ struct FtdOptions {
   unsigned rate_hz = 1000;
   std::string cal;         ///< calibration file for slot 0 ("" = built-in)
   std::string cal_b;       ///< calibration file for slot 1 ("" = none)
+  std::string payload;     ///< payload file for gravity compensation ("" = none)
   std::string modbus_tcp;  ///< HOST:PORT ("" = no TCP server)
   std::string modbus_rtu;  ///< serial device ("" = no RTU server)
   unsigned baud = 19200;

@@ -135,7 +135,7 @@ TEST(FtdModbus, SimulatedWrenchArrivesWithinDerivedToleranceAndTareZeroes) {
 
   std::array<std::uint16_t, 30> r{};
   ASSERT_EQ(c.Input(0, 30, r.data()), 30);
-  EXPECT_EQ(r[fw::kInMapVersion], 1);
+  EXPECT_EQ(r[fw::kInMapVersion], 2);  // docs/spec/modbus-map.md
   EXPECT_EQ(r[fw::kInStatus] & ~fw::kStatusStale, fw::kStatusSimulated);
   for (std::size_t a = 0; a < 6; ++a) {
     const double tol = kSigmas * e.sigma_si[a] / std::sqrt(kFilter) + e.fixed_error_si[a] +
@@ -185,9 +185,9 @@ TEST(FtdModbus, ExceptionsAndProtectedWritesOverTheWire) {
   EXPECT_EQ(err, EMBXILADD);
   EXPECT_EQ(c.Input(fw::kInputRegisterCount - 4, 5, r.data(), &err), -1);
   EXPECT_EQ(err, EMBXILADD);
-  EXPECT_EQ(c.Holding(22, 1, r.data(), &err), -1);
+  EXPECT_EQ(c.Holding(30, 1, r.data(), &err), -1);  // map version 2: holding 0 … 29
   EXPECT_EQ(err, EMBXILADD);
-  EXPECT_EQ(c.Write(22, 0, &err), -1);
+  EXPECT_EQ(c.Write(30, 0, &err), -1);
   EXPECT_EQ(err, EMBXILADD);
   // Reserved 5 … 9: read 0, accept only 0.
   EXPECT_EQ(c.Holding(5, 5, r.data(), &err), 5);
@@ -392,7 +392,7 @@ TEST(FtdModbus, GarbageAndHalfFramesDoNotDisturbOtherClients) {
     Client c(ftd.port());
     std::array<std::uint16_t, 74> r{};
     while (!stop) {
-      if (c.Input(0, 74, r.data()) == 74 && r[0] == 1) {
+      if (c.Input(0, 74, r.data()) == 74 && r[0] == 2) {
         ++ok;
       } else {
         if (failed++ == 0) {
@@ -510,7 +510,7 @@ TEST(FtdModbus, PipelinedRequestsInOneSegmentAreAllAnswered) {
     const std::uint8_t* r = &got[static_cast<std::size_t>(t) * kReply];
     EXPECT_EQ(r[1], t);
     EXPECT_EQ(r[7], 4);
-    EXPECT_EQ((r[9] << 8) | r[10], 1);  // map version
+    EXPECT_EQ((r[9] << 8) | r[10], 2);  // map version
   }
   close(fd);
   EXPECT_EQ(ftd.Stop(), 0);

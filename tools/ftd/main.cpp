@@ -40,6 +40,8 @@ int Run(int argc, char** argv) {
   app.add_option("--cal", opt.cal,
                  "calibration file, slot 0 (default: the simulated sensor's own)");
   app.add_option("--cal-b", opt.cal_b, "calibration file for slot 1 (holding register 3)");
+  app.add_option("--payload", opt.payload,
+                 "payload file (ftcal payload) for gravity compensation (holding 22–28)");
   app.add_option("--modbus-tcp", opt.modbus_tcp,
                  "serve Modbus TCP on HOST:PORT (port 0: any free)");
   app.add_option("--modbus-rtu", opt.modbus_rtu, "serve Modbus RTU on a serial DEVICE");
