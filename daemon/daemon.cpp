@@ -240,6 +240,7 @@ void Ftd::Start() {
                      std::system_category().message(errno) + ")");
     }
   }
+  if (!opt_.rdt.empty()) StartRdt();
   if (!opt_.log.empty()) {
     std::FILE* f = std::fopen(opt_.log.c_str(), "w");
     if (f == nullptr) {
@@ -256,6 +257,29 @@ void Ftd::Start() {
   threads_.emplace_back([this] { SamplingLoop(); });
   if (tcp_) threads_.emplace_back([this] { tcp_->Run(stop_); });
   if (rtu_) threads_.emplace_back([this] { rtu_->Run(stop_); });
+  if (rdt_) threads_.emplace_back([this] { rdt_->Run(stop_); });
+}
+
+void Ftd::StartRdt() {
+  RdtOptions ro;
+  try {
+    ParseHostPort(opt_.rdt, &ro.host, &ro.port);
+  } catch (const FtdError& e) {  // its message names --modbus-tcp
+    const std::string m = e.what();
+    throw FtdError("--rdt" + m.substr(m.find(' ')));
+  }
+  if (!(opt_.rdt_counts_per_n > 0) || !(opt_.rdt_counts_per_nm > 0) ||
+      !std::isfinite(opt_.rdt_counts_per_n) || !std::isfinite(opt_.rdt_counts_per_nm)) {
+    throw FtdError("--rdt-counts-per-n and --rdt-counts-per-nm must be positive");
+  }
+  ro.counts_per_n = opt_.rdt_counts_per_n;
+  ro.counts_per_nm = opt_.rdt_counts_per_nm;
+  ro.buffer_records = opt_.rdt_buffer;
+  rdt_ = std::make_unique<RdtServer>(ro, map_.get());
+  std::string error;
+  if (!rdt_->Open(&error)) throw FtdError("RDT on " + opt_.rdt + ": " + error);
+  std::fprintf(stderr, "ftd: serving RDT on %s:%u (%g counts/N, %g counts/N·m)\n", ro.host.c_str(),
+               static_cast<unsigned>(rdt_->port()), ro.counts_per_n, ro.counts_per_nm);
 }
 
 void Ftd::SamplingLoop() {
@@ -269,6 +293,7 @@ void Ftd::SamplingLoop() {
     }
     if (s != hal::Status::kOk) continue;
     samples_.fetch_add(1, std::memory_order_relaxed);
+    if (published && rdt_) rdt_->Publish(device_->last_published());
     if (!published || ring_.empty()) continue;
     const std::uint64_t head = ring_head_.load(std::memory_order_relaxed);
     if (head - ring_tail_.load(std::memory_order_acquire) >= ring_.size()) {
