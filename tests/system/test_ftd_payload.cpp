@@ -10,37 +10,16 @@
 #include <cstdio>
 #include <thread>
 
-#include "calibration/cal_file.hpp"
 #include "calibration/payload_file.hpp"
 #include "firmware/register_map.hpp"
-#include "sim/default_sensor.hpp"
-#include "sim/ideal_calibration.hpp"
 #include "tests/support/temp_dir.hpp"
-#include "tests/system/builtin_adc.hpp"
 #include "tests/system/ftd_process.hpp"
+#include "tests/system/sim_noise.hpp"
 
 namespace ftstack {
 namespace {
 
 using Eigen::Vector3d;
-
-/// Noise σ of one sample per axis (the simulated ADC's input noise and quantisation propagated
-/// through the ideal calibration) and the fixed-point core's worst-case error, SI.
-void DeriveNoise(std::array<double, 6>* sigma, std::array<double, 6>* fixed_error) {
-  const auto model = sim::MakeDefaultSensor();
-  const test::BuiltinAdc builtin = test::BuiltinSimAdc();
-  const cal::CalFile c = sim::IdealCalibration(*model, builtin.info);
-  const double q = builtin.info.full_scale_nvv * 1e-6 / builtin.info.max_counts;
-  const double var = builtin.noise_rms_mvv * builtin.noise_rms_mvv + q * q / 12.0;
-  for (std::size_t i = 0; i < 6; ++i) {
-    double s2 = 0;
-    for (std::size_t ch = 0; ch < 6; ++ch) s2 += c.cal.matrix[i][ch] * c.cal.matrix[i][ch] * var;
-    (*sigma)[i] = std::sqrt(s2);
-  }
-  fw::LoadReport rep;
-  (void)cal::ToFixed(c, builtin.info, &rep);
-  *fixed_error = rep.worst_case_error_si;
-}
 
 std::vector<std::uint16_t> Floats(const Vector3d& v) {
   std::vector<std::uint16_t> r(6);
@@ -74,8 +53,9 @@ TEST(FtdPayload, EightOrientationsReadZeroAfterTheGravityVectorIsWritten) {
   cal::SavePayloadFile(dir / "payload.json", pf);
   const std::uint32_t file_crc = cal::LoadPayloadFile(dir / "payload.json").crc32;
 
-  std::array<double, 6> sigma{}, fixed_error{};
-  DeriveNoise(&sigma, &fixed_error);
+  const test::SimNoise noise = test::DeriveSimNoise();
+  const std::array<double, 6>& sigma = noise.sigma;
+  const std::array<double, 6>& fixed_error = noise.fixed_error;
   constexpr int kFilter = 256;
   const double d = M_PI / 180.0;
   const std::array<std::array<double, 3>, 8> rpy = {{{0, 0, 0},
