@@ -25,6 +25,7 @@
 #include "tests/support/temp_dir.hpp"
 #include "tests/system/builtin_adc.hpp"
 #include "tests/system/ftd_process.hpp"
+#include "tests/system/sim_noise.hpp"
 
 namespace ftstack {
 namespace {
@@ -41,22 +42,8 @@ struct Expected {
   std::array<double, 6> fixed_error_si{};
 };
 Expected DeriveExpected() {
-  const auto model = sim::MakeDefaultSensor();
-  const test::BuiltinAdc builtin = test::BuiltinSimAdc();
-  const hal::AdcInfo adc = builtin.info;
-  const cal::CalFile c = sim::IdealCalibration(*model, adc);
-  const double q_mvv = adc.full_scale_nvv * 1e-6 / adc.max_counts;
-  const double var = builtin.noise_rms_mvv * builtin.noise_rms_mvv + q_mvv * q_mvv / 12.0;
-  Expected e;
-  for (std::size_t i = 0; i < 6; ++i) {
-    double s2 = 0;
-    for (std::size_t ch = 0; ch < 6; ++ch) s2 += c.cal.matrix[i][ch] * c.cal.matrix[i][ch] * var;
-    e.sigma_si[i] = std::sqrt(s2);
-  }
-  fw::LoadReport rep;
-  (void)cal::ToFixed(c, adc, &rep);
-  e.fixed_error_si = rep.worst_case_error_si;
-  return e;
+  const test::SimNoise n = test::DeriveSimNoise();
+  return {n.sigma, n.fixed_error};
 }
 
 /// A libmodbus TCP client connected to the daemon.
