@@ -9,6 +9,7 @@
 #include "calibration/cal_file.hpp"
 #include "calibration/fit.hpp"
 #include "calibration/fit_report.hpp"
+#include "calibration/known_mass.hpp"
 #include "calibration/payload.hpp"
 #include "calibration/slots.hpp"
 #include "measurement/recording.hpp"
@@ -35,6 +36,30 @@ void PrintWorstCase(const ftstack::fw::LoadReport& rep) {
       rep.worst_case_error_si[3], rep.worst_case_error_si[4], rep.worst_case_error_si[5]);
 }
 
+/// A rig recording for `ftcal fit`: with a reference wrench, or with known masses (mass_kg,
+/// arm_*_m, g*_mps2) turned into one, plus the jig's load when asked to identify it.
+ftstack::Recording ReadRigRecording(const std::string& path, bool identify_jig) {
+  using namespace ftstack;
+  ReadOptions opt;
+  opt.require_bridges = true;
+  Recording rec = ReadRecording(path, opt);
+  if (!cal::IsKnownMassRecording(rec)) {
+    if (identify_jig) throw std::invalid_argument("--identify-jig needs a mass_kg column");
+    for (const std::string& c : WrenchColumns()) (void)rec.Column(c);  // names the file
+    return rec;
+  }
+  rec = cal::WithReferenceFromMasses(rec);
+  if (identify_jig) {
+    const cal::JigEstimate jig = cal::IdentifyJig(rec);
+    std::printf("jig: %.4f ± %.4f kg, centre of mass %.2f %.2f %.2f mm (± %.2f, %.2f, %.2f mm)\n",
+                jig.mass_kg, jig.mass_sigma_kg, jig.com_m[0] * 1e3, jig.com_m[1] * 1e3,
+                jig.com_m[2] * 1e3, jig.com_sigma_m[0] * 1e3, jig.com_sigma_m[1] * 1e3,
+                jig.com_sigma_m[2] * 1e3);
+    rec = cal::WithJig(rec, jig);
+  }
+  return rec;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -52,7 +77,9 @@ int main(int argc, char** argv) {
   int folds = 10;
 
   auto* fit = app.add_subcommand("fit", "fit a calibration to rig data (reference wrench + b*)");
-  fit->add_option("--in", in_path, "rig recording (t, Fx…Mz, b0…, optional temp_C, block/pose)")
+  fit->add_option("--in", in_path,
+                  "rig recording (t, b0…, Fx…Mz or mass_kg arm_*_m g*_mps2, optional temp_C, "
+                  "block/pose)")
       ->required();
   fit->add_option("--out", out_path, "calibration file to write")->required();
   fit->add_option("--report", report_path, "self-contained HTML report with plots");
@@ -65,6 +92,10 @@ int main(int argc, char** argv) {
   fit->add_option("--serial", serial, "serial number written to the file");
   fit->add_option("--folds", folds, "cross-validation folds over whole load blocks")
       ->check(CLI::Range(2, 100));
+  bool identify_jig = false;
+  fit->add_flag("--identify-jig", identify_jig,
+                "known-mass recordings: identify the loading jig's mass and centre of mass and "
+                "add its load to the reference");
 
   auto* apply = app.add_subcommand("apply", "run the firmware's fixed-point core on a recording");
   apply->add_option("--cal", cal_path, "calibration file")->required();
@@ -117,10 +148,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     if (*fit) {
-      ReadOptions opt;
-      opt.require_bridges = true;
-      opt.require_wrench = true;
-      const Recording rec = ReadRecording(in_path, opt);
+      const Recording rec = ReadRigRecording(in_path, identify_jig);
       cal::FitOptions fo;
       fo.folds = folds;
       hal::AdcInfo adc{};
