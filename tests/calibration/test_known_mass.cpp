@@ -14,6 +14,7 @@
 #include "calibration/known_mass.hpp"
 #include "sim/sensor_description.hpp"
 #include "sim/sensor_model.hpp"
+#include "tests/calibration/run_ftcal.hpp"
 #include "tests/support/temp_dir.hpp"
 
 namespace {
@@ -166,14 +167,7 @@ TEST(KnownMass, MissingColumnsAndBadValuesNameTheFile) {
   EXPECT_THROW((void)ftstack::cal::WithReferenceFromMasses(no_g), ftstack::RecordingError);
 }
 
-int RunFtcal(const std::string& args, std::string* out) {
-  const std::string cmd = std::string(FTSTACK_BIN_DIR) + "/ftcal " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  char buf[4096];
-  while (p != nullptr && std::fgets(buf, sizeof buf, p) != nullptr) *out += buf;
-  const int status = p != nullptr ? pclose(p) : -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+using ftstack::test::RunFtcal;
 
 TEST(FtcalFitKnownMass, FitsFromMassesAndReportsTheJig) {
   ftstack::test::TempDir dir("ftcal_known_mass");

@@ -12,6 +12,7 @@
 
 #include "calibration/payload.hpp"
 #include "sim/default_sensor.hpp"
+#include "tests/calibration/run_ftcal.hpp"
 #include "tests/support/temp_dir.hpp"
 
 namespace {
@@ -250,14 +251,7 @@ TEST(PayloadFile, RoundTripsAndRefusesCorruption) {
 
 namespace {
 
-int RunFtcal(const std::string& args, std::string* out) {
-  const std::string cmd = std::string(FTSTACK_BIN_DIR) + "/ftcal " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  char buf[4096];
-  while (p != nullptr && std::fgets(buf, sizeof buf, p) != nullptr) *out += buf;
-  const int status = p != nullptr ? pclose(p) : -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+using ftstack::test::RunFtcal;
 
 void WriteReadings(const std::string& path, const std::vector<PayloadReading>& rs) {
   std::ofstream o(path);
