@@ -1,5 +1,4 @@
-// Calibration with known masses: reference wrenches from mass, lever arm and gravity per row, and
-// the loading jig's own mass and centre of mass identified jointly with an affine calibration.
+// Calibration with known masses: reference wrenches from mass, arm and gravity; jig identification.
 #pragma once
 
 #include <array>
