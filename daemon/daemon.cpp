@@ -275,6 +275,7 @@ void Ftd::StartRdt() {
   ro.counts_per_n = opt_.rdt_counts_per_n;
   ro.counts_per_nm = opt_.rdt_counts_per_nm;
   ro.buffer_records = opt_.rdt_buffer;
+  ro.status_mask = opt_.rdt_status_mask;
   rdt_ = std::make_unique<RdtServer>(ro, map_.get());
   std::string error;
   if (!rdt_->Open(&error)) throw FtdError("RDT on " + opt_.rdt + ": " + error);

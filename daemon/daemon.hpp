@@ -42,9 +42,10 @@ struct FtdOptions {
   std::string rdt;      ///< HOST:PORT of the RDT server ("" = none)
   double rdt_counts_per_n = 1e6;
   double rdt_counts_per_nm = 1e6;
-  unsigned rdt_buffer = 4;  ///< records per packet in buffered RDT modes
-  std::string modbus_tcp;   ///< HOST:PORT ("" = no TCP server)
-  std::string modbus_rtu;   ///< serial device ("" = no RTU server)
+  unsigned rdt_buffer = 4;                 ///< records per packet in buffered RDT modes
+  std::uint32_t rdt_status_mask = 0xFFFF;  ///< status bits copied into RDT records
+  std::string modbus_tcp;                  ///< HOST:PORT ("" = no TCP server)
+  std::string modbus_rtu;                  ///< serial device ("" = no RTU server)
   unsigned baud = 19200;
   char parity = 'N';
   unsigned unit_id = 1;

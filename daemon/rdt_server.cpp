@@ -175,7 +175,7 @@ void RdtServer::SendSample(const Slot& s) {
     std::uint8_t* r = &c.packet[c.pending * kRdtRecordBytes];
     PutU32(r, ++c.rdt_sequence);
     PutU32(r + 4, s.ft_sequence);
-    PutU32(r + 8, s.status);
+    PutU32(r + 8, s.status & opt_.status_mask);
     for (std::size_t a = 0; a < fw::kAxes; ++a) {
       PutU32(r + 12 + 4 * a, static_cast<std::uint32_t>(counts[a]));
     }

@@ -35,6 +35,9 @@ struct RdtOptions {
   double counts_per_n = 1e6;             ///< counts per N in the Fx Fy Fz fields
   double counts_per_nm = 1e6;            ///< counts per N·m in the Tx Ty Tz fields
   unsigned buffer_records = 4;           ///< records per packet in buffered / multi-unit mode
+  /// Status bits copied into the records' status word (drivers that treat any non-zero status as
+  /// a fault may want only the fault bits, e.g. 0x031F without tare 5, temperature 6, simulated 7).
+  std::uint32_t status_mask = 0xFFFF;
 };
 
 /// Largest number of streaming clients and of records in one packet.

@@ -53,6 +53,9 @@ int Run(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--rdt-buffer", opt.rdt_buffer, "RDT records per packet in buffered mode")
       ->check(CLI::Range(1u, 40u));
+  app.add_option("--rdt-status-mask", opt.rdt_status_mask,
+                 "status bits copied into RDT records (default 0xFFFF: all)")
+      ->check(CLI::Range(0u, 0xFFFFu));
   app.add_option("--baud", opt.baud, "RTU baud rate")->check(CLI::Range(300u, 4000000u));
   app.add_option("--parity", parity, "RTU parity N|E|O")->check(CLI::IsMember({"N", "E", "O"}));
   app.add_option("--unit-id", opt.unit_id, "Modbus unit id")->check(CLI::Range(1u, 247u));
