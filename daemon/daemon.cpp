@@ -241,14 +241,7 @@ void Ftd::Start() {
     }
   }
   if (!opt_.rdt.empty()) StartRdt();
-  if (!opt_.log.empty()) {
-    std::FILE* f = std::fopen(opt_.log.c_str(), "w");
-    if (f == nullptr) {
-      throw FtdError(opt_.log + ": cannot write: " + std::system_category().message(errno));
-    }
-    std::fclose(f);
-    ring_.resize(kLogRingCapacity);
-  }
+  if (!opt_.log.empty()) PrepareLog();
 
   stop_ = false;
   start_us_ = fw::MonotonicUs();
@@ -258,6 +251,15 @@ void Ftd::Start() {
   if (tcp_) threads_.emplace_back([this] { tcp_->Run(stop_); });
   if (rtu_) threads_.emplace_back([this] { rtu_->Run(stop_); });
   if (rdt_) threads_.emplace_back([this] { rdt_->Run(stop_); });
+}
+
+void Ftd::PrepareLog() {
+  std::FILE* f = std::fopen(opt_.log.c_str(), "w");
+  if (f == nullptr) {
+    throw FtdError(opt_.log + ": cannot write: " + std::system_category().message(errno));
+  }
+  std::fclose(f);
+  ring_.resize(kLogRingCapacity);
 }
 
 void Ftd::StartRdt() {

@@ -102,6 +102,7 @@ class Ftd {
  private:
   void SamplingLoop();
   void StartRdt();
+  void PrepareLog();  ///< checks that --log can be written, sizes the log ring
 
   FtdOptions opt_;
   SimulatorFactory simulator_ = nullptr;

@@ -60,6 +60,18 @@ ftstack::Recording ReadRigRecording(const std::string& path, bool identify_jig) 
   return rec;
 }
 
+/// ftcal payload: identify, write the payload file, print the summary.
+void RunPayload(const std::string& in_path, const std::string& out_path, double max_condition) {
+  using namespace ftstack;
+  const Recording rec = ReadRecording(in_path);
+  cal::PayloadFitOptions po;
+  po.max_condition = max_condition;
+  cal::PayloadFit pfit = cal::FitPayload(cal::PayloadReadingsFromRecording(rec), po);
+  pfit.file.date = Today();
+  cal::SavePayloadFile(out_path, pfit.file);
+  std::printf("%swrote %s\n", cal::PayloadSummary(pfit).c_str(), out_path.c_str());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -186,13 +198,7 @@ int main(int argc, char** argv) {
       }
       std::printf("wrote %s\n", out_path.c_str());
     } else if (*payload) {
-      const Recording rec = ReadRecording(in_path);
-      cal::PayloadFitOptions po;
-      po.max_condition = max_condition;
-      cal::PayloadFit pfit = cal::FitPayload(cal::PayloadReadingsFromRecording(rec), po);
-      pfit.file.date = Today();
-      cal::SavePayloadFile(out_path, pfit.file);
-      std::printf("%swrote %s\n", cal::PayloadSummary(pfit).c_str(), out_path.c_str());
+      RunPayload(in_path, out_path, max_condition);
     } else if (*import_ati) {
       const cal::AtiImport imp = cal::ImportAtiCal(ati_path);
       for (const std::string& w : imp.warnings)
