@@ -8,10 +8,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <thread>
 
 #include "calibration/payload_file.hpp"
 #include "firmware/register_map.hpp"
+#include "tests/calibration/run_ftcal.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/system/ftd_process.hpp"
 #include "tests/system/sim_noise.hpp"
@@ -109,6 +111,91 @@ TEST(FtdPayload, EightOrientationsReadZeroAfterTheGravityVectorIsWritten) {
     modbus_close(ctx);
     modbus_free(ctx);
     EXPECT_EQ(ftd.Stop(SIGTERM), 0);
+  }
+}
+
+Eigen::Matrix3d Rpy(double r, double p, double y) {
+  const double d = M_PI / 180.0;
+  return (Eigen::AngleAxisd(y * d, Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(p * d, Vector3d::UnitY()) * Eigen::AngleAxisd(r * d, Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+/// Runs ftd with the payload's load in orientation r (plus `extra` arguments, and the gravity
+/// vector written when `compensate`), filter 256, and returns the wrench it then reads (N, N·m).
+std::array<double, 6> FtdReading(double mass, const Vector3d& com, const Eigen::Matrix3d& r,
+                                 std::vector<std::string> extra, bool compensate) {
+  const Vector3d weight(0, 0, -mass * 9.80665);
+  const Vector3d f = r.transpose() * weight;
+  const Vector3d m = r.transpose() * (r * com).cross(weight);
+  char wrench[256];
+  std::snprintf(wrench, sizeof wrench, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", f.x(), f.y(), f.z(), m.x(),
+                m.y(), m.z());
+  std::vector<std::string> args = {"--adc", "sim",          "--sim-wrench",
+                                   wrench,  "--modbus-tcp", "127.0.0.1:0"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  test::FtdProcess ftd(args);
+  std::array<double, 6> out{};
+  out.fill(NAN);
+  if (ftd.port() <= 0) return out;
+  modbus_t* ctx = modbus_new_tcp("127.0.0.1", ftd.port());
+  modbus_set_response_timeout(ctx, 1, 0);
+  std::array<std::uint16_t, 85> in{};
+  bool ok = modbus_connect(ctx) == 0 && modbus_write_register(ctx, fw::kHoldFilterLength, 256) == 1;
+  if (ok && compensate) {
+    const auto regs = Floats(r.transpose() * Vector3d(0, 0, -9.80665));
+    ok = modbus_write_registers(ctx, fw::kHoldGravity, 6, regs.data()) == 6 &&
+         modbus_write_register(ctx, fw::kHoldGravityComp, 1) == 1;
+  }
+  if (ok && ReadAfter(ctx, 266, &in)) {
+    for (std::size_t k = 0; k < 6; ++k) out[k] = fw::UnpackFloat32(&in[fw::kInWrenchFloat + 2 * k]);
+  }
+  modbus_close(ctx);
+  modbus_free(ctx);
+  (void)ftd.Stop(SIGTERM);
+  return out;
+}
+
+/// The robot workflow through the real chain: static readings from ftd in six poses → ftcal
+/// payload → ftd --payload reads zero in a seventh pose it was not fitted on.
+TEST(FtdPayload, IdentifiedFromFtdReadingsThenCompensatedInANewPose) {
+  test::TempDir dir("ftd_payload_flow");
+  const double mass = 1.4;
+  const Vector3d com(0.010, 0.020, 0.070);
+  const std::vector<Eigen::Matrix3d> poses = {Rpy(0, 0, 0),   Rpy(180, 0, 0), Rpy(90, 0, 0),
+                                              Rpy(-90, 0, 0), Rpy(0, 90, 0),  Rpy(0, -90, 0)};
+  {
+    std::ofstream csv(dir / "poses.csv");
+    csv << "gx_mps2,gy_mps2,gz_mps2,Fx,Fy,Fz,Mx,My,Mz\n";
+    csv.precision(10);
+    for (const auto& r : poses) {
+      const Vector3d g = r.transpose() * Vector3d(0, 0, -9.80665);
+      const auto w = FtdReading(mass, com, r, {}, false);
+      csv << g.x() << ',' << g.y() << ',' << g.z();
+      for (double v : w) csv << ',' << v;
+      csv << '\n';
+    }
+  }
+  std::string out;
+  ASSERT_EQ(
+      test::RunFtcal("payload --in " + (dir / "poses.csv") + " --out " + (dir / "p.json"), &out), 0)
+      << out;
+  const cal::PayloadFile p = cal::LoadPayloadFile(dir / "p.json");
+  EXPECT_NEAR(p.mass_kg, mass, 0.01 * mass) << out;
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(p.com_m[static_cast<std::size_t>(k)], com(k), 1e-3) << out;
+  // A pose the fit did not see.
+  const auto w = FtdReading(mass, com, Rpy(-50, 35, 100), {"--payload", dir / "p.json"}, true);
+  const test::SimNoise noise = test::DeriveSimNoise();
+  for (std::size_t k = 0; k < 6; ++k) {
+    // Filtered noise + core error + LSB, plus 3σ of what the identification could not pin down
+    // (mass and bias for forces; centre of mass and bias for moments), each on the full weight.
+    const double id =
+        k < 3 ? 3 * (p.mass_sigma_kg * 9.80665 + p.force_bias_sigma_n[k])
+              : 3 * (p.com_sigma_m[0] + p.com_sigma_m[1] + p.com_sigma_m[2]) * mass * 9.80665 +
+                    3 * p.moment_bias_sigma_nm[k - 3];
+    const double tol = 5.0 * noise.sigma[k] / 16.0 + noise.fixed_error[k] + fw::AxisLsb(k) + id;
+    EXPECT_NEAR(w[k], 0.0, tol) << "axis " << k << "\n" << out;
   }
 }
 
