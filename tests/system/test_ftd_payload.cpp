@@ -168,9 +168,12 @@ TEST(FtdPayload, IdentifiedFromFtdReadingsThenCompensatedInANewPose) {
     std::ofstream csv(dir / "poses.csv");
     csv << "gx_mps2,gy_mps2,gz_mps2,Fx,Fy,Fz,Mx,My,Mz\n";
     csv.precision(10);
-    for (const auto& r : poses) {
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      const Eigen::Matrix3d& r = poses[i];
       const Vector3d g = r.transpose() * Vector3d(0, 0, -9.80665);
-      const auto w = FtdReading(mass, com, r, {}, false);
+      // A seed per pose: independent noise (one seed would repeat one noise sequence, which the
+      // fit would take for a bias).
+      const auto w = FtdReading(mass, com, r, {"--seed", std::to_string(11 + i)}, false);
       csv << g.x() << ',' << g.y() << ',' << g.z();
       for (double v : w) csv << ',' << v;
       csv << '\n';
