@@ -108,9 +108,13 @@ PayloadFile LoadPayloadFile(const std::string& path) {
   if (!in) throw PayloadFileError(path + ": cannot open: " + std::strerror(errno));
   std::stringstream ss;
   ss << in.rdbuf();
+  return ParsePayloadFile(ss.str(), path);
+}
+
+PayloadFile ParsePayloadFile(const std::string& text, const std::string& path) {
   nlohmann::json j;
   try {
-    j = ParseJsonText(ss.str(), path);
+    j = ParseJsonText(text, path);
   } catch (const CalFileError& e) {
     throw PayloadFileError(e.what());
   }

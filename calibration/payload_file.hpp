@@ -45,6 +45,8 @@ struct PayloadFile {
 [[nodiscard]] PayloadFile PayloadFromJson(const nlohmann::json& j, const std::string& path);
 /// Reads and verifies a payload file; syntax errors name line and column.
 [[nodiscard]] PayloadFile LoadPayloadFile(const std::string& path);
+/// The same for a file's text already in memory; `path` only names it in messages.
+[[nodiscard]] PayloadFile ParsePayloadFile(const std::string& text, const std::string& path);
 /// Writes atomically (temporary file, fsync, rename).
 void SavePayloadFile(const std::string& path, const PayloadFile& p);
 

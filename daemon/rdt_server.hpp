@@ -73,6 +73,10 @@ class RdtServer {
   void Publish(const fw::DeviceSample& d);
   /// Serves until `stop` is set.
   void Run(const std::atomic<bool>& stop);
+  /// One received datagram from ip:port (network order), as Run handles it; public for the fuzzer.
+  void HandleRequest(const std::uint8_t* buf, long n, std::uint32_t ip, std::uint16_t port);
+  /// Sends what Publish queued to the streaming clients, as Run does after each wake-up.
+  void DrainRing();
   [[nodiscard]] RdtStats stats() const;
 
  private:
@@ -95,10 +99,8 @@ class RdtServer {
   };
   static constexpr std::size_t kRingSize = 4096;
 
-  void HandleRequest(const std::uint8_t* buf, long n, std::uint32_t ip, std::uint16_t port);
   void SendSample(const Slot& s);
   void Flush(Client& c);
-  void DrainRing();
 
   RdtOptions opt_;
   fw::RegisterMap* map_;
