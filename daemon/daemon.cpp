@@ -1,8 +1,10 @@
 #include "daemon/daemon.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -11,6 +13,7 @@
 #include "calibration/cal_file.hpp"
 #include "calibration/payload_file.hpp"
 #include "daemon/hardware_adc.hpp"
+#include "daemon/realtime.hpp"
 #include "measurement/recording.hpp"
 
 namespace ftstack::daemon {
@@ -43,6 +46,12 @@ void LoadSlot(const std::string& path, const char* name, const hal::AdcInfo& adc
               std::array<double, 6>* rated) {
   try {
     *slot = SlotFromFile(path, adc, rated);
+    if (slot->fixed.invalid_axes != 0) {
+      std::fprintf(stderr,
+                   "ftd: calibration slot %s (%s) flags axis %s invalid (not calibrated): served "
+                   "as NaN / 0 with status bit 10\n",
+                   name, path.c_str(), cal::AxisList(slot->fixed.invalid_axes).c_str());
+    }
   } catch (const std::exception& e) {
     *slot = fw::CalSlot{};
     std::fprintf(stderr, "ftd: calibration slot %s refused: %s\n", name, e.what());
@@ -247,7 +256,17 @@ void Ftd::Start() {
   start_us_ = fw::MonotonicUs();
   stop_us_ = 0;
   running_ = true;
+  // Memory first (before the threads' stacks), then the sampling thread's policy; one line says
+  // what the system granted. A benchmark run (--unpaced) never asks: it would hog a core.
+  const std::string memory = opt_.paced ? LockMemory() : "memory not locked (--unpaced)";
   threads_.emplace_back([this] { SamplingLoop(); });
+  pthread_setname_np(threads_.back().native_handle(), "ftd-sampler");
+  bool rt = false;
+  const std::string sched = opt_.paced ? MakeRealtime(threads_.back().native_handle(), &rt)
+                                       : "default scheduler (--unpaced)";
+  realtime_ = "sampling thread: " + sched + ", " + memory;
+  std::fprintf(stderr, "ftd: %s%s\n", realtime_.c_str(),
+               rt ? "" : " — samples may be late under load (late_samples counts them)");
   if (tcp_) threads_.emplace_back([this] { tcp_->Run(stop_); });
   if (rtu_) threads_.emplace_back([this] { rtu_->Run(stop_); });
   if (rdt_) threads_.emplace_back([this] { rdt_->Run(stop_); });
@@ -285,16 +304,43 @@ void Ftd::StartRdt() {
                static_cast<unsigned>(rdt_->port()), ro.counts_per_n, ro.counts_per_nm);
 }
 
+void Ftd::BackOff(std::uint32_t pause_us) {
+  // In slices, so that Stop() is not kept waiting for a whole pause.
+  const std::uint64_t until = fw::MonotonicUs() + pause_us;
+  for (std::uint64_t now = fw::MonotonicUs(); now < until && !stop_.load(std::memory_order_relaxed);
+       now = fw::MonotonicUs()) {
+    const std::uint64_t slice = std::min<std::uint64_t>(until - now, 10000);
+    timespec ts{static_cast<time_t>(slice / 1000000), static_cast<long>(slice % 1000000) * 1000};
+    nanosleep(&ts, nullptr);
+  }
+}
+
 void Ftd::SamplingLoop() {
   bool published = false;
+  const std::uint32_t period_us = device_->sample_period_us();
+  std::uint32_t backoff_us = 0;
   while (!stop_.load(std::memory_order_relaxed)) {
+    const std::uint64_t t0 = fw::MonotonicUs();
     const hal::Status s = device_->Step(&published);
     if (s == hal::Status::kEndOfData || s == hal::Status::kNotConfigured ||
         s == hal::Status::kUnavailable) {
       ended_ = true;
       return;
     }
-    if (s != hal::Status::kOk) continue;
+    if (s != hal::Status::kOk) {
+      // The step published the fault (bit 3, and bit 8 once no sample comes); an error that
+      // returns at once must not turn this loop into a busy one: pause, doubling from one
+      // period up to kMaxBackoffUs, until a step succeeds.
+      adc_errors_.fetch_add(1, std::memory_order_relaxed);
+      if (fw::MonotonicUs() - t0 < period_us) {
+        backoff_us = backoff_us == 0 ? std::max<std::uint32_t>(period_us, 1)
+                                     : std::min(2 * backoff_us, kMaxBackoffUs);
+        backoffs_.fetch_add(1, std::memory_order_relaxed);
+        BackOff(backoff_us);
+      }
+      continue;
+    }
+    backoff_us = 0;
     samples_.fetch_add(1, std::memory_order_relaxed);
     if (published && rdt_) rdt_->Publish(device_->last_published());
     if (!published || ring_.empty()) continue;
@@ -376,6 +422,9 @@ FtdStats Ftd::stats() const {
   s.logged_rows = logged_rows_;
   s.log_dropped = log_dropped_.load(std::memory_order_relaxed);
   s.sampling_ended = ended_.load(std::memory_order_relaxed);
+  s.adc_errors = adc_errors_.load(std::memory_order_relaxed);
+  s.backoffs = backoffs_.load(std::memory_order_relaxed);
+  s.realtime = realtime_;
   return s;
 }
 

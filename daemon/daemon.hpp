@@ -54,7 +54,15 @@ struct FtdOptions {
   std::string spidev;
   std::uint64_t seed = 1;
   bool paced = true;  ///< simulated ADC follows the wall clock (false: as fast as possible)
+  /// Simulated ADC: hold the sampling thread sim_stall_ms on every sim_stall_every-th sample
+  /// (0: never) — a deterministic stand-in for a preempted sampler (--sim-stall EVERY:MS).
+  unsigned sim_stall_every = 0;
+  double sim_stall_ms = 0;
 };
+
+/// Longest pause of the sampling loop after a backend call that failed at once (the back-off
+/// doubles from one sample period up to this).
+inline constexpr std::uint32_t kMaxBackoffUs = 100000;
 
 /// Parses "HOST:PORT"; throws FtdError naming the bad part.
 void ParseHostPort(const std::string& text, std::string* host, std::uint16_t* port);
@@ -71,6 +79,9 @@ struct FtdStats {
   std::uint64_t logged_rows = 0;
   std::uint64_t log_dropped = 0;  ///< samples the logger could not keep up with
   bool sampling_ended = false;    ///< replay finished or the ADC failed for good
+  std::uint64_t adc_errors = 0;   ///< failed sampling steps (timeouts, read errors)
+  std::uint64_t backoffs = 0;     ///< pauses after a step that failed at once (no busy loop)
+  std::string realtime;           ///< the sampling thread's scheduling and memory, one line
 };
 
 /// The running daemon. Start() spawns the threads; Stop() (or the destructor) joins them.
@@ -103,6 +114,7 @@ class Ftd {
   void SamplingLoop();
   void StartRdt();
   void PrepareLog();  ///< checks that --log can be written, sizes the log ring
+  void BackOff(std::uint32_t pause_us);
 
   FtdOptions opt_;
   SimulatorFactory simulator_ = nullptr;
@@ -129,6 +141,9 @@ class Ftd {
   std::atomic<bool> stop_{false};
   std::atomic<bool> ended_{false};
   std::atomic<std::uint64_t> samples_{0};
+  std::atomic<std::uint64_t> adc_errors_{0};
+  std::atomic<std::uint64_t> backoffs_{0};
+  std::string realtime_;
   std::uint64_t start_us_ = 0;
   std::uint64_t stop_us_ = 0;  ///< when Stop was called (0 while running)
   std::vector<std::thread> threads_;

@@ -31,6 +31,7 @@ struct DeviceSample {
   std::uint32_t late_samples = 0;       ///< samples read late since start (missed deadlines)
   std::int64_t payload_mass_ug = 0;     ///< payload of gravity compensation, µg (0: none)
   std::uint32_t payload_crc = 0;        ///< CRC-32 of its payload file (input registers 79–80)
+  std::uint8_t peaks_invalid_axes = 0;  ///< bit r: peak r is not a value (sensor frame)
 };
 
 /// One calibration slot as the device holds it.
@@ -139,6 +140,9 @@ class Device {
   std::uint32_t publish_sequence_ = 0;
   std::uint64_t samples_ = 0;
   std::atomic<std::uint64_t> last_sample_us_{0};
+  std::uint64_t start_us_ = 0;       ///< device clock at Start: the samples' time origin
+  std::uint64_t last_stamp_us_ = 0;  ///< time given to the previous sample, since Start
+  bool stamped_ = false;
   std::uint64_t previous_read_us_ = 0;  ///< 0 until the first sample
   std::uint32_t late_samples_ = 0;
 };

@@ -70,13 +70,16 @@ void BuildInputRegisters(const DeviceSample& d, const hal::AdcInfo& adc, std::ui
   // the wrench registers read NaN and 0, never a held or clipped value.
   const bool cal_ok = (status & (kStatusCalInvalid | kStatusSaturated)) == 0;
   for (std::size_t i = 0; i < kAxes; ++i) {
-    PackFloat32(cal_ok ? LsbToSi(s.wrench[i], i) : kNaN, &r[kInWrenchFloat + 2 * i]);
+    // An axis the calibration does not determine (status bit 10) is never a value either.
+    const bool axis_ok = cal_ok && (s.invalid_axes & (1u << i)) == 0;
+    const bool peak_ok = (d.peaks_invalid_axes & (1u << i)) == 0;
+    PackFloat32(axis_ok ? LsbToSi(s.wrench[i], i) : kNaN, &r[kInWrenchFloat + 2 * i]);
     // Forces are already mN; moments go from 10 µN·m to mN·m, rounded to nearest.
     const std::int32_t v =
         i < 3 ? s.wrench[i]
               : static_cast<std::int32_t>(RoundDiv(s.wrench[i], kMomentLsbPerMilliNm));
-    PackI32(cal_ok ? v : 0, &r[kInWrenchInt + 2 * i]);
-    PackFloat32(LsbToSi(d.peaks_lsb[i], i), &r[kInPeaks + 2 * i]);
+    PackI32(axis_ok ? v : 0, &r[kInWrenchInt + 2 * i]);
+    PackFloat32(peak_ok ? LsbToSi(d.peaks_lsb[i], i) : kNaN, &r[kInPeaks + 2 * i]);
   }
   PackFloat32(s.has_temperature ? static_cast<float>(s.temperature_mdegc * 1e-3) : kNaN,
               &r[kInTemperature]);

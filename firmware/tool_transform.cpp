@@ -68,6 +68,17 @@ TransformStatus MakeToolTransform(const ToolTransformParams& params, FixedToolTr
   return TransformStatus::kOk;
 }
 
+std::uint8_t ToolFrameInvalidAxes(const FixedToolTransform& t, std::uint8_t sensor_invalid) {
+  if (t.identity || sensor_invalid == 0) return sensor_invalid;
+  std::uint8_t out = 0;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    for (std::size_t j = 0; j < kAxes; ++j) {
+      if ((sensor_invalid & (1u << j)) != 0 && t.coef[r][j] != 0) out |= 1u << r;
+    }
+  }
+  return out;
+}
+
 void ApplyToolTransform(const FixedToolTransform& t, const WrenchLsb& in, WrenchLsb* out,
                         bool* saturated) {
   if (t.identity) {

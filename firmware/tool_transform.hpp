@@ -47,4 +47,9 @@ enum class TransformStatus : std::uint8_t {
 void ApplyToolTransform(const FixedToolTransform& t, const WrenchLsb& in, WrenchLsb* out,
                         bool* saturated);
 
+/// The tool-frame axes that depend on any sensor-frame axis in `sensor_invalid` (bit per axis):
+/// row r is invalid when a non-zero coefficient takes an invalid axis into it.
+[[nodiscard]] std::uint8_t ToolFrameInvalidAxes(const FixedToolTransform& t,
+                                                std::uint8_t sensor_invalid);
+
 }  // namespace ftstack::fw

@@ -174,7 +174,7 @@ TEST(FtcalFitKnownMass, FitsFromMassesAndReportsTheJig) {
   ftstack::WriteRecording(dir / "rig.csv", MakeRig(Jig{}, 8, nullptr));
   std::string out;
   ASSERT_EQ(RunFtcal("fit --in " + (dir / "rig.csv") + " --out " + (dir / "cal.json") +
-                         " --model linear --folds 8 --identify-jig",
+                         " --model linear --folds 8 --identify-jig --rated 200,200,400,10,10,8",
                      &out),
             0)
       << out;
@@ -186,7 +186,7 @@ TEST(FtcalFitKnownMass, FitsFromMassesAndReportsTheJig) {
   ftstack::WriteRecording(dir / "flat.csv", MakeRig(Jig{}, 1, nullptr));
   out.clear();
   EXPECT_EQ(RunFtcal("fit --in " + (dir / "flat.csv") + " --out " + (dir / "c2.json") +
-                         " --model linear --folds 2 --identify-jig",
+                         " --model linear --folds 2 --identify-jig --rated 200,200,400,10,10,8",
                      &out),
             1);
   EXPECT_NE(out.find("not identifiable"), std::string::npos) << out;

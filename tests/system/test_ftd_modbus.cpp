@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <map>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <system_error>
@@ -534,10 +536,18 @@ TEST(FtdModbus, EveryReplyComesFromOneSample) {
     Client c(ftd.port());
     ASSERT_TRUE(c.WaitSamples(200));  // past start-up, when the sampler may catch up in a burst
   }
+  // The timestamp is the measured read time (not count × period), so it cannot be predicted
+  // from the sequence: every reply of one sequence number must carry the same timestamp (shared
+  // by both readers), and a later sequence a later timestamp. The wrench is the simulator's at
+  // the sample's own time (sequence − 1) ms.
+  std::mutex seen_mutex;
+  std::map<std::uint32_t, std::uint32_t> ts_of_seq;
   auto reader = [&] {
     Client c(ftd.port());
     std::array<std::uint16_t, 18> r{};
     std::uint32_t first = 0;
+    std::uint32_t prev_seq = 0;
+    std::uint32_t prev_ts = 0;
     // One second of samples (1000 sequence numbers), read as fast as the server answers.
     for (std::uint32_t seq = 0; first == 0 || seq - first < 1000;) {
       if (c.Input(0, 18, r.data()) != 18) {
@@ -547,10 +557,18 @@ TEST(FtdModbus, EveryReplyComesFromOneSample) {
       seq = UnpackU32(&r[fw::kInSequence]);
       const std::uint32_t ts = UnpackU32(&r[fw::kInTimestampUs]);
       if (first == 0) first = seq;
-      const double t_s = ts * 1e-6;
-      const bool same =
-          ts == (seq - 1) * 1000u &&
-          std::fabs(UnpackFloat32(&r[fw::kInWrenchFloat + 4]) - TriangleFz(t_s)) <= tol;
+      const double t_s = (seq - 1) * 1e-3;
+      bool same = std::fabs(UnpackFloat32(&r[fw::kInWrenchFloat + 4]) - TriangleFz(t_s)) <= tol;
+      if (prev_seq != 0) {
+        same = same && (seq == prev_seq ? ts == prev_ts : (seq > prev_seq && ts > prev_ts));
+      }
+      {
+        const std::lock_guard<std::mutex> lock(seen_mutex);
+        const auto [it, inserted] = ts_of_seq.emplace(seq, ts);
+        same = same && (inserted || it->second == ts);
+      }
+      prev_seq = seq;
+      prev_ts = ts;
       if (!same) ++bad;
       ++checked;
     }

@@ -74,6 +74,10 @@ int Run(int argc, char** argv) {
   app.add_option("--print-hz", print_hz,
                  "rate of reading lines on stdout (default: 5, or 0 when stderr is a terminal and "
                  "shows the status line)");
+  std::string sim_stall;
+  app.add_option("--sim-stall", sim_stall,
+                 "simulated ADC: hold the sampling thread MS ms on every EVERY-th sample, "
+                 "EVERY:MS (tests the late-sample counter)");
   app.add_flag("--unpaced", unpaced, "run the simulated ADC as fast as possible (benchmarks)");
   app.get_option("--sim-wrench")->excludes(app.get_option("--replay"));
   CLI11_PARSE(app, argc, argv);
@@ -84,6 +88,20 @@ int Run(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ftd: --sim-wrench: %s\n", e.what());
     return 2;
+  }
+  if (!sim_stall.empty()) {
+    unsigned every = 0;
+    double ms = 0;
+    char tail = 0;
+    if (std::sscanf(sim_stall.c_str(), "%u:%lf%c", &every, &ms, &tail) != 2 || every < 1 ||
+        !(ms > 0 && ms <= 10000)) {
+      std::fprintf(stderr,
+                   "ftd: --sim-stall '%s': expected EVERY:MS (EVERY >= 1, 0 < MS <= 10000)\n",
+                   sim_stall.c_str());
+      return 2;
+    }
+    opt.sim_stall_every = every;
+    opt.sim_stall_ms = ms;
   }
 
   std::signal(SIGINT, OnSignal);
@@ -147,6 +165,11 @@ int Run(int argc, char** argv) {
                static_cast<unsigned long long>(st.samples), st.elapsed_s,
                st.elapsed_s > 0 ? static_cast<double>(st.samples) / st.elapsed_s : 0.0,
                st.log_dropped > 0 ? " — log dropped samples" : "");
+  if (st.adc_errors > 0) {
+    std::fprintf(stderr, "ftd: %llu failed ADC steps, %llu back-off pauses\n",
+                 static_cast<unsigned long long>(st.adc_errors),
+                 static_cast<unsigned long long>(st.backoffs));
+  }
   return 0;
 }
 }  // namespace
