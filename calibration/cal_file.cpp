@@ -361,10 +361,9 @@ CalFile LoadCalFile(const std::string& path) {
   return ParseCalFile(ss.str(), path);
 }
 
-CalFile ParseCalFile(const std::string& text, const std::string& path) {
-  nlohmann::json j;
+nlohmann::json ParseJsonText(const std::string& text, const std::string& path) {
   try {
-    j = nlohmann::json::parse(text);
+    return nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     // Turn the byte offset into line:column.
     std::size_t line = 1;
@@ -382,6 +381,10 @@ CalFile ParseCalFile(const std::string& text, const std::string& path) {
   } catch (const nlohmann::json::exception& e) {  // e.g. a number out of double's range
     throw CalFileError(path + ": not valid JSON (corrupt): " + e.what());
   }
+}
+
+CalFile ParseCalFile(const std::string& text, const std::string& path) {
+  const nlohmann::json j = ParseJsonText(text, path);
   try {
     return FromJson(j, path);
   } catch (const nlohmann::json::exception& e) {

@@ -65,6 +65,8 @@ struct CalFile {
 [[nodiscard]] CalFile LoadCalFile(const std::string& path);
 /// The same for a file's text already in memory; `path` only names it in messages.
 [[nodiscard]] CalFile ParseCalFile(const std::string& text, const std::string& path);
+/// Parses JSON text; throws CalFileError naming `path` and, for syntax errors, line:column.
+[[nodiscard]] nlohmann::json ParseJsonText(const std::string& text, const std::string& path);
 /// Writes atomically: temporary file, fsync, rename over `path`, fsync of the directory.
 void SaveCalFile(const std::string& path, const CalFile& file);
 /// The same for any text.

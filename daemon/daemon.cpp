@@ -11,6 +11,7 @@
 #include <system_error>
 
 #include "calibration/cal_file.hpp"
+#include "calibration/payload_file.hpp"
 #include "daemon/hardware_adc.hpp"
 #include "daemon/realtime.hpp"
 #include "measurement/recording.hpp"
@@ -55,6 +56,27 @@ void LoadSlot(const std::string& path, const char* name, const hal::AdcInfo& adc
     *slot = fw::CalSlot{};
     std::fprintf(stderr, "ftd: calibration slot %s refused: %s\n", name, e.what());
   }
+}
+
+/// Loads `path` as gravity compensation's payload into `cfg`; a refused file stops ftd (FtdError):
+/// unlike a calibration, a robot relying on compensation must not run with none.
+void LoadPayload(const std::string& path, fw::DeviceConfig* cfg) {
+  cal::PayloadFile p;
+  try {
+    p = cal::LoadPayloadFile(path);
+  } catch (const std::exception& e) {
+    throw FtdError(std::string("--payload refused: ") + e.what());
+  }
+  if (fw::MakeFixedPayload(p.mass_kg, p.com_m, p.force_bias_n, p.moment_bias_nm, &cfg->payload) !=
+      fw::PayloadStatus::kOk) {
+    throw FtdError("--payload " + path + ": outside what the firmware accepts (0 < mass ≤ " +
+                   std::to_string(fw::kMaxPayloadMassKg) + " kg, |m·c| ≤ 100 kg·m)");
+  }
+  cfg->payload_crc = p.crc32;
+  std::fprintf(stderr,
+               "ftd: payload %s: %.4g kg at (%.1f, %.1f, %.1f) mm; gravity compensation off "
+               "until holding 28 = 1\n",
+               path.c_str(), p.mass_kg, p.com_m[0] * 1e3, p.com_m[1] * 1e3, p.com_m[2] * 1e3);
 }
 
 /// A hardware converter (HX711 over GPIO, ADS131M over SPI); needs a calibration file.
@@ -191,6 +213,8 @@ void Ftd::Start() {
   for (const std::int32_t r : cfg.rated_lsb) any_zero = any_zero || r == 0;
   if (any_zero) cfg.rated_lsb = {};  // no complete rating: overload rule off
 
+  if (!opt_.payload.empty()) LoadPayload(opt_.payload, &cfg);
+
   core_ = std::make_unique<fw::WrenchCore>();
   device_ = std::make_unique<fw::Device>(adc, *core_);
   switch (device_->Start(cfg)) {
@@ -225,14 +249,8 @@ void Ftd::Start() {
                      std::system_category().message(errno) + ")");
     }
   }
-  if (!opt_.log.empty()) {
-    std::FILE* f = std::fopen(opt_.log.c_str(), "w");
-    if (f == nullptr) {
-      throw FtdError(opt_.log + ": cannot write: " + std::system_category().message(errno));
-    }
-    std::fclose(f);
-    ring_.resize(kLogRingCapacity);
-  }
+  if (!opt_.rdt.empty()) StartRdt();
+  if (!opt_.log.empty()) PrepareLog();
 
   stop_ = false;
   start_us_ = fw::MonotonicUs();
@@ -251,6 +269,39 @@ void Ftd::Start() {
                rt ? "" : " — samples may be late under load (late_samples counts them)");
   if (tcp_) threads_.emplace_back([this] { tcp_->Run(stop_); });
   if (rtu_) threads_.emplace_back([this] { rtu_->Run(stop_); });
+  if (rdt_) threads_.emplace_back([this] { rdt_->Run(stop_); });
+}
+
+void Ftd::PrepareLog() {
+  std::FILE* f = std::fopen(opt_.log.c_str(), "w");
+  if (f == nullptr) {
+    throw FtdError(opt_.log + ": cannot write: " + std::system_category().message(errno));
+  }
+  std::fclose(f);
+  ring_.resize(kLogRingCapacity);
+}
+
+void Ftd::StartRdt() {
+  RdtOptions ro;
+  try {
+    ParseHostPort(opt_.rdt, &ro.host, &ro.port);
+  } catch (const FtdError& e) {  // its message names --modbus-tcp
+    const std::string m = e.what();
+    throw FtdError("--rdt" + m.substr(m.find(' ')));
+  }
+  if (!(opt_.rdt_counts_per_n > 0) || !(opt_.rdt_counts_per_nm > 0) ||
+      !std::isfinite(opt_.rdt_counts_per_n) || !std::isfinite(opt_.rdt_counts_per_nm)) {
+    throw FtdError("--rdt-counts-per-n and --rdt-counts-per-nm must be positive");
+  }
+  ro.counts_per_n = opt_.rdt_counts_per_n;
+  ro.counts_per_nm = opt_.rdt_counts_per_nm;
+  ro.buffer_records = opt_.rdt_buffer;
+  ro.status_mask = opt_.rdt_status_mask;
+  rdt_ = std::make_unique<RdtServer>(ro, map_.get());
+  std::string error;
+  if (!rdt_->Open(&error)) throw FtdError("RDT on " + opt_.rdt + ": " + error);
+  std::fprintf(stderr, "ftd: serving RDT on %s:%u (%g counts/N, %g counts/N·m)\n", ro.host.c_str(),
+               static_cast<unsigned>(rdt_->port()), ro.counts_per_n, ro.counts_per_nm);
 }
 
 void Ftd::BackOff(std::uint32_t pause_us) {
@@ -291,6 +342,7 @@ void Ftd::SamplingLoop() {
     }
     backoff_us = 0;
     samples_.fetch_add(1, std::memory_order_relaxed);
+    if (published && rdt_) rdt_->Publish(device_->last_published());
     if (!published || ring_.empty()) continue;
     const std::uint64_t head = ring_head_.load(std::memory_order_relaxed);
     if (head - ring_tail_.load(std::memory_order_acquire) >= ring_.size()) {

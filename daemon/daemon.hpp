@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "daemon/backend.hpp"
+#include "daemon/rdt_server.hpp"
 #include "firmware/device.hpp"
 #include "firmware/modbus_server.hpp"
 #include "firmware/register_map.hpp"
@@ -35,10 +36,16 @@ struct FtdOptions {
   std::optional<std::array<double, 6>> sim_wrench;  ///< constant applied wrench, N and N·m
   std::string replay;                               ///< recording whose wrench columns are played
   unsigned rate_hz = 1000;
-  std::string cal;         ///< calibration file for slot 0 ("" = built-in)
-  std::string cal_b;       ///< calibration file for slot 1 ("" = none)
-  std::string modbus_tcp;  ///< HOST:PORT ("" = no TCP server)
-  std::string modbus_rtu;  ///< serial device ("" = no RTU server)
+  std::string cal;      ///< calibration file for slot 0 ("" = built-in)
+  std::string cal_b;    ///< calibration file for slot 1 ("" = none)
+  std::string payload;  ///< payload file for gravity compensation ("" = none)
+  std::string rdt;      ///< HOST:PORT of the RDT server ("" = none)
+  double rdt_counts_per_n = 1e6;
+  double rdt_counts_per_nm = 1e6;
+  unsigned rdt_buffer = 4;                 ///< records per packet in buffered RDT modes
+  std::uint32_t rdt_status_mask = 0xFFFF;  ///< status bits copied into RDT records
+  std::string modbus_tcp;                  ///< HOST:PORT ("" = no TCP server)
+  std::string modbus_rtu;                  ///< serial device ("" = no RTU server)
   unsigned baud = 19200;
   char parity = 'N';
   unsigned unit_id = 1;
@@ -98,11 +105,15 @@ class Ftd {
   [[nodiscard]] fw::Device& device() { return *device_; }
   [[nodiscard]] fw::RegisterMap& register_map() { return *map_; }
   [[nodiscard]] const fw::ServerCounters* tcp_counters() const;
+  /// The RDT server (nullptr without --rdt).
+  [[nodiscard]] const RdtServer* rdt() const { return rdt_.get(); }
   /// One status line (no newline): sequence, wrench, status bits, sample rate, clients.
   [[nodiscard]] std::string StatusLine() const;
 
  private:
   void SamplingLoop();
+  void StartRdt();
+  void PrepareLog();  ///< checks that --log can be written, sizes the log ring
   void BackOff(std::uint32_t pause_us);
 
   FtdOptions opt_;
@@ -113,6 +124,7 @@ class Ftd {
   std::unique_ptr<fw::RegisterMap> map_;
   std::unique_ptr<fw::ModbusTcpServer> tcp_;
   std::unique_ptr<fw::ModbusRtuServer> rtu_;
+  std::unique_ptr<RdtServer> rdt_;
   std::unique_ptr<RecordingWriter> writer_;
 
   // Single-producer (sampling thread) single-consumer (DrainLog) ring of published samples.

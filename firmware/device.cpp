@@ -73,6 +73,8 @@ void Device::ApplySettings() {
   }
   if (s.decimation >= 1 && s.decimation <= kMaxDecimation) active_.decimation = s.decimation;
   active_.transform = s.transform;
+  active_.gravity_umps2 = s.gravity_umps2;
+  active_.gravity_comp = s.gravity_comp && config_.payload.present;
   if (s.tare_generation != active_.tare_generation) {
     active_.tare_generation = s.tare_generation;
     if (s.tare_kind == 1) {
@@ -146,7 +148,12 @@ hal::Status Device::Step(bool* published) {
   sticky_status_ = 0;
   if ((status & kStatusCalInvalid) == 0) {
     bool sat = false;
-    ApplyToolTransform(active_.transform, p.wrench, &d.sample.wrench, &sat);
+    WrenchLsb sensor = p.wrench;
+    if (active_.gravity_comp) {  // payload weight and moment off, in the sensor frame
+      CompensateGravity(config_.payload, active_.gravity_umps2, p.wrench, &sensor, &sat);
+      status |= kStatusPayloadComp;
+    }
+    ApplyToolTransform(active_.transform, sensor, &d.sample.wrench, &sat);
     if (sat) status |= kStatusSaturated;  // the tool-frame wrench was clipped
     // An axis the calibration does not determine taints every tool-frame axis it enters.
     d.sample.invalid_axes = ToolFrameInvalidAxes(active_.transform, p.invalid_axes);
@@ -167,6 +174,8 @@ hal::Status Device::Step(bool* published) {
   d.publish_period_us = sample_period_us_ * active_.decimation;
   d.sample_period_us = sample_period_us_;
   d.late_samples = late_samples_;
+  d.payload_mass_ug = config_.payload.present ? config_.payload.mass_ug : 0;
+  d.payload_crc = config_.payload_crc;
   d.publish_time_us = now_us;
   last_ = d;
   published_.Write(d);

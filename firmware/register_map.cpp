@@ -12,17 +12,8 @@ namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
+[[nodiscard]] bool HoldingMapped(std::uint32_t a) { return a < kHoldingRegisterSpan; }
 [[nodiscard]] bool HoldingMount(std::uint32_t a) { return a >= kHoldMount && a < kHoldMount + 12u; }
-[[nodiscard]] bool HoldingMapped(std::uint32_t a) {
-  return a < kHoldTransform + 12u || HoldingMount(a);
-}
-
-/// A write to a 12-register float block at `first` must cover whole floats.
-[[nodiscard]] bool WholeFloats(std::uint32_t first, std::uint32_t addr, std::uint32_t end) {
-  const std::uint32_t lo = addr > first ? addr : first;
-  const std::uint32_t hi = end < first + 12u ? end : first + 12u;
-  return (lo - first) % 2 == 0 && (hi - first) % 2 == 0;
-}
 
 [[nodiscard]] ToolTransformParams ParamsOf(const std::array<std::uint16_t, 12>& regs) {
   ToolTransformParams p{};
@@ -33,10 +24,21 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
   return p;
 }
 
-/// Holding registers 5 … 9: reserved. They read 0 and accept 0 (so that a PLC's block read or
-/// write of 0 … 21 works); any other value is refused with 03.
+/// Holding registers 5 … 9 and 29: reserved. They read 0 and accept 0 (so that a PLC's block
+/// read or write of 0 … 29 works); any other value is refused with 03.
 [[nodiscard]] bool HoldingReserved(std::uint32_t a) {
-  return a > kHoldUnlock && a < kHoldTransform;
+  return (a > kHoldUnlock && a < kHoldTransform) || a == kHoldReserved29;
+}
+
+[[nodiscard]] bool InGravity(std::uint32_t a) { return a >= kHoldGravity && a < kHoldGravity + 6u; }
+
+/// A write [addr, end) touching the float block [first, first + 2·floats) covers whole floats.
+[[nodiscard]] bool WholeFloats(std::uint32_t addr, std::uint32_t end, std::uint32_t first,
+                               std::uint32_t floats) {
+  const std::uint32_t block_end = first + 2u * floats;
+  const std::uint32_t lo = addr > first ? addr : first;
+  const std::uint32_t hi = end < block_end ? end : block_end;
+  return (lo - first) % 2 == 0 && (hi - first) % 2 == 0;
 }
 
 [[nodiscard]] float LsbToSi(std::int32_t v, std::size_t axis) {
@@ -106,6 +108,9 @@ void BuildInputRegisters(const DeviceSample& d, const hal::AdcInfo& adc, std::ui
   PackU32(d.cal_crc, &r[kInCalCrc]);
   PackU32(d.late_samples, &r[kInLateSamples]);
   r[kInTimestampWraps] = s.timestamp_wraps;
+  PackFloat32(static_cast<float>(static_cast<double>(d.payload_mass_ug) * 1e-9),
+              &r[kInPayloadMass]);
+  PackU32(d.payload_crc, &r[kInPayloadCrc]);
 }
 
 RegisterMap::RegisterMap(Device& device) : device_(device), settings_(device.initial_settings()) {}
@@ -167,11 +172,18 @@ ModbusException RegisterMap::ReadHolding(std::uint16_t addr, std::uint16_t count
       case kHoldUnlock:
         v = unlocked ? 1 : 0;
         break;
+      case kHoldGravityComp:
+        v = settings_.gravity_comp ? 1 : 0;
+        break;
       default:
-        if (HoldingMount(a)) {
+        if (HoldingReserved(a)) {
+          v = 0;
+        } else if (InGravity(a)) {
+          v = gravity_regs_[a - kHoldGravity];
+        } else if (HoldingMount(a)) {
           v = mount_regs_[a - kHoldMount];
         } else {
-          v = HoldingReserved(a) ? 0 : transform_regs_[a - kHoldTransform];
+          v = transform_regs_[a - kHoldTransform];
         }
         break;
     }
@@ -193,8 +205,10 @@ ModbusException RegisterMap::WriteHolding(std::uint16_t addr, const std::uint16_
   DeviceSettings next = settings_;
   std::array<std::uint16_t, 12> next_transform = transform_regs_;
   std::array<std::uint16_t, 12> next_mount = mount_regs_;
+  std::array<std::uint16_t, 6> next_gravity = gravity_regs_;
   bool transform_written = false;
   bool mount_written = false;
+  bool gravity_written = false;
   bool unlock_written = false;
   for (std::uint32_t a = addr; a < end; ++a) {
     const std::uint16_t v = values[a - addr];
@@ -228,9 +242,20 @@ ModbusException RegisterMap::WriteHolding(std::uint16_t addr, const std::uint16_
         if (v != kUnlockKey) return ModbusException::kIllegalDataValue;
         unlock_written = true;
         break;
-      default:  // 5 … 9 reserved, 10 … 21 tool transform, 30 … 41 mount transform
+      case kHoldGravityComp:
+        if (v > 1 || (v == 1 && !device_.payload_present())) {
+          return ModbusException::kIllegalDataValue;
+        }
+        next.gravity_comp = v == 1;
+        break;
+      default:  // 5 … 9, 29 reserved, 10 … 21 tool transform, 22 … 27 gravity, 30 … 41 mount
         if (HoldingReserved(a)) {
           if (v != 0) return ModbusException::kIllegalDataValue;
+          break;
+        }
+        if (InGravity(a)) {  // not protected: a robot writes it as it moves
+          next_gravity[a - kHoldGravity] = v;
+          gravity_written = true;
           break;
         }
         if (!unlocked) return ModbusException::kIllegalDataValue;
@@ -246,8 +271,8 @@ ModbusException RegisterMap::WriteHolding(std::uint16_t addr, const std::uint16_
   }
   if (transform_written || mount_written) {
     // A float is two registers: a write must cover whole floats.
-    if ((transform_written && !WholeFloats(kHoldTransform, addr, end)) ||
-        (mount_written && !WholeFloats(kHoldMount, addr, end))) {
+    if ((transform_written && !WholeFloats(addr, end, kHoldTransform, 6)) ||
+        (mount_written && !WholeFloats(addr, end, kHoldMount, 6))) {
       return ModbusException::kIllegalDataValue;
     }
     if (MakeMountedToolTransform(ParamsOf(next_transform), ParamsOf(next_mount), &next.transform) !=
@@ -255,10 +280,19 @@ ModbusException RegisterMap::WriteHolding(std::uint16_t addr, const std::uint16_
       return ModbusException::kIllegalDataValue;
     }
   }
+  if (gravity_written) {
+    if (!WholeFloats(addr, end, kHoldGravity, 3)) return ModbusException::kIllegalDataValue;
+    for (std::size_t i = 0; i < 3; ++i) {
+      if (!GravityToFixed(UnpackFloat32(&next_gravity[2 * i]), &next.gravity_umps2[i])) {
+        return ModbusException::kIllegalDataValue;
+      }
+    }
+  }
   // Everything validated: commit.
   settings_ = next;
   transform_regs_ = next_transform;
   mount_regs_ = next_mount;
+  gravity_regs_ = next_gravity;
   if (unlock_written) {
     unlock_armed_ = true;
     unlock_until_us_ = now_us + kUnlockDurationUs;

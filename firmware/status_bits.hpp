@@ -20,6 +20,7 @@ enum StatusBit : std::uint16_t {
   /// The calibration flags an axis invalid (its rig never excited it): that axis's wrench
   /// registers read NaN / 0 (in the tool frame: every axis the transform mixes it into).
   kStatusAxisInvalid = 1u << 10,
+  kStatusPayloadComp = 1u << 12,  ///< the payload's weight and moment (and bias) are subtracted
 };
 
 }  // namespace ftstack::fw

@@ -27,6 +27,7 @@
 #include "tests/support/temp_dir.hpp"
 #include "tests/system/builtin_adc.hpp"
 #include "tests/system/ftd_process.hpp"
+#include "tests/system/sim_noise.hpp"
 
 namespace ftstack {
 namespace {
@@ -43,22 +44,8 @@ struct Expected {
   std::array<double, 6> fixed_error_si{};
 };
 Expected DeriveExpected() {
-  const auto model = sim::MakeDefaultSensor();
-  const test::BuiltinAdc builtin = test::BuiltinSimAdc();
-  const hal::AdcInfo adc = builtin.info;
-  const cal::CalFile c = sim::IdealCalibration(*model, adc);
-  const double q_mvv = adc.full_scale_nvv * 1e-6 / adc.max_counts;
-  const double var = builtin.noise_rms_mvv * builtin.noise_rms_mvv + q_mvv * q_mvv / 12.0;
-  Expected e;
-  for (std::size_t i = 0; i < 6; ++i) {
-    double s2 = 0;
-    for (std::size_t ch = 0; ch < 6; ++ch) s2 += c.cal.matrix[i][ch] * c.cal.matrix[i][ch] * var;
-    e.sigma_si[i] = std::sqrt(s2);
-  }
-  fw::LoadReport rep;
-  (void)cal::ToFixed(c, adc, &rep);
-  e.fixed_error_si = rep.worst_case_error_si;
-  return e;
+  const test::SimNoise n = test::DeriveSimNoise();
+  return {n.sigma, n.fixed_error};
 }
 
 /// A libmodbus TCP client connected to the daemon.
@@ -137,7 +124,7 @@ TEST(FtdModbus, SimulatedWrenchArrivesWithinDerivedToleranceAndTareZeroes) {
 
   std::array<std::uint16_t, 30> r{};
   ASSERT_EQ(c.Input(0, 30, r.data()), 30);
-  EXPECT_EQ(r[fw::kInMapVersion], 2);
+  EXPECT_EQ(r[fw::kInMapVersion], 2);  // docs/spec/modbus-map.md
   EXPECT_EQ(r[fw::kInStatus] & ~fw::kStatusStale, fw::kStatusSimulated);
   for (std::size_t a = 0; a < 6; ++a) {
     const double tol = kSigmas * e.sigma_si[a] / std::sqrt(kFilter) + e.fixed_error_si[a] +
@@ -187,9 +174,9 @@ TEST(FtdModbus, ExceptionsAndProtectedWritesOverTheWire) {
   EXPECT_EQ(err, EMBXILADD);
   EXPECT_EQ(c.Input(fw::kInputRegisterCount - 4, 5, r.data(), &err), -1);
   EXPECT_EQ(err, EMBXILADD);
-  EXPECT_EQ(c.Holding(22, 1, r.data(), &err), -1);
+  EXPECT_EQ(c.Holding(fw::kHoldingRegisterSpan, 1, r.data(), &err), -1);  // map v2: 0 … 41
   EXPECT_EQ(err, EMBXILADD);
-  EXPECT_EQ(c.Write(22, 0, &err), -1);
+  EXPECT_EQ(c.Write(fw::kHoldingRegisterSpan, 0, &err), -1);
   EXPECT_EQ(err, EMBXILADD);
   // Reserved 5 … 9: read 0, accept only 0.
   EXPECT_EQ(c.Holding(5, 5, r.data(), &err), 5);
@@ -394,7 +381,7 @@ TEST(FtdModbus, GarbageAndHalfFramesDoNotDisturbOtherClients) {
     Client c(ftd.port());
     std::array<std::uint16_t, 74> r{};
     while (!stop) {
-      if (c.Input(0, 74, r.data()) == 74 && r[0] == fw::kMapVersion) {
+      if (c.Input(0, 74, r.data()) == 74 && r[0] == 2) {
         ++ok;
       } else {
         if (failed++ == 0) {

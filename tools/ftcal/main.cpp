@@ -1,4 +1,4 @@
-// ftcal — calibration command line: fit, apply, import-ati, verify, design (logic in calibration/).
+// ftcal — calibration CLI: fit, apply, import-ati, verify, design, payload (logic in calibration/).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <ctime>
@@ -10,6 +10,8 @@
 #include "calibration/excitation.hpp"
 #include "calibration/fit.hpp"
 #include "calibration/fit_report.hpp"
+#include "calibration/known_mass.hpp"
+#include "calibration/payload.hpp"
 #include "calibration/slots.hpp"
 #include "measurement/recording.hpp"
 #include "sim/rig.hpp"
@@ -35,6 +37,42 @@ void PrintWorstCase(const ftstack::fw::LoadReport& rep) {
       rep.worst_case_error_si[3], rep.worst_case_error_si[4], rep.worst_case_error_si[5]);
 }
 
+/// A rig recording for `ftcal fit`: with a reference wrench, or with known masses (mass_kg,
+/// arm_*_m, g*_mps2) turned into one, plus the jig's load when asked to identify it.
+ftstack::Recording ReadRigRecording(const std::string& path, bool identify_jig) {
+  using namespace ftstack;
+  ReadOptions opt;
+  opt.require_bridges = true;
+  Recording rec = ReadRecording(path, opt);
+  if (!cal::IsKnownMassRecording(rec)) {
+    if (identify_jig) throw std::invalid_argument("--identify-jig needs a mass_kg column");
+    for (const std::string& c : WrenchColumns()) (void)rec.Column(c);  // names the file
+    return rec;
+  }
+  rec = cal::WithReferenceFromMasses(rec);
+  if (identify_jig) {
+    const cal::JigEstimate jig = cal::IdentifyJig(rec);
+    std::printf("jig: %.4f ± %.4f kg, centre of mass %.2f %.2f %.2f mm (± %.2f, %.2f, %.2f mm)\n",
+                jig.mass_kg, jig.mass_sigma_kg, jig.com_m[0] * 1e3, jig.com_m[1] * 1e3,
+                jig.com_m[2] * 1e3, jig.com_sigma_m[0] * 1e3, jig.com_sigma_m[1] * 1e3,
+                jig.com_sigma_m[2] * 1e3);
+    rec = cal::WithJig(rec, jig);
+  }
+  return rec;
+}
+
+/// ftcal payload: identify, write the payload file, print the summary.
+void RunPayload(const std::string& in_path, const std::string& out_path, double max_condition) {
+  using namespace ftstack;
+  const Recording rec = ReadRecording(in_path);
+  cal::PayloadFitOptions po;
+  po.max_condition = max_condition;
+  cal::PayloadFit pfit = cal::FitPayload(cal::PayloadReadingsFromRecording(rec), po);
+  pfit.file.date = Today();
+  cal::SavePayloadFile(out_path, pfit.file);
+  std::printf("%swrote %s\n", cal::PayloadSummary(pfit).c_str(), out_path.c_str());
+}
+
 }  // namespace
 
 /// What `ftcal fit` is told.
@@ -48,15 +86,13 @@ struct FitArgs {
   std::string serial = "unknown";
   int folds = 10;
   bool allow_unexcited = false;
+  bool identify_jig = false;  ///< known-mass recordings: identify the loading jig
 };
 
 /// `ftcal fit`: reads the rig recording, checks every axis's excitation, fits, writes. Throws.
 void RunFit(const FitArgs& args) {
   using namespace ftstack;
-  ReadOptions opt;
-  opt.require_bridges = true;
-  opt.require_wrench = true;
-  const Recording rec = ReadRecording(args.in_path, opt);
+  const Recording rec = ReadRigRecording(args.in_path, args.identify_jig);
   cal::FitOptions fo;
   fo.folds = args.folds;
   hal::AdcInfo adc{};
@@ -128,7 +164,9 @@ int main(int argc, char** argv) {
   FitArgs fa;  // fit's options are its own (design's --sensor default must not reach it)
 
   auto* fit = app.add_subcommand("fit", "fit a calibration to rig data (reference wrench + b*)");
-  fit->add_option("--in", fa.in_path, "rig recording (t, Fx…Mz, b0…, optional temp_C, block/pose)")
+  fit->add_option("--in", fa.in_path,
+                  "rig recording (t, b0…, Fx…Mz or mass_kg arm_*_m g*_mps2, optional temp_C, "
+                  "block/pose)")
       ->required();
   fit->add_option("--out", fa.out_path, "calibration file to write")->required();
   fit->add_option("--report", fa.report_path, "self-contained HTML report with plots");
@@ -146,6 +184,9 @@ int main(int argc, char** argv) {
   fit->add_flag("--allow-unexcited", fa.allow_unexcited,
                 "write axes the rig did not excite flagged invalid (ftd then never serves them) "
                 "instead of refusing");
+  fit->add_flag("--identify-jig", fa.identify_jig,
+                "known-mass recordings: identify the loading jig's mass and centre of mass and "
+                "add its load to the reference");
 
   auto* apply = app.add_subcommand("apply", "run the firmware's fixed-point core on a recording");
   apply->add_option("--cal", cal_path, "calibration file")->required();
@@ -184,10 +225,24 @@ int main(int argc, char** argv) {
   design->add_option("--temperatures", temps, "repeat at these body temperatures, °C")
       ->delimiter(',');
 
+  double max_condition = 30.0;
+  auto* payload = app.add_subcommand(
+      "payload", "identify a payload (mass, centre of mass) and the sensor bias from static poses");
+  payload
+      ->add_option("--in", in_path,
+                   "recording: one static reading per row, gx_mps2 gy_mps2 gz_mps2 (gravity in "
+                   "the sensor frame) and Fx…Mz")
+      ->required();
+  payload->add_option("--out", out_path, "payload file to write (JSON, CRC-32)")->required();
+  payload->add_option("--max-condition", max_condition, "refuse a pose set above this condition")
+      ->check(CLI::Range(2.0, 1e6));
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (*fit) {
       RunFit(fa);
+    } else if (*payload) {
+      RunPayload(in_path, out_path, max_condition);
     } else if (*import_ati) {
       const cal::AtiImport imp = cal::ImportAtiCal(ati_path);
       for (const std::string& w : imp.warnings)

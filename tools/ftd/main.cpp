@@ -22,6 +22,21 @@ void OnSignal(int) { g_stop = true; }
 }  // namespace
 
 namespace {
+/// The --rdt options (ATI Net F/T RDT server).
+void AddRdtOptions(CLI::App& app, ftstack::daemon::FtdOptions& opt) {
+  app.add_option("--rdt", opt.rdt,
+                 "serve ATI Net F/T RDT over UDP on HOST:PORT (ATI's port: 49152; 0: any free)");
+  app.add_option("--rdt-counts-per-n", opt.rdt_counts_per_n, "RDT counts per N (Fx Fy Fz)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--rdt-counts-per-nm", opt.rdt_counts_per_nm, "RDT counts per N·m (Tx Ty Tz)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--rdt-buffer", opt.rdt_buffer, "RDT records per packet in buffered mode")
+      ->check(CLI::Range(1u, 40u));
+  app.add_option("--rdt-status-mask", opt.rdt_status_mask,
+                 "status bits copied into RDT records (default 0xFFFF: all)")
+      ->check(CLI::Range(0u, 0xFFFFu));
+}
+
 int Run(int argc, char** argv) {
   using namespace ftstack;
   CLI::App app{"ftd — force/torque sensor daemon (firmware main loop on a board or host)"};
@@ -40,9 +55,12 @@ int Run(int argc, char** argv) {
   app.add_option("--cal", opt.cal,
                  "calibration file, slot 0 (default: the simulated sensor's own)");
   app.add_option("--cal-b", opt.cal_b, "calibration file for slot 1 (holding register 3)");
+  app.add_option("--payload", opt.payload,
+                 "payload file (ftcal payload) for gravity compensation (holding 22–28)");
   app.add_option("--modbus-tcp", opt.modbus_tcp,
                  "serve Modbus TCP on HOST:PORT (port 0: any free)");
   app.add_option("--modbus-rtu", opt.modbus_rtu, "serve Modbus RTU on a serial DEVICE");
+  AddRdtOptions(app, opt);
   app.add_option("--baud", opt.baud, "RTU baud rate")->check(CLI::Range(300u, 4000000u));
   app.add_option("--parity", parity, "RTU parity N|E|O")->check(CLI::IsMember({"N", "E", "O"}));
   app.add_option("--unit-id", opt.unit_id, "Modbus unit id")->check(CLI::Range(1u, 247u));
