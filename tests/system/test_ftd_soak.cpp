@@ -19,6 +19,7 @@
 #include "firmware/register_map.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "tests/system/ftd_process.hpp"
+#include "tests/system/raw_connect.hpp"
 
 namespace ftstack {
 namespace {
@@ -52,18 +53,7 @@ modbus_t* Connect(int port) {
   return ctx;
 }
 
-int RawConnect(int port) {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(static_cast<std::uint16_t>(port));
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0) {
-    close(fd);
-    return -1;
-  }
-  return fd;
-}
+using test::RawConnect;
 
 struct PollerResult {
   long replies = 0;
@@ -185,8 +175,9 @@ void Barrage(int port, unsigned seed, const std::atomic<bool>& stop, long* sent)
 
 TEST(FtdSoak, SixteenClientsAndAMalformedBarrageNoErrorsNoStaleRepliesMemoryFlat) {
   const double seconds = SoakSeconds();
-  test::FtdProcess ftd(
-      {"--sim-wrench", "0,0,100,0,0,0", "--rate-hz", "1000", "--modbus-tcp", "127.0.0.1:0"});
+  const test::TempDir tmp("ftd_soak");  // the logger thread writes a recording all along
+  test::FtdProcess ftd({"--sim-wrench", "0,0,100,0,0,0", "--rate-hz", "1000", "--modbus-tcp",
+                        "127.0.0.1:0", "--log", tmp / "soak.csv"});
   ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
   std::atomic<bool> stop{false};
   constexpr int kPollers = 15;  // + 1 writer of holding registers = 16 libmodbus clients
@@ -230,6 +221,11 @@ TEST(FtdSoak, SixteenClientsAndAMalformedBarrageNoErrorsNoStaleRepliesMemoryFlat
   EXPECT_TRUE(ftd.alive());
   EXPECT_EQ(ftd.Stop(SIGTERM), 0) << ftd.Stderr();
   EXPECT_EQ(ftd.Stderr().find("ThreadSanitizer"), std::string::npos) << ftd.Stderr();
+  // The logger kept up: the recording holds about a row per sample of the run.
+  std::ifstream rec(tmp / "soak.csv");
+  long rows = 0;
+  for (std::string line; std::getline(rec, line);) ++rows;
+  EXPECT_GT(rows, static_cast<long>(500 * seconds)) << "rows in the recording";
 }
 
 }  // namespace
