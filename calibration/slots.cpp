@@ -63,8 +63,10 @@ char CalSlots::Recorded(std::string* note) const {
   const auto tb = fs::last_write_time(SlotPath('B'), eb);
   if (ea && eb) return 0;
   const char slot = ea ? 'B' : (eb ? 'A' : (tb > ta ? 'B' : 'A'));
+  const bool tie = !ea && !eb && ta == tb;  // within one tick of the file system's clock
   *note = std::string("the active-slot record is missing or unreadable; taking slot ") + slot +
-          " (written last)";
+          (tie ? " (both slot files carry the same modification time: undecidable, A taken)"
+               : " (written last)");
   return slot;
 }
 

@@ -122,6 +122,9 @@ class FtcalCrash : public ::testing::Test {
     const std::string dir = tmp_ / name;
     cal::CalSlots slots(dir);
     EXPECT_EQ(slots.InstallFromPath(tmp_ / "first.json"), 'A');
+    // Installs are seconds apart in use; here apart by more than the file system's clock tick
+    // (modification times decide when the `active` record is lost).
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
     EXPECT_EQ(slots.InstallFromPath(tmp_ / "second.json"), 'B');
     return dir;
   }
