@@ -163,8 +163,9 @@ void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts,
   // Without a tare tare_f_ is zero; with one the bias drops out (see FixedCalibration).
   const std::size_t n = plan_.channels;
   const std::size_t nf = plan_.features;
-  std::array<std::int64_t, kMaxFeatures> f;       // features; only [0, nf) are read
-  std::array<std::int64_t, kMaxChannels> x_zero;  // clamped counts − zero (products' origin)
+  // Features; only [0, nf) are written and read (zeroing all 53 each sample would cost time).
+  std::array<std::int64_t, kMaxFeatures> f;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+  std::array<std::int64_t, kMaxChannels> x_zero{};  // clamped counts − zero (products' origin)
   bool clamped = false;
   for (std::size_t c = 0; c < n; ++c) {
     const std::int32_t raw = counts[c];
@@ -187,7 +188,7 @@ void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts,
   }
   // The loader guarantees Σ|coef|·|f| + |bias| ≤ 2^61 for every input between the rails, so no
   // partial sum in any order can overflow.
-  std::array<std::int64_t, kAxes> acc;
+  std::array<std::int64_t, kAxes> acc{};
   for (std::size_t r = 0; r < kAxes; ++r) acc[r] = tare_active_ ? 0 : cal_.bias[r];
   for (std::size_t j = 0; j < nf; ++j) {
     const std::int64_t fj = f[j];
