@@ -1,4 +1,5 @@
-// Per-sample cost of the fixed-point core next to a plain double-precision Eigen implementation.
+// Per-sample cost of the fixed-point core next to a double-precision Eigen implementation of the
+// same model.
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Dense>
@@ -13,6 +14,9 @@ using namespace ftstack;
 
 constexpr int kSamples = 1024;  // cycled input set, so the loop is not a single cached value
 
+/// Model terms of a configuration (second benchmark argument).
+enum Terms : int { kLinear = 0, kSecondOrder = 1, kTemperature = 2, kBoth = 3 };
+
 hal::AdcInfo Adc24(std::uint8_t n) {
   hal::AdcInfo a;
   a.channel_count = n;
@@ -23,7 +27,9 @@ hal::AdcInfo Adc24(std::uint8_t n) {
   return a;
 }
 
-fw::FloatCalibration RandomCal(std::uint8_t n, std::mt19937_64& rng) {
+/// A random calibration; with second order every product of two bridges (N(N+1)/2 terms), with
+/// temperature a zero drift and a gain drift per bridge.
+fw::FloatCalibration RandomCal(std::uint8_t n, int terms, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   fw::FloatCalibration cal{};
   cal.channel_count = n;
@@ -31,30 +37,59 @@ fw::FloatCalibration RandomCal(std::uint8_t n, std::mt19937_64& rng) {
     for (std::size_t c = 0; c < n; ++c) cal.matrix[r][c] = (r < 3 ? 150.0 : 6.0) * u(rng);
     cal.bias[r] = 0.1 * u(rng);
   }
+  for (std::size_t c = 0; c < n; ++c) cal.offset_mvv[c] = 0.05 * u(rng);
+  if ((terms & kSecondOrder) != 0) {
+    for (std::uint8_t a = 0; a < n; ++a) {
+      for (std::uint8_t b = a; b < n; ++b) {
+        const std::size_t k = cal.product_count++;
+        cal.products[k] = fw::ProductTerm{a, b};
+        for (std::size_t r = 0; r < fw::kAxes; ++r) {
+          cal.product_matrix[r][k] = (r < 3 ? 2.0 : 0.08) * u(rng);
+        }
+      }
+    }
+  }
+  if ((terms & kTemperature) != 0) {
+    cal.temperature_compensated = true;
+    for (std::size_t c = 0; c < n; ++c) {
+      cal.bias_slope_mvv_per_c[c] = 1e-4 * u(rng);
+      cal.gain_slope_per_c[c] = 2e-4 * u(rng);
+    }
+  }
   return cal;
 }
 
 std::vector<hal::AdcSample> RandomSamples(std::uint8_t n, std::mt19937_64& rng) {
   std::uniform_int_distribution<std::int32_t> d(-4000000, 4000000);
+  std::uniform_int_distribution<std::int32_t> t(0, 60000);
   std::vector<hal::AdcSample> v(kSamples);
   for (auto& s : v) {
     s.channel_count = n;
     for (std::size_t c = 0; c < n; ++c) s.counts[c] = d(rng);
+    s.temperature_mdegc = t(rng);
+    s.has_temperature = true;
   }
   return v;
+}
+
+bool LoadFixed(benchmark::State& state, fw::WrenchCore& core, std::uint8_t n, int terms,
+               std::mt19937_64& rng) {
+  fw::FixedCalibration fixed{};
+  if (fw::LoadCalibration(RandomCal(n, terms, rng), Adc24(n), &fixed, nullptr) !=
+      fw::LoadStatus::kOk) {
+    state.SkipWithError("calibration refused");
+    return false;
+  }
+  core.SetCalibration(fixed);
+  return true;
 }
 
 // The whole per-sample path: fault checks, matrix, moving average (length 1 and 16).
 void BM_FixedCore(benchmark::State& state) {
   const auto n = static_cast<std::uint8_t>(state.range(0));
   std::mt19937_64 rng(1);
-  fw::FixedCalibration fixed{};
-  if (fw::LoadCalibration(RandomCal(n, rng), Adc24(n), &fixed, nullptr) != fw::LoadStatus::kOk) {
-    state.SkipWithError("calibration refused");
-    return;
-  }
   fw::WrenchCore core;
-  core.SetCalibration(fixed);
+  if (!LoadFixed(state, core, n, kLinear, rng)) return;
   if (!core.SetFilterLength(static_cast<std::uint16_t>(state.range(1)))) return;
   const auto samples = RandomSamples(n, rng);
   fw::CoreOutput out{};
@@ -68,59 +103,120 @@ void BM_FixedCore(benchmark::State& state) {
 }
 BENCHMARK(BM_FixedCore)->Args({6, 1})->Args({8, 1})->Args({6, 16})->Args({8, 16});
 
-// The matrix step alone in fixed point.
+// The model step in fixed point: counts (and temperature) → wrench, LSB.
 void BM_FixedMatrix(benchmark::State& state) {
   const auto n = static_cast<std::uint8_t>(state.range(0));
+  const auto terms = static_cast<int>(state.range(1));
   std::mt19937_64 rng(1);
-  fw::FixedCalibration fixed{};
-  if (fw::LoadCalibration(RandomCal(n, rng), Adc24(n), &fixed, nullptr) != fw::LoadStatus::kOk) {
-    state.SkipWithError("calibration refused");
-    return;
-  }
   fw::WrenchCore core;
-  core.SetCalibration(fixed);
+  if (!LoadFixed(state, core, n, terms, rng)) return;
   const auto samples = RandomSamples(n, rng);
   fw::WrenchLsb y{};
   bool sat = false;
+  bool temp_range = false;
   std::size_t i = 0;
   for (auto _ : state) {
-    core.Apply(samples[i].counts, y, &sat);
+    const hal::AdcSample& s = samples[i];
+    core.Apply(s.counts, s.temperature_mdegc, s.has_temperature, y, &sat, &temp_range);
     benchmark::DoNotOptimize(y);
     i = (i + 1) & (kSamples - 1);
   }
   state.SetItemsProcessed(state.iterations());
 }
-BENCHMARK(BM_FixedMatrix)->Arg(6)->Arg(8);
 
-// Plain double precision with Eigen: counts → mV/V → M·(x − offset) + bias.
-void BM_EigenDouble(benchmark::State& state) {
-  const auto n = static_cast<int>(state.range(0));
-  std::mt19937_64 rng(1);
-  const fw::FloatCalibration cal = RandomCal(static_cast<std::uint8_t>(n), rng);
-  Eigen::Matrix<double, 6, Eigen::Dynamic> m(6, n);
-  for (int r = 0; r < 6; ++r) {
-    for (int c = 0; c < n; ++c)
-      m(r, c) = cal.matrix[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)];
+/// The same model in double precision with Eigen, written as one would on a board with an FPU:
+/// x = counts·(mV/V per count) − offset; x' = x − α·ΔT − (γ∘x)·ΔT; features [x'; x_a·x_b];
+/// wrench = [M P]·features + bias, one matrix-vector product of fixed row count and bounded,
+/// run-time column count (no heap), as the fixed-point core handles any N at run time.
+class DoubleCore {
+ public:
+  static constexpr int kMaxF = static_cast<int>(fw::kMaxChannels + fw::kMaxProducts);
+  using Matrix = Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::ColMajor, 6, kMaxF>;
+  using Features = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxF, 1>;
+
+  explicit DoubleCore(const fw::FloatCalibration& cal, const hal::AdcInfo& adc)
+      : n_(cal.channel_count), products_(cal.product_count), temp_(cal.temperature_compensated) {
+    mvv_per_count_ = 1.0 / fw::CountsPerMvv(adc);
+    m_.resize(6, n_ + products_);
+    f_.resize(n_ + products_);
+    for (int r = 0; r < 6; ++r) {
+      const auto ru = static_cast<std::size_t>(r);
+      bias_(r) = cal.bias[ru];
+      for (int c = 0; c < n_; ++c) m_(r, c) = cal.matrix[ru][static_cast<std::size_t>(c)];
+      for (int k = 0; k < products_; ++k) {
+        m_(r, n_ + k) = cal.product_matrix[ru][static_cast<std::size_t>(k)];
+      }
+    }
+    for (int c = 0; c < n_; ++c) {
+      const auto cu = static_cast<std::size_t>(c);
+      offset_(c) = cal.offset_mvv[cu];
+      alpha_(c) = cal.bias_slope_mvv_per_c[cu];
+      gamma_(c) = cal.gain_slope_per_c[cu];
+    }
+    for (int k = 0; k < products_; ++k) {
+      a_[static_cast<std::size_t>(k)] = cal.products[static_cast<std::size_t>(k)].a;
+      b_[static_cast<std::size_t>(k)] = cal.products[static_cast<std::size_t>(k)].b;
+    }
+    t_ref_ = cal.temp_ref_c;
+    t_min_ = cal.temp_min_c;
+    t_max_ = cal.temp_max_c;
   }
-  Eigen::Matrix<double, 6, 1> bias;
-  for (int r = 0; r < 6; ++r) bias(r) = cal.bias[static_cast<std::size_t>(r)];
-  const Eigen::VectorXd offset = Eigen::VectorXd::Zero(n);
-  const double mvv_per_count = 3.90625 / 8388607.0;
-  const auto samples = RandomSamples(static_cast<std::uint8_t>(n), rng);
-  Eigen::VectorXd x(n);
+
+  void Apply(const hal::AdcSample& s, Eigen::Matrix<double, 6, 1>& y) {
+    Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, fw::kMaxChannels, 1> x(n_);
+    for (int c = 0; c < n_; ++c) {
+      x(c) = s.counts[static_cast<std::size_t>(c)] * mvv_per_count_ - offset_(c);
+    }
+    for (int k = 0; k < products_; ++k) {
+      f_(n_ + k) = x(a_[static_cast<std::size_t>(k)]) * x(b_[static_cast<std::size_t>(k)]);
+    }
+    if (temp_) {
+      const double dt = std::clamp(s.temperature_mdegc * 1e-3, t_min_, t_max_) - t_ref_;
+      f_.head(n_) = x - dt * (alpha_.head(n_) + gamma_.head(n_).cwiseProduct(x));
+    } else {
+      f_.head(n_) = x;
+    }
+    y.noalias() = m_ * f_;
+    y += bias_;
+  }
+
+ private:
+  int n_;
+  int products_;
+  bool temp_;
+  double mvv_per_count_ = 0;
+  Matrix m_;
+  Features f_;
+  Eigen::Matrix<double, 6, 1> bias_;
+  Eigen::Matrix<double, fw::kMaxChannels, 1> offset_, alpha_, gamma_;
+  std::array<std::uint8_t, fw::kMaxProducts> a_{}, b_{};
+  double t_ref_ = 20, t_min_ = -20, t_max_ = 80;
+};
+
+void BM_EigenDouble(benchmark::State& state) {
+  const auto n = static_cast<std::uint8_t>(state.range(0));
+  const auto terms = static_cast<int>(state.range(1));
+  std::mt19937_64 rng(1);
+  DoubleCore core(RandomCal(n, terms, rng), Adc24(n));
+  const auto samples = RandomSamples(n, rng);
   Eigen::Matrix<double, 6, 1> y;
   std::size_t i = 0;
   for (auto _ : state) {
-    for (int c = 0; c < n; ++c)
-      x(c) = samples[i].counts[static_cast<std::size_t>(c)] * mvv_per_count;
-    y.noalias() = m * (x - offset);
-    y += bias;
+    core.Apply(samples[i], y);
     benchmark::DoNotOptimize(y);
     i = (i + 1) & (kSamples - 1);
   }
   state.SetItemsProcessed(state.iterations());
 }
-BENCHMARK(BM_EigenDouble)->Arg(6)->Arg(8);
+
+// Every configuration (N, terms) for fixed point and for double, measured in the same run.
+void Configurations(benchmark::internal::Benchmark* b) {
+  for (int n : {6, 8}) {
+    for (int terms : {kLinear, kSecondOrder, kTemperature, kBoth}) b->Args({n, terms});
+  }
+}
+BENCHMARK(BM_FixedMatrix)->Apply(Configurations);
+BENCHMARK(BM_EigenDouble)->Apply(Configurations);
 
 }  // namespace
 

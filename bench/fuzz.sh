@@ -35,7 +35,7 @@ fi
 log "building the harnesses (progress below)"
 cmake --build "$BUILD" -j "$(nproc)" --target fuzzers
 declare -A dict=([recording]=csv [cal_file]=json [sensor]=json [profile]=json [ati]=xml [payload]=json)
-[ ${#names[@]} -gt 0 ] || names=(recording cal_file ati sensor profile modbus payload rdt)
+[ ${#names[@]} -gt 0 ] || names=(recording cal_file ati sensor profile modbus tcp_frame payload rdt)
 mkdir -p "$BUILD/findings"
 status=0
 printf '\n%-10s %10s %8s %8s %8s  %s\n' harness execs exec/s cov ft result

@@ -7,16 +7,25 @@ MIN_TIME=${BENCH_MIN_TIME:-0.2}
 
 section() { printf '\n== %s ==\n' "$*"; }
 
-# --- firmware core (issue 2): ns per sample, fixed point vs double-precision Eigen, same run ----
+# --- firmware core (issues 2, 15): ns per sample, fixed point vs double-precision Eigen, one run --
+# BM_FixedMatrix/N/terms and BM_EigenDouble/N/terms compute the same model (terms: 0 linear,
+# 1 second order, 2 temperature, 3 both); the ratio fixed/double is printed per configuration.
 if [ -x "$B/bench_core" ]; then
   section "fixed-point core vs double-precision Eigen (CPU ns per sample, one run)"
   "$B/bench_core" --benchmark_min_time="$MIN_TIME" --benchmark_format=csv 2>/dev/null |
-    awk -F, 'NR>1 && $1 ~ /BM_/ { gsub(/"/,"",$1); t[$1]=$4; printf "  %-24s %8.1f ns CPU\n", $1, $4 }
+    awk -F, 'NR>1 && $1 ~ /BM_/ { gsub(/"/,"",$1); t[$1]=$4 }
       END {
-        for (n = 6; n <= 8; n += 2) {
-          f = t["BM_FixedMatrix/" n]; e = t["BM_EigenDouble/" n]; c = t["BM_FixedCore/" n "/1"];
-          if (f > 0 && e > 0) printf "  N=%d: matrix step fixed/double = %.2f; whole core (filter 1) %.1f ns\n", n, f / e, c
+        split("linear,second order,temperature,second order + temperature", name, ",")
+        printf "  %-4s %-28s %10s %10s %8s\n", "N", "terms", "fixed ns", "double ns", "ratio"
+        worst = 0
+        for (n = 6; n <= 8; n += 2) for (k = 0; k <= 3; ++k) {
+          f = t["BM_FixedMatrix/" n "/" k]; e = t["BM_EigenDouble/" n "/" k]
+          if (f > 0 && e > 0) { printf "  %-4d %-28s %10.1f %10.1f %8.2f\n", n, name[k+1], f, e, f / e
+                                if (f / e > worst) worst = f / e }
         }
+        printf "  worst fixed/double = %.2f (target <= 1.00)\n", worst
+        for (n = 6; n <= 8; n += 2) printf "  whole core N=%d (faults, tare, filter 1 / 16): %.1f / %.1f ns\n", n,
+          t["BM_FixedCore/" n "/1"], t["BM_FixedCore/" n "/16"]
       }'
 fi
 

@@ -5,6 +5,8 @@
 
 #include <cerrno>
 #include <cmath>
+#include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -392,13 +394,26 @@ CalFile ParseCalFile(const std::string& text, const std::string& path) {
   }
 }
 
-void WriteFileAtomic(const std::string& path, const std::string& text) {
+void CrashPoint(const std::string& step) {
+  const char* at = std::getenv("FTSTACK_CRASH_AT");
+  if (at != nullptr && step == at) ::raise(SIGKILL);
+}
+
+void WriteFileAtomic(const std::string& path, const std::string& text, const char* crash_tag) {
+  const std::string tag = crash_tag != nullptr ? crash_tag : "";
+  auto crash = [&](const char* step) {
+    if (crash_tag != nullptr) CrashPoint(tag + "-" + step);
+  };
   const std::string tmp = path + ".tmp";
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (fd < 0) throw CalFileError(tmp + ": cannot write: " + std::strerror(errno));
+  // The torn-write injection stops after half the bytes.
+  const char* at = crash_tag != nullptr ? std::getenv("FTSTACK_CRASH_AT") : nullptr;
+  const bool torn = at != nullptr && tag + "-write" == at;
+  const std::size_t size = torn ? text.size() / 2 : text.size();
   std::size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t w = ::write(fd, text.data() + done, text.size() - done);
+  while (done < size) {
+    const ssize_t w = ::write(fd, text.data() + done, size - done);
     if (w < 0) {
       if (errno == EINTR) continue;
       ::close(fd);
@@ -406,19 +421,25 @@ void WriteFileAtomic(const std::string& path, const std::string& text) {
     }
     done += static_cast<std::size_t>(w);
   }
+  crash("write");
+  crash("fsync");
   if (::fsync(fd) != 0 || ::close(fd) != 0) {
     throw CalFileError(tmp + ": fsync/close failed: " + std::strerror(errno));
   }
+  crash("rename");
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     throw CalFileError(path + ": rename failed: " + std::strerror(errno));
   }
+  crash("dirsync");
+  // The rename is durable only once the directory entry is on disk.
   std::filesystem::path dir = std::filesystem::path(path).parent_path();
   if (dir.empty()) dir = ".";
   const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY);
-  if (dfd >= 0) {
-    (void)::fsync(dfd);
-    ::close(dfd);
-  }
+  if (dfd < 0) throw CalFileError(dir.string() + ": cannot open the directory to sync it");
+  const int rc = ::fsync(dfd);
+  ::close(dfd);
+  if (rc != 0)
+    throw CalFileError(dir.string() + ": directory fsync failed: " + std::strerror(errno));
 }
 
 void SaveCalFile(const std::string& path, const CalFile& file) {

@@ -69,8 +69,17 @@ struct CalFile {
 [[nodiscard]] nlohmann::json ParseJsonText(const std::string& text, const std::string& path);
 /// Writes atomically: temporary file, fsync, rename over `path`, fsync of the directory.
 void SaveCalFile(const std::string& path, const CalFile& file);
-/// The same for any text.
-void WriteFileAtomic(const std::string& path, const std::string& text);
+/// The same for any text. With a `crash_tag` T the steps are crash-injection points (see
+/// CrashPoint): "T-write" (the temporary file torn: half written), "T-fsync", "T-rename" and
+/// "T-dirsync" (each just before that step).
+void WriteFileAtomic(const std::string& path, const std::string& text,
+                     const char* crash_tag = nullptr);
+
+/// Test hook for crash injection: when the environment variable FTSTACK_CRASH_AT equals `step`,
+/// the process kills itself here with SIGKILL (no handler, no flush, no unwinding — as a power
+/// cut would stop it, minus the kernel's page cache). Does nothing otherwise. Used by
+/// `ftcal install` (CalSlots::Install) and its crash test; never set it in production.
+void CrashPoint(const std::string& step);
 
 /// The default ADC of the simulated sensor: 24-bit, ±3.90625 mV/V (gain 128, ratio 0.5).
 [[nodiscard]] hal::AdcInfo DefaultAdc(std::uint8_t channels);

@@ -12,7 +12,10 @@ namespace ftstack::cal {
 /// calibration is verified, written into the inactive slot (temporary file, fsync, rename),
 /// read back and verified again, and only then made active by replacing `active` atomically.
 /// A refused file never touches the active slot. If the active slot is found corrupt when
-/// loading, the other slot (the previous calibration) is used and the reason reported.
+/// loading, the other slot (the previous calibration) is used and the reason reported; if
+/// `active` itself is missing or unreadable, the slot file written last is taken. Every step of
+/// Install is a crash-injection point (FTSTACK_CRASH_AT, see CrashPoint); a crash at any of them
+/// leaves exactly one valid calibration that LoadActive (and so ftd --cal-dir) uses.
 class CalSlots {
  public:
   explicit CalSlots(std::string dir);
@@ -33,6 +36,12 @@ class CalSlots {
   [[nodiscard]] std::string SlotPath(char slot) const;
 
  private:
+  /// The slot `active` records; when that record is missing or unreadable, the slot file
+  /// written last (and *note says so); 0 when neither slot file exists.
+  [[nodiscard]] char Recorded(std::string* note) const;
+  /// The slot LoadActive would use (the recorded one, or the other when it is refused).
+  [[nodiscard]] char InUse() const;
+
   std::string dir_;
 };
 

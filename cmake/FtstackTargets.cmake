@@ -41,6 +41,20 @@ if(FTSTACK_SANITIZE)
   add_link_options(-fsanitize=address,undefined)
 endif()
 
+if(FTSTACK_TSAN)
+  if(FTSTACK_SANITIZE OR FTSTACK_FUZZ)
+    message(FATAL_ERROR "FTSTACK_TSAN cannot be combined with ASan (FTSTACK_SANITIZE, FTSTACK_FUZZ)")
+  endif()
+  add_compile_options(-fsanitize=thread -fno-omit-frame-pointer -g)
+  add_link_options(-fsanitize=thread)
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    # TSan does not model std::atomic_thread_fence (firmware/seqlock.hpp); GCC says so with -Wtsan.
+    # The seqlock's payload is relaxed atomics, so TSan still sees no plain data race there; the
+    # fences' ordering is what TSan cannot check (the seqlock's own tests do).
+    add_compile_options(-Wno-tsan)
+  endif()
+endif()
+
 # Embedded code (hal/, firmware/): no exceptions, no RTTI.
 add_library(ftstack_embedded INTERFACE)
 target_compile_options(ftstack_embedded INTERFACE $<$<COMPILE_LANGUAGE:CXX>:-fno-exceptions -fno-rtti>)

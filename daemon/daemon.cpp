@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -12,6 +13,7 @@
 
 #include "calibration/cal_file.hpp"
 #include "calibration/payload_file.hpp"
+#include "calibration/slots.hpp"
 #include "daemon/hardware_adc.hpp"
 #include "daemon/realtime.hpp"
 #include "measurement/recording.hpp"
@@ -143,8 +145,26 @@ Ftd::Ftd(FtdOptions options, SimulatorFactory simulator)
 
 Ftd::~Ftd() { Stop(); }
 
+char Ftd::ResolveSlotDirectory() {
+  const cal::CalSlots slots(opt_.cal_dir);
+  opt_.cal = slots.SlotPath('A');
+  opt_.cal_b = std::filesystem::exists(slots.SlotPath('B')) ? slots.SlotPath('B') : "";
+  char slot = 0;
+  std::string note;
+  try {
+    (void)slots.LoadActive(&slot, &note);
+  } catch (const cal::CalFileError& e) {
+    std::fprintf(stderr, "ftd: %s\n", e.what());
+    return 0;
+  }
+  if (!note.empty()) std::fprintf(stderr, "ftd: %s: %s\n", opt_.cal_dir.c_str(), note.c_str());
+  return slot;
+}
+
 void Ftd::Start() {
   if (running_) return;
+  char dir_slot = 0;  // with --cal-dir: the slot the directory makes active ('A', 'B'; 0: none)
+  if (!opt_.cal_dir.empty()) dir_slot = ResolveSlotDirectory();
   try {
     if (opt_.adc == "sim") {
       if (simulator_ == nullptr) {
@@ -193,7 +213,12 @@ void Ftd::Start() {
   // A field device comes up whatever its calibration files hold: on slot A if it is valid, else
   // on a valid slot B (and says so), else without calibration (status bit 4, wrench invalid).
   cfg.allow_uncalibrated = true;
-  if (!cfg.slots[0].present && cfg.slots[1].present) {
+  if (dir_slot == 'B' && cfg.slots[1].present) {
+    cfg.initial_slot = 1;
+    rated = rated_b;
+    std::fprintf(stderr, "ftd: running on calibration slot B (%s, active in %s)\n",
+                 opt_.cal_b.c_str(), opt_.cal_dir.c_str());
+  } else if (!cfg.slots[0].present && cfg.slots[1].present) {
     cfg.initial_slot = 1;
     rated = rated_b;
     std::fprintf(stderr, "ftd: running on calibration slot B (%s)\n", opt_.cal_b.c_str());

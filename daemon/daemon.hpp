@@ -36,8 +36,11 @@ struct FtdOptions {
   std::optional<std::array<double, 6>> sim_wrench;  ///< constant applied wrench, N and N·m
   std::string replay;                               ///< recording whose wrench columns are played
   unsigned rate_hz = 1000;
-  std::string cal;      ///< calibration file for slot 0 ("" = built-in)
-  std::string cal_b;    ///< calibration file for slot 1 ("" = none)
+  std::string cal;    ///< calibration file for slot 0 ("" = built-in)
+  std::string cal_b;  ///< calibration file for slot 1 ("" = none)
+  /// A slot directory of `ftcal install` (cal_A.json, cal_B.json, active): slots 0/1 from its
+  /// files, starting on the one CalSlots::LoadActive resolves ("" = use cal / cal_b).
+  std::string cal_dir;
   std::string payload;  ///< payload file for gravity compensation ("" = none)
   std::string rdt;      ///< HOST:PORT of the RDT server ("" = none)
   double rdt_counts_per_n = 1e6;
@@ -111,6 +114,9 @@ class Ftd {
   [[nodiscard]] std::string StatusLine() const;
 
  private:
+  /// --cal-dir: points cal/cal_b at the directory's slot files and returns the active slot
+  /// ('A', 'B') as CalSlots::LoadActive resolves it (0 when none is valid), logging why.
+  char ResolveSlotDirectory();
   void SamplingLoop();
   void StartRdt();
   void PrepareLog();  ///< checks that --log can be written, sizes the log ring

@@ -4,8 +4,20 @@
 
 namespace ftstack::fw {
 
+namespace {
+
+/// Reciprocals of every moving-average fill 1 … kMaxFilterLength (index 0 unused).
+constexpr auto kFillReciprocal = [] {
+  std::array<std::uint64_t, kMaxFilterLength + 1> m{};
+  for (std::uint32_t d = 1; d <= kMaxFilterLength; ++d) m[d] = Reciprocal63(d);
+  return m;
+}();
+
+}  // namespace
+
 void WrenchCore::SetCalibration(const FixedCalibration& cal) {
   cal_ = cal;
+  BuildPlan();
   ClearTare();
   ResetFilter();
   last_valid_ = {};
@@ -26,6 +38,48 @@ void WrenchCore::ClearTare() {
   tare_counts_ = {};
   tare_extra_ = {};
   tare_offset_ = {};
+  tare_f_ = {};
+}
+
+void WrenchCore::BuildPlan() {
+  plan_ = Plan{};
+  const std::size_t n = cal_.channel_count;
+  if (!cal_.valid || n > kMaxChannels || cal_.extra_count > kMaxFeatures - kMaxChannels) return;
+  std::size_t j = 0;
+  auto add = [&](std::size_t cal_index) {  // cal_index: the feature's column in cal_.coef
+    for (std::size_t r = 0; r < kAxes; ++r) plan_.coef[j][r] = cal_.coef[r][cal_index];
+    if (cal_index >= n) {
+      const FixedFeature& e = cal_.extra[cal_index - n];
+      plan_.source[j] = static_cast<std::uint8_t>(cal_index - n);
+      plan_.a[j] = e.a;
+      plan_.b[j] = e.b;
+      plan_.shift[j] = e.shift;
+      plan_.half[j] = e.shift > 0 ? std::int64_t{1} << (e.shift - 1) : 0;
+    }
+    ++j;
+  };
+  for (std::size_t c = 0; c < n; ++c) add(c);
+  for (FeatureKind kind :
+       {FeatureKind::kTemperature, FeatureKind::kProduct, FeatureKind::kTempProduct}) {
+    for (std::size_t k = 0; k < cal_.extra_count; ++k) {
+      if (cal_.extra[k].kind == kind) add(n + k);
+    }
+    if (kind == FeatureKind::kTemperature) plan_.temp_end = static_cast<std::uint8_t>(j);
+    if (kind == FeatureKind::kProduct) plan_.product_end = static_cast<std::uint8_t>(j);
+  }
+  plan_.channels = static_cast<std::uint8_t>(n);
+  plan_.features = static_cast<std::uint8_t>(j);
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    plan_.round_half[r] = cal_.shift[r] > 0 ? std::int64_t{1} << (cal_.shift[r] - 1) : 0;
+  }
+}
+
+void WrenchCore::BuildTareFeatures() {
+  const std::size_t n = cal_.channel_count;
+  tare_f_ = {};
+  if (!tare_active_) return;
+  for (std::size_t c = 0; c < n; ++c) tare_f_[c] = tare_counts_[c];
+  for (std::size_t j = n; j < plan_.features; ++j) tare_f_[j] = tare_extra_[plan_.source[j]];
 }
 
 void WrenchCore::ComputeTareOffset() {
@@ -109,39 +163,50 @@ void WrenchCore::ExtraFeatures(const std::array<std::int32_t, kMaxChannels>& cou
 void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts,
                        std::int32_t temperature_mdegc, bool has_temperature, WrenchLsb& y,
                        bool* saturated, bool* temp_range) const {
-  std::array<std::int64_t, kMaxChannels> x{};
-  std::array<std::int32_t, kMaxChannels> clamped{};
-  for (std::size_t c = 0; c < cal_.channel_count; ++c) {
-    std::int32_t v = counts[c];
-    if (v > cal_.max_counts) {
-      v = cal_.max_counts;
-      *saturated = true;
-    } else if (v < cal_.min_counts) {
-      v = cal_.min_counts;
-      *saturated = true;
-    }
-    clamped[c] = v;
-    x[c] = static_cast<std::int64_t>(v) - (tare_active_ ? tare_counts_[c] : 0);
+  // The hot path: y_r = round((Σ_j coef[r][j]·f_j + bias_r) / 2^shift_r), features in plan order.
+  // Without a tare tare_f_ is zero; with one the bias drops out (see FixedCalibration).
+  const std::size_t n = plan_.channels;
+  const std::size_t nf = plan_.features;
+  // Features; only [0, nf) are written and read (zeroing all 53 each sample would cost time).
+  std::array<std::int64_t, kMaxFeatures> f;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+  std::array<std::int64_t, kMaxChannels> x_zero{};  // clamped counts − zero (products' origin)
+  bool clamped = false;
+  for (std::size_t c = 0; c < n; ++c) {
+    const std::int32_t raw = counts[c];
+    const std::int32_t v =
+        raw > cal_.max_counts ? cal_.max_counts : (raw < cal_.min_counts ? cal_.min_counts : raw);
+    clamped |= v != raw;
+    f[c] = v - tare_f_[c];
+    x_zero[c] = static_cast<std::int64_t>(v) - cal_.zero[c];
   }
-  std::array<std::int64_t, kMaxFeatures - kMaxChannels> f{};
-  if (cal_.extra_count > 0) {
-    ExtraFeatures(clamped, DeltaT(temperature_mdegc, has_temperature, temp_range), f);
-    if (tare_active_) {
-      for (std::size_t k = 0; k < cal_.extra_count; ++k) f[k] -= tare_extra_[k];
+  if (nf > n) {
+    const std::int64_t dt = DeltaT(temperature_mdegc, has_temperature, temp_range);
+    std::size_t j = n;
+    for (; j < plan_.temp_end; ++j) f[j] = dt;
+    // The loader checked |x̃_a·x̃_b| + half ≤ 2^63 − 1 (kFeatureOverflow) and sized the shifts.
+    for (; j < plan_.product_end; ++j) {
+      f[j] = (x_zero[plan_.a[j]] * x_zero[plan_.b[j]] + plan_.half[j]) >> plan_.shift[j];
     }
+    for (; j < nf; ++j) f[j] = (x_zero[plan_.a[j]] * dt + plan_.half[j]) >> plan_.shift[j];
+    for (j = n; j < nf; ++j) f[j] -= tare_f_[j];
   }
-  const std::size_t n = cal_.channel_count;
+  // The loader guarantees Σ|coef|·|f| + |bias| ≤ 2^61 for every input between the rails, so no
+  // partial sum in any order can overflow.
+  std::array<std::int64_t, kAxes> acc{};
+  for (std::size_t r = 0; r < kAxes; ++r) acc[r] = tare_active_ ? 0 : cal_.bias[r];
+  for (std::size_t j = 0; j < nf; ++j) {
+    const std::int64_t fj = f[j];
+    const auto& col = plan_.coef[j];
+    for (std::size_t r = 0; r < kAxes; ++r) acc[r] += col[r] * fj;
+  }
   for (std::size_t r = 0; r < kAxes; ++r) {
     if ((cal_.invalid_axes & (1u << r)) != 0) {
       y[r] = 0;  // not determined by the calibration: never a value (status bit 10)
       continue;
     }
-    // The loader guarantees |acc| < 2^62 for every x between the rails.
-    std::int64_t acc = tare_active_ ? 0 : cal_.bias[r];
-    for (std::size_t c = 0; c < n; ++c) acc += cal_.coef[r][c] * x[c];
-    for (std::size_t k = 0; k < cal_.extra_count; ++k) acc += cal_.coef[r][n + k] * f[k];
-    y[r] = SatToI32(RoundShift(acc, cal_.shift[r]), saturated);
+    y[r] = SatToI32((acc[r] + plan_.round_half[r]) >> cal_.shift[r], &clamped);
   }
+  if (clamped) *saturated = true;
 }
 
 void WrenchCore::Process(const hal::AdcSample& in, bool simulated, CoreOutput& out) {
@@ -219,6 +284,7 @@ void WrenchCore::Process(const hal::AdcSample& in, bool simulated, CoreOutput& o
                       tare_extra_);
       }
       tare_active_ = true;
+      BuildTareFeatures();
       ComputeTareOffset();
       ResetFilter();
     }
@@ -256,12 +322,15 @@ void WrenchCore::Process(const hal::AdcSample& in, bool simulated, CoreOutput& o
     slot[r] = y[r];
   }
   if (filter_fill_ < filter_length_) ++filter_fill_;
-  filter_pos_ = static_cast<std::uint16_t>((filter_pos_ + 1) % filter_length_);
+  if (++filter_pos_ == filter_length_) filter_pos_ = 0;
   if (filter_fill_ == 1) {
     out.wrench = y;  // no averaging: skip the divisions
   } else {
+    // |sum| ≤ 256·2^31 = 2^39: within RoundDivByReciprocal's exact range (no division per axis).
+    const std::uint64_t m = kFillReciprocal[filter_fill_];
     for (std::size_t r = 0; r < kAxes; ++r) {
-      out.wrench[r] = SatToI32(RoundDiv(filter_sum_[r], filter_fill_), &out.arithmetic_saturated);
+      out.wrench[r] = SatToI32(RoundDivByReciprocal(filter_sum_[r], filter_fill_, m),
+                               &out.arithmetic_saturated);
     }
   }
   last_valid_ = out.wrench;

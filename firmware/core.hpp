@@ -82,6 +82,10 @@ class WrenchCore {
 
  private:
   void ResetFilter();
+  /// Rearranges the installed calibration for the per-sample path (see Plan).
+  void BuildPlan();
+  /// Copies the tare's features into plan order (tare_f_): zero without an active tare.
+  void BuildTareFeatures();
   /// Fills the derived features (ΔT, products) for clamped counts and a clamped temperature.
   void ExtraFeatures(const std::array<std::int32_t, kMaxChannels>& counts, std::int32_t dt_mdegc,
                      std::array<std::int64_t, kMaxFeatures - kMaxChannels>& f) const;
@@ -91,7 +95,29 @@ class WrenchCore {
   std::int32_t DeltaT(std::int32_t temperature_mdegc, bool has_temperature,
                       bool* out_of_range) const;
 
+  /// The calibration as the per-sample path reads it: features ordered channels, ΔT, products,
+  /// ΔT products (each group one branch-free loop), coefficients feature-major so one feature
+  /// multiplies into all six accumulators, rounding halves precomputed. The same integers as
+  /// cal_ (a permutation of the terms of each row's sum), so the loader's proof holds unchanged.
+  struct Plan {
+    std::uint8_t channels = 0;                   ///< bridge features (0 for an invalid calibration)
+    std::uint8_t features = 0;                   ///< channels + extra features
+    std::uint8_t temp_end = 0;                   ///< ΔT features are [channel_count, temp_end)
+    std::uint8_t product_end = 0;                ///< products are [temp_end, product_end)
+    std::array<std::uint8_t, kMaxFeatures> a{};  ///< first bridge of a derived feature
+    std::array<std::uint8_t, kMaxFeatures> b{};  ///< second bridge of a product
+    std::array<std::uint8_t, kMaxFeatures> shift{};   ///< right shift of a derived feature
+    std::array<std::int64_t, kMaxFeatures> half{};    ///< its rounding half (0 for shift 0)
+    std::array<std::uint8_t, kMaxFeatures> source{};  ///< index in cal_.extra of a plan feature
+    std::array<std::int64_t, kAxes> round_half{};     ///< rounding half of each row's shift
+    std::array<std::array<std::int64_t, kAxes>, kMaxFeatures> coef{};  ///< coef[feature][axis]
+  };
+
   FixedCalibration cal_{};
+  Plan plan_{};
+  /// Every feature's value at the active tare, plan order (channels: the tare counts); all zero
+  /// without an active tare, so the per-sample path subtracts it unconditionally.
+  std::array<std::int64_t, kMaxFeatures> tare_f_{};
   CoreLimits limits_{};
   std::array<std::int32_t, kMaxChannels> tare_counts_{};
   bool tare_active_ = false;

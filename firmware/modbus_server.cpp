@@ -16,7 +16,6 @@
 namespace ftstack::fw {
 namespace {
 
-constexpr std::size_t kMbapLength = 7;
 constexpr int kPollMs = 100;
 /// Frames served per connection per poll round, so one flooding client cannot starve the others.
 constexpr int kFramesPerRound = 16;
@@ -181,7 +180,7 @@ ServerStatus ModbusTcpServer::Open(const char* host, std::uint16_t port, std::ui
 void ModbusTcpServer::Close(Connection& c) {
   if (c.fd >= 0) ::close(c.fd);
   c.fd = -1;
-  c.fill = 0;
+  c.frames.Reset();
 }
 
 void ModbusTcpServer::Accept() {
@@ -193,7 +192,7 @@ void ModbusTcpServer::Accept() {
     // A free slot, else evict in this order: a client stuck mid-frame, a client that never
     // completed a request, the client silent longest.
     Connection* slot = nullptr;
-    auto rank = [](const Connection& c) { return c.fill > 0 ? 0 : (c.served ? 2 : 1); };
+    auto rank = [](const Connection& c) { return c.frames.fill() > 0 ? 0 : (c.served ? 2 : 1); };
     for (Connection& c : conns_) {
       if (c.fd < 0) {
         slot = &c;
@@ -213,7 +212,7 @@ void ModbusTcpServer::Accept() {
       counters_.dropped.fetch_add(1, std::memory_order_relaxed);
     }
     slot->fd = fd;
-    slot->fill = 0;
+    slot->frames.Reset();
     slot->served = false;
     slot->last_active_us = MonotonicUs();
     counters_.connections.fetch_add(1, std::memory_order_relaxed);
@@ -224,19 +223,16 @@ bool ModbusTcpServer::Service(Connection& c) {
   int frames = 0;
   for (;;) {
     // Serve every complete frame in the buffer.
-    while (c.fill >= kMbapLength) {
-      const std::uint16_t protocol = Be16(&c.buf[2]);
-      const std::uint16_t length = Be16(&c.buf[4]);
-      if (protocol != 0 || length < 2 || length > kMaxTcpAdu - 6) {
+    for (FrameState st = c.frames.Next(); st != FrameState::kNeedMore; st = c.frames.Next()) {
+      if (st == FrameState::kBadHeader) {
         counters_.dropped.fetch_add(1, std::memory_order_relaxed);
         return false;  // not Modbus/TCP: the stream cannot be resynchronised
       }
-      const std::size_t total = 6u + length;
-      if (c.fill < total) break;
-      const std::uint8_t unit = c.buf[6];
+      const std::uint8_t unit = c.frames.unit();
       if (unit == unit_id_ || unit == kTcpWildcardUnit) {
         modbus_set_socket(ctx_, c.fd);
-        const bool ok = HandleRequest(map_, ctx_, mapping_, c.buf.data(), static_cast<int>(total),
+        const bool ok = HandleRequest(map_, ctx_, mapping_, c.frames.frame(),
+                                      static_cast<int>(c.frames.frame_length()),
                                       static_cast<int>(kMbapLength), true, &counters_);
         modbus_set_socket(ctx_, -1);
         if (!ok) return false;
@@ -244,13 +240,12 @@ bool ModbusTcpServer::Service(Connection& c) {
       } else {
         counters_.ignored.fetch_add(1, std::memory_order_relaxed);
       }
-      std::memmove(c.buf.data(), c.buf.data() + total, c.fill - total);
-      c.fill -= total;
+      c.frames.Pop();
       if (++frames >= kFramesPerRound) return true;
     }
-    const ssize_t n = ::recv(c.fd, c.buf.data() + c.fill, c.buf.size() - c.fill, 0);
+    const ssize_t n = ::recv(c.fd, c.frames.space(), c.frames.space_size(), 0);
     if (n > 0) {
-      c.fill += static_cast<std::size_t>(n);
+      (void)c.frames.Commit(static_cast<std::size_t>(n));
       c.last_active_us = MonotonicUs();
       continue;
     }
@@ -263,7 +258,7 @@ bool ModbusTcpServer::Service(Connection& c) {
 
 bool ModbusTcpServer::FramePending(const Connection& c) {
   // A complete frame (or a header to refuse) already buffered: no new data will announce it.
-  return c.fd >= 0 && c.fill >= kMbapLength && c.fill >= 6u + Be16(&c.buf[4]);
+  return c.fd >= 0 && c.frames.Pending();
 }
 
 void ModbusTcpServer::Run(const std::atomic<bool>& stop) {

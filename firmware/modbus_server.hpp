@@ -9,11 +9,10 @@
 #include <modbus/modbus.h>
 
 #include "firmware/register_map.hpp"
+#include "firmware/tcp_frame.hpp"
 
 namespace ftstack::fw {
 
-/// Largest Modbus ADU: 7-byte MBAP header + 253-byte PDU.
-inline constexpr std::size_t kMaxTcpAdu = 260;
 /// Largest number of simultaneous TCP clients. When all are taken, a new connection replaces the
 /// one stuck longest mid-frame, else one that never completed a request, else the one silent
 /// longest (so stalled or abandoned clients cannot lock working ones out).
@@ -72,10 +71,9 @@ class ModbusTcpServer {
  private:
   struct Connection {
     int fd = -1;
-    std::size_t fill = 0;
     std::uint64_t last_active_us = 0;  ///< when it last sent something (or connected)
     bool served = false;               ///< completed at least one request
-    std::array<std::uint8_t, kMaxTcpAdu> buf{};
+    TcpFrameAssembler frames;
   };
   void Accept();
   /// Reads what is available and serves every complete frame; false when the connection must go.

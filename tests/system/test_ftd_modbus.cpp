@@ -27,6 +27,7 @@
 #include "tests/support/temp_dir.hpp"
 #include "tests/system/builtin_adc.hpp"
 #include "tests/system/ftd_process.hpp"
+#include "tests/system/raw_connect.hpp"
 #include "tests/system/sim_noise.hpp"
 
 namespace ftstack {
@@ -358,18 +359,7 @@ TEST(FtdModbus, CalibrationSlotsAndTheirCrc) {
   rmdir(base.c_str());
 }
 
-int RawConnect(int port) {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(static_cast<std::uint16_t>(port));
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0) {
-    close(fd);
-    return -1;
-  }
-  return fd;
-}
+using test::RawConnect;
 
 TEST(FtdModbus, GarbageAndHalfFramesDoNotDisturbOtherClients) {
   test::FtdProcess ftd({"--modbus-tcp", "127.0.0.1:0", "--rate-hz", "2000"});

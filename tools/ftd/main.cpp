@@ -54,7 +54,13 @@ int Run(int argc, char** argv) {
   app.add_option("--rate-hz", opt.rate_hz, "sample rate, Hz")->check(CLI::Range(1u, 100000u));
   app.add_option("--cal", opt.cal,
                  "calibration file, slot 0 (default: the simulated sensor's own)");
-  app.add_option("--cal-b", opt.cal_b, "calibration file for slot 1 (holding register 3)");
+  auto* cal_b =
+      app.add_option("--cal-b", opt.cal_b, "calibration file for slot 1 (holding register 3)");
+  app.add_option("--cal-dir", opt.cal_dir,
+                 "slot directory of ftcal install: slots 0/1 from cal_A.json/cal_B.json, "
+                 "starting on the active one")
+      ->excludes(cal_b)
+      ->check(CLI::ExistingDirectory);
   app.add_option("--payload", opt.payload,
                  "payload file (ftcal payload) for gravity compensation (holding 22–28)");
   app.add_option("--modbus-tcp", opt.modbus_tcp,
