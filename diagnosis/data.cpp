@@ -1,6 +1,9 @@
 #include "diagnosis/data.hpp"
 
 #include <algorithm>
+#include <cmath>
+
+#include "measurement/units.hpp"
 
 namespace ftstack::diag {
 namespace {
@@ -21,7 +24,31 @@ void Relay(std::size_t done, std::size_t total, void* user) {
   }
 }
 
-Recording Read(const std::string& path, ProgressRelay* relay) {
+/// Converts `rec`'s bridge columns from their declared unit to mV/V, refusing values outside the
+/// declared converter's codes or, undeclared, outside the assumed converter (±3.90625 mV/V).
+std::string ToMvv(Recording* rec, bool check_assumed) {
+  const InputUnit u = ResolveInputUnit(*rec);
+  const std::size_t n = rec->BridgeCount();
+  ValueRange r;
+  r.unit = ToString(u.unit);
+  if (u.unit == BridgeUnit::kCounts) {
+    r.min = static_cast<double>(MinCode(u.converter));
+    r.max = static_cast<double>(MaxCode(u.converter));
+    r.what = "the codes of the " + std::to_string(u.converter.bits) + "-bit " +
+             ToString(u.converter.coding) + " converter";
+    CheckBridgeRange(*rec, n, r, 0.5);
+  } else if (u.source == "format default" && check_assumed) {
+    r.min = -3.90625;
+    r.max = 3.90625;
+    r.what = "the range of the assumed converter";
+    CheckBridgeRange(*rec, n, r, 0.0);
+  }
+  ConvertBridgesToMvv(rec, n, u);
+  return Describe(u);
+}
+
+Recording Read(const std::string& path, ProgressRelay* relay, std::string* unit,
+               bool check_assumed) {
   ReadOptions opt;
   opt.required = {"t"};
   opt.require_bridges = true;
@@ -29,7 +56,9 @@ Recording Read(const std::string& path, ProgressRelay* relay) {
     opt.progress = &Relay;
     opt.progress_user = relay;
   }
-  return ReadRecording(path, opt);
+  Recording rec = ReadRecording(path, opt);
+  *unit = ToMvv(&rec, check_assumed);
+  return rec;
 }
 
 bool HasWrench(const Recording& r) {
@@ -109,9 +138,13 @@ DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path, 
   ProgressRelay r1{progress, user, 0.0, 0.5, "reading sim"};
   ProgressRelay r2{progress, user, 0.5, 0.5, "reading real"};
   try {
-    const Recording sim = Read(sim_path, &r1);
-    const Recording real = Read(real_path, &r2);
-    return FromRecordings(sim, real);
+    std::string sim_unit;
+    std::string real_unit;
+    const Recording sim = Read(sim_path, &r1, &sim_unit, false);
+    const Recording real = Read(real_path, &r2, &real_unit, true);
+    DiagData d = FromRecordings(sim, real);
+    d.real_unit = real_unit;
+    return d;
   } catch (const RecordingError& e) {
     throw DiagInputError(e.what());
   }
@@ -122,6 +155,7 @@ DiagData LoadPredictedReal(const std::string& real_path, const std::string& mode
                            void* user) {
   ProgressRelay r1{progress, user, 0.0, 0.8, "reading real"};
   Recording real;
+  std::string unit;
   try {
     ReadOptions opt;
     opt.required = {"t"};
@@ -132,6 +166,7 @@ DiagData LoadPredictedReal(const std::string& real_path, const std::string& mode
       opt.progress_user = &r1;
     }
     real = ReadRecording(real_path, opt);
+    unit = ToMvv(&real, true);
   } catch (const RecordingError& e) {
     throw DiagInputError(e.what());
   }
@@ -144,6 +179,7 @@ DiagData LoadPredictedReal(const std::string& real_path, const std::string& mode
   DiagData d;
   d.sim_name = model_name;
   d.real_name = real_path;
+  d.real_unit = unit;
   d.t_s = real.Column("t");
   d.real_mvv = Bridges(real, nr);
   d.wrench = WrenchOf(real);

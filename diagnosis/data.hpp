@@ -23,13 +23,14 @@ class DiagInputError : public std::runtime_error {
 
 /// One aligned pair of recordings, column-major (row i is sample i).
 struct DiagData {
-  std::vector<double> t_s;     ///< sample times, s, strictly increasing
-  Eigen::MatrixXd wrench;      ///< n × 6: Fx Fy Fz (N) Mx My Mz (N·m); 0 columns when absent
-  std::vector<double> temp_c;  ///< body temperature, °C; empty when the real file has none
-  Eigen::MatrixXd sim_mvv;     ///< n × N predicted bridge outputs, mV/V
-  Eigen::MatrixXd real_mvv;    ///< n × N measured bridge outputs, mV/V
-  std::string sim_name;        ///< where the prediction came from (file or sensor description)
-  std::string real_name;       ///< the real recording's path
+  std::vector<double> t_s;         ///< sample times, s, strictly increasing
+  Eigen::MatrixXd wrench;          ///< n × 6: Fx Fy Fz (N) Mx My Mz (N·m); 0 columns when absent
+  std::vector<double> temp_c;      ///< body temperature, °C; empty when the real file has none
+  Eigen::MatrixXd sim_mvv;         ///< n × N predicted bridge outputs, mV/V
+  Eigen::MatrixXd real_mvv;        ///< n × N measured bridge outputs, mV/V
+  std::string sim_name;            ///< where the prediction came from (file or sensor description)
+  std::string real_name;           ///< the real recording's path
+  std::string real_unit = "mV/V";  ///< the real file's declared bridge unit (converted to mV/V)
 
   [[nodiscard]] std::size_t rows() const { return t_s.size(); }
   [[nodiscard]] int channels() const { return static_cast<int>(real_mvv.cols()); }

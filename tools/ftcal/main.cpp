@@ -9,6 +9,7 @@
 #include "calibration/cal_file.hpp"
 #include "calibration/fit.hpp"
 #include "calibration/fit_report.hpp"
+#include "calibration/input_units.hpp"
 #include "calibration/slots.hpp"
 #include "measurement/recording.hpp"
 #include "sim/rig.hpp"
@@ -49,6 +50,17 @@ int main(int argc, char** argv) {
   std::string sensor_path;
   std::string serial = "unknown";
   int folds = 10;
+  UnitOverrides units;
+  bool allow_flagged = false;
+  auto unit_options = [&units](CLI::App* sub) {
+    sub->add_option("--bridge-unit", units.unit,
+                    "unit of the b* columns: mV/V, V or counts (overrides # bridge_unit)");
+    sub->add_option("--converter", units.converter,
+                    "converter of counts: \"bits=10,coding=unsigned|signed|offset-binary,gain=1,"
+                    "ratiometric=yes,reference_ratio=1,reference_v=…,full_scale_mvv=…\"");
+    sub->add_option("--excitation-v", units.excitation_v, "bridge excitation, V")
+        ->check(CLI::PositiveNumber);
+  };
 
   auto* fit = app.add_subcommand("fit", "fit a calibration to rig data (reference wrench + b*)");
   fit->add_option("--in", in_path, "rig recording (t, Fx…Mz, b0…, optional temp_C, block/pose)")
@@ -64,11 +76,15 @@ int main(int argc, char** argv) {
   fit->add_option("--serial", serial, "serial number written to the file");
   fit->add_option("--folds", folds, "cross-validation folds over whole load blocks")
       ->check(CLI::Range(2, 100));
+  unit_options(fit);
 
   auto* apply = app.add_subcommand("apply", "run the firmware's fixed-point core on a recording");
   apply->add_option("--cal", cal_path, "calibration file")->required();
   apply->add_option("--in", in_path, "recording with b* columns")->required();
   apply->add_option("--out", out_path, "output recording t,Fx,Fy,Fz,Mx,My,Mz")->required();
+  apply->add_flag("--allow-flagged", allow_flagged,
+                  "exit 0 even when rows carry status bits (they stay marked in `status`)");
+  unit_options(apply);
 
   std::string ati_path;
   auto* import_ati = app.add_subcommand("import-ati", "convert an ATI DAQ .cal file (gauge volts)");
@@ -107,7 +123,7 @@ int main(int argc, char** argv) {
       ReadOptions opt;
       opt.require_bridges = true;
       opt.require_wrench = true;
-      const Recording rec = ReadRecording(in_path, opt);
+      Recording rec = ReadRecording(in_path, opt);
       cal::FitOptions fo;
       fo.folds = folds;
       hal::AdcInfo adc{};
@@ -123,6 +139,10 @@ int main(int argc, char** argv) {
         adc.full_scale_nvv = std::llround(1000.0 * s.adc.reference_ratio / s.adc_gain * 1e6);
         have_adc = true;
       }
+      if (!have_adc) adc = cal::DefaultAdc(static_cast<std::uint8_t>(rec.BridgeCount()));
+      const cal::FitInput input = cal::PrepareFitInput(&rec, units, adc);
+      adc = input.adc;
+      std::printf("%s\n", input.description.c_str());
       if (!rated_text.empty()) fo.rated = tools::ParseWrench(rated_text);
       if (model_name != "auto") {
         const auto k = cal::ParseModelKind(model_name);
@@ -133,8 +153,8 @@ int main(int argc, char** argv) {
       bo.scale = fo.rated;
       const cal::RigData data = cal::RigDataFromRecording(rec, bo);
       const cal::FitResult result = cal::FitCalibration(data, fo);
-      if (!have_adc) adc = cal::DefaultAdc(static_cast<std::uint8_t>(data.bridges.cols()));
-      const cal::CalFile file = cal::CalFileFromFit(result, adc, serial, Today());
+      cal::CalFile file = cal::CalFileFromFit(result, adc, serial, Today());
+      cal::RecordInputUnit(input, &file);
       fw::LoadReport rep{};
       (void)cal::ToFixed(file, file.adc, &rep);
       cal::SaveCalFile(out_path, file);
@@ -181,9 +201,20 @@ int main(int argc, char** argv) {
       const cal::CalFile cal = cal::LoadCalFile(cal_path);
       ReadOptions opt;
       opt.require_bridges = true;
-      const Recording in = ReadRecording(in_path, opt);
-      WriteRecording(out_path, cal::ApplyCalibration(cal, in));
+      Recording in = ReadRecording(in_path, opt);
+      const std::string used = cal::PrepareApplyInput(&in, units, cal);
+      std::fprintf(stderr, "ftcal: %s\n", used.c_str());
+      const Recording out = cal::ApplyCalibration(cal, in);
+      WriteRecording(out_path, out);
       std::fprintf(stderr, "ftcal: wrote %zu rows to %s\n", in.rows(), out_path.c_str());
+      const std::size_t flagged = tools::ReportStatusBits(out.Column("status"), stderr);
+      if (flagged > 0 && !allow_flagged) {
+        std::fprintf(stderr,
+                     "ftcal: %zu of %zu rows carry status bits (their wrench is not a valid "
+                     "reading); exit 3 (--allow-flagged to accept)\n",
+                     flagged, out.rows());
+        return 3;
+      }
     } else if (*verify) {
       const cal::CalFile cal = cal::LoadCalFile(cal_path);
       fw::LoadReport rep{};

@@ -74,8 +74,11 @@ int RunDiagnose(const DiagnoseArgs& args) {
     bar.last = -1;
     const Report report = Diagnose(data, opt);
     if (bar.tty) std::fprintf(stderr, "\n");
-    WriteJson(args.json, ToJson(report));
+    auto json = ToJson(report);
+    json["real_bridge_unit"] = data.real_unit;
+    WriteJson(args.json, json);
     if (!args.html.empty()) WriteHtml(args.html, data, report);
+    std::printf("real recording: %s (diagnosed in mV/V)\n", data.real_unit.c_str());
     std::fputs(SummaryText(report).c_str(), stdout);
     return kExitOk;
   } catch (const std::exception& e) {
