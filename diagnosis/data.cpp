@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 #include "measurement/units.hpp"
 
@@ -104,6 +105,34 @@ double DiagData::rate_hz() const {
   return 1.0 / dt[dt.size() / 2];
 }
 
+std::vector<int> FindSegments(const Recording& real) {
+  std::vector<int> seg(real.rows(), 0);
+  int count = real.rows() > 0 ? 1 : 0;
+  if (real.Has("segment")) {
+    const auto& col = real.Column("segment");
+    std::map<double, int> seen;  // value → number, in order of first row
+    for (std::size_t i = 0; i < col.size(); ++i) {
+      const auto it = seen.emplace(col[i], static_cast<int>(seen.size())).first;
+      seg[i] = it->second;
+    }
+    count = static_cast<int>(seen.size());
+  } else if (real.Has("t") && real.rows() > 2) {
+    const auto& t = real.Column("t");
+    std::vector<double> dt(t.size() - 1);
+    for (std::size_t i = 1; i < t.size(); ++i) dt[i - 1] = t[i] - t[i - 1];
+    std::vector<double> sorted = dt;
+    std::nth_element(sorted.begin(),
+                     sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+    const double gap = kSegmentGapPeriods * sorted[sorted.size() / 2];
+    for (std::size_t i = 1; i < t.size(); ++i) {
+      if (dt[i - 1] > gap) ++count;
+      seg[i] = count - 1;
+    }
+  }
+  if (count <= 1) seg.clear();
+  return seg;
+}
+
 DiagData FromRecordings(const Recording& sim, const Recording& real) {
   const std::size_t nr = real.BridgeCount();
   const std::size_t ns = sim.BridgeCount();
@@ -129,6 +158,7 @@ DiagData FromRecordings(const Recording& sim, const Recording& real) {
     d.wrench = WrenchOf(sim);
   }
   if (real.Has("temp_C")) d.temp_c = real.Column("temp_C");
+  d.segment = FindSegments(real);
   CheckUsable(d);
   return d;
 }
@@ -184,6 +214,7 @@ DiagData LoadPredictedReal(const std::string& real_path, const std::string& mode
   d.real_mvv = Bridges(real, nr);
   d.wrench = WrenchOf(real);
   if (real.Has("temp_C")) d.temp_c = real.Column("temp_C");
+  d.segment = FindSegments(real);
   const auto n = static_cast<Eigen::Index>(d.t_s.size());
   d.sim_mvv.resize(n, static_cast<Eigen::Index>(nr));
   for (Eigen::Index i = 0; i < n; ++i) {

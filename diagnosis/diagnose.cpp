@@ -1,5 +1,7 @@
 #include "diagnosis/diagnose.hpp"
 
+#include "diagnosis/identifiability.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -394,11 +396,21 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
     cum += f.pred;
     ce.hold_rms_after = HoldRms(cx, cx.resid, &cum);
     ce.rms_after = ChannelRms(cx.resid - cum);
+    // Each effect is tested against its confounders on what the other claimed effects leave.
+    const Confounding conf = CheckConfounders(cx, cx.resid - (cum - f.pred), f, options.z_claim);
+    ce.confounded_with = conf.with;
+    ce.confounding = conf.words;
     ce.fit = std::move(f);
     r.effects.push_back(std::move(ce));
   }
   r.model = cum;
-  r.verdict = r.effects.front().fit.name;
+  r.verdict = "undetermined";
+  for (const auto& e : r.effects) {
+    if (e.confounded_with.empty()) {
+      r.verdict = e.fit.name;
+      break;
+    }
+  }
   // The noise reported is re-estimated once the claimed effects are removed (broadband effects
   // such as ringing or skew on fast edges lift the spectrum's median a little).
   for (int c = 0; c < cx.nc; ++c) {
@@ -442,6 +454,11 @@ nlohmann::json ToJson(const Report& r) {
     ej["holdout"] = {{"rms_before", e.hold_rms_before}, {"rms_after", e.hold_rms_after}};
     ej["model"] = e.fit.variant;
     ej["n_params"] = e.fit.n_params;
+    ej["identifiable"] = e.confounded_with.empty();
+    if (!e.confounded_with.empty()) {
+      ej["confounded_with"] = e.confounded_with;
+      ej["confounding"] = e.confounding;
+    }
     effects.push_back(ej);
   }
   j["effects"] = effects;
@@ -449,7 +466,10 @@ nlohmann::json ToJson(const Report& r) {
                   {"rms_after", r.hold_rms_after},
                   {"rows", r.cx.n_hold},
                   {"block_s", r.cx.block_s},
-                  {"scheme", "every third block of block_s held out; fits use the other rows"}};
+                  {"scheme",
+                   "every third block of block_s held out; fits use the other rows; blocks "
+                   "restart at every segment"},
+                  {"segments", r.cx.segments}};
   auto cands = nlohmann::json::array();
   for (const auto& c : r.candidates) {
     cands.push_back({{"name", c.name},

@@ -57,9 +57,11 @@ std::string SpecFor(const std::string& effect, double f, std::uint64_t seed) {
   return effect;
 }
 
+/// The claimed effect named `name`, if the report names it as identified (an effect the report
+/// itself calls confounded is not a claim).
 const ClaimedEffect* Claimed(const Report& r, const std::string& name) {
   for (const auto& e : r.effects) {
-    if (e.fit.name == name) return &e;
+    if (e.fit.name == name && e.confounded_with.empty()) return &e;
   }
   return nullptr;
 }
@@ -205,6 +207,13 @@ ScoreResult RunCase(const ScoreCase& c) {
   }
   out.detected = true;
   out.located = true;
+  // Extra effects claimed beside the right ones are penalised: the case is not detected.
+  for (const auto& name : out.named) {
+    bool truth = false;
+    for (const auto& t : rec.effects) truth = truth || t.name == name;
+    if (!truth) ++out.extra;
+  }
+  if (out.extra > 0) out.detected = false;
   for (const auto& t : rec.effects) {
     const ClaimedEffect* ce = Claimed(r, t.name);
     if (ce == nullptr) out.detected = false;
