@@ -389,6 +389,17 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
   } else {
     claimed.push_back(best.fit);
   }
+  // A claimed thermal_zero_drift is refined with a thermometer lag τ ≥ 0 where the lag pays for
+  // itself (effects/thermal_lag.cpp); ranked without it, so a lag never wins a claim on its own.
+  for (std::size_t k = 0; k < claimed.size(); ++k) {
+    if (claimed[k].name != "thermal_zero_drift") continue;
+    Mat rest = cx.resid;
+    for (std::size_t o = 0; o < claimed.size(); ++o) {
+      if (o != k) rest -= claimed[o].pred;
+    }
+    auto lagged = FitThermalZeroLagged(cx, rest);
+    if (lagged && lagged->params.contains("lag_s")) claimed[k] = std::move(*lagged);
+  }
   Mat cum = Mat::Zero(cx.n, cx.nc);
   for (auto& f : claimed) {
     ClaimedEffect ce;

@@ -312,6 +312,8 @@ std::optional<EffectFit> FitZeroDrift(const Context& cx, const Mat& target) {
   return best;
 }
 
+std::optional<EffectFit> FitThermalZeroPlain(const Context& cx, const Mat& target);
+
 }  // namespace
 
 std::optional<EffectFit> FitThermalZeroOn(const Context& cx, const Mat& target,
@@ -564,7 +566,9 @@ std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
   return best;
 }
 
-std::optional<EffectFit> FitHysteresis(const Context& cx, const Mat& target) {
+}  // namespace
+
+std::optional<EffectFit> FitHysteresisOperator(const Context& cx, const Mat& target) {
   // Two rate-independent operators on each bridge's own load history: Dahl (exponential approach
   // after a reversal) and play/backlash (linear approach, then flat); width searched for each.
   Mat z(cx.n, cx.nc);
@@ -614,6 +618,8 @@ std::optional<EffectFit> FitHysteresis(const Context& cx, const Mat& target) {
       c, 2.0 * std::fabs(h), 2.0 * std::fabs(h) / cx.sigma(c), RowCorr(cx, target, best.pred, c));
   return best;
 }
+
+namespace {
 
 // One coefficient per channel on a feature of the channel's load; significant channels only.
 template <class F>
@@ -1435,15 +1441,21 @@ Sums Score(const Context& cx, const Eigen::MatrixXd& target, const Eigen::Matrix
   return s;
 }
 
+namespace {
+std::optional<EffectFit> FitThermalZeroPlain(const Context& cx, const Mat& target) {
+  return FitThermalZeroOn(cx, target, cx.dtemp);
+}
+}  // namespace
+
 const std::vector<EffectSpec>& Effects() {
   static const std::vector<EffectSpec> kEffects = {
       {"zero_offset", &FitZeroOffset},
       {"zero_drift", &FitZeroDrift},
-      {"thermal_zero_drift", &FitThermalZeroLagged},
+      {"thermal_zero_drift", &FitThermalZeroPlain},
       {"thermal_span_drift", &FitThermalSpan},
       {"excitation_drift", &FitExcitation},
       {"creep", &FitCreep},
-      {"hysteresis", &FitHysteresis},
+      {"hysteresis", &FitHysteresisFamily},
       {"bridge_nonlinearity", &FitBridgeNonlinearity},
       {"geometric_nonlinearity", &FitGeometric},
       {"load_stiffening", &FitLoadStiffening},

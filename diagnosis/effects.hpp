@@ -83,6 +83,16 @@ struct EffectSpec {
 [[nodiscard]] std::optional<EffectFit> FitThermalZeroLagged(const Context& cx,
                                                             const Eigen::MatrixXd& target);
 
+/// hysteresis as one rate-independent operator (Dahl or play, width searched) per bridge.
+[[nodiscard]] std::optional<EffectFit> FitHysteresisOperator(const Context& cx,
+                                                             const Eigen::MatrixXd& target);
+/// hysteresis of general rate-independent shape: the one-operator fit or a Preisach superposition
+/// of relays (thresholds on 8 quantiles of each bridge's load, weights fitted per bridge; this
+/// class contains Prandtl–Ishlinskii sums of play operators), whichever has the lower training
+/// BIC (effects/hysteresis_pi.cpp).
+[[nodiscard]] std::optional<EffectFit> FitHysteresisFamily(const Context& cx,
+                                                           const Eigen::MatrixXd& target);
+
 /// Whitened sums over train or hold-out rows.
 struct Sums {
   double train_sse = 0.0;

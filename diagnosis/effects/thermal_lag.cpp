@@ -29,14 +29,16 @@ std::optional<EffectFit> FitThermalZeroLagged(const Context& cx, const Eigen::Ma
   };
   const auto none = at(0.0);
   if (!none) return std::nullopt;
-  // Lags from 2 sample periods to a third of the record, log-spaced.
+  // Lags from 2 sample periods to a sixth of the record, log-spaced.
   const double lo = std::log(std::max(2.0 * cx.dt, 1e-3));
-  const double hi = std::log(std::max(duration / 3.0, 4.0 * cx.dt));
+  const double hi = std::log(std::max(duration / 6.0, 4.0 * cx.dt));
   std::vector<double> grid;
   for (int j = 0; j < 14; ++j) grid.push_back(lo + (hi - lo) * j / 13.0);
   double best_sse = 0.0;
   const double best_log = MinimizeOnGrid(sse, grid, 12, &best_sse);
-  if (!(best_sse < none->train_sse_w - 10.0)) return none;  // no lag: the plain model
+  // The lag must pay for itself clearly (as a whole extra effect would): else the plain model.
+  const double margin = 10.0 * std::log(std::max<double>(2.0, static_cast<double>(cx.n_train)));
+  if (!(best_sse < none->train_sse_w - margin)) return none;
   const double tau = std::exp(best_log);
   auto fit = at(tau);
   if (!fit) return none;

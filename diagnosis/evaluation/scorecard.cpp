@@ -201,6 +201,7 @@ ScoreResult RunCase(const ScoreCase& c) {
   out.excess_removed = before > 0 ? 1.0 - std::max(0.0, after) / before : 1.0;
   if (rec.effects.empty()) {
     out.detected = r.verdict == "none" && r.effects.empty();
+    out.named_right = out.detected;
     out.located = r.mismatch_channels.empty();
     out.excess_removed = 1.0;
     return out;
@@ -213,10 +214,10 @@ ScoreResult RunCase(const ScoreCase& c) {
     for (const auto& t : rec.effects) truth = truth || t.name == name;
     if (!truth) ++out.extra;
   }
-  if (out.extra > 0) out.detected = false;
+  out.named_right = true;
   for (const auto& t : rec.effects) {
     const ClaimedEffect* ce = Claimed(r, t.name);
-    if (ce == nullptr) out.detected = false;
+    if (ce == nullptr) out.named_right = false;
     ScoreResult part;
     Judge(rec, r, t, ce, &part);
     out.located = out.located && part.located;
@@ -227,6 +228,7 @@ ScoreResult RunCase(const ScoreCase& c) {
       out.param_ok = part.param_ok;
     }
   }
+  out.detected = out.named_right && out.extra == 0;
   return out;
 }
 

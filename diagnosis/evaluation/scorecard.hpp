@@ -26,6 +26,7 @@ struct ScoreResult {
   double size_sigma = 0.0;         ///< truth: the effect's peak / noise σ
   bool detected = false;     ///< the right name(s) claimed and nothing else (none: nothing claimed)
   int extra = 0;             ///< effects claimed that the truth does not hold
+  bool named_right = false;  ///< the right name(s) claimed as identified (extras allowed)
   bool located = false;      ///< channel / onset / frequency / delay / region right
   std::string param;         ///< key parameter compared ("" if the effect has none)
   double param_error = 0.0;  ///< relative (or absolute s for onset_s) error
