@@ -391,14 +391,23 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
   }
   // A claimed thermal_zero_drift is refined with a thermometer lag τ ≥ 0 where the lag pays for
   // itself (effects/thermal_lag.cpp); ranked without it, so a lag never wins a claim on its own.
+  // A claimed zero_drift is replaced by a lagged thermal_zero_drift where temperature exists and
+  // the lagged model scores better on the held-out rows (penalised like the ranking): a gauge
+  // temperature lagging the thermometer otherwise loses to a drift in time.
+  const double log_hold = std::log(std::max<double>(2.0, static_cast<double>(cx.n_hold)));
   for (std::size_t k = 0; k < claimed.size(); ++k) {
-    if (claimed[k].name != "thermal_zero_drift") continue;
+    const bool thermal = claimed[k].name == "thermal_zero_drift";
+    if (!thermal && !(claimed[k].name == "zero_drift" && !cx.dtemp.empty())) continue;
     Mat rest = cx.resid;
     for (std::size_t o = 0; o < claimed.size(); ++o) {
       if (o != k) rest -= claimed[o].pred;
     }
     auto lagged = FitThermalZeroLagged(cx, rest);
-    if (lagged && lagged->params.contains("lag_s")) claimed[k] = std::move(*lagged);
+    if (!lagged || !lagged->params.contains("lag_s")) continue;
+    const double cost_old =
+        Score(cx, rest, &claimed[k].pred).hold_sse + claimed[k].n_params * log_hold;
+    const double cost_new = Score(cx, rest, &lagged->pred).hold_sse + lagged->n_params * log_hold;
+    if (thermal || cost_new < cost_old) claimed[k] = std::move(*lagged);
   }
   Mat cum = Mat::Zero(cx.n, cx.nc);
   for (auto& f : claimed) {

@@ -77,7 +77,9 @@ std::optional<EffectFit> FitHysteresisFamily(const Context& cx, const Eigen::Mat
     for (std::size_t i = 0; i < n; ++i) {  // streamed: no n × relays matrix is held
       if (!cx.restart.empty() && cx.restart[i] != 0) g.state.fill(0.0);
       g.Step(load[i]);
-      if (cx.train[i] == 0) continue;
+      // Weights from every k-th training row on long records (k = the search stride, ~12 000
+      // rows): the relay states change only at threshold crossings, so little is lost.
+      if (cx.train[i] == 0 || i % static_cast<std::size_t>(cx.search_stride) != 0) continue;
       for (int j = 0; j < kRelays; ++j) x[j] = g.state[static_cast<std::size_t>(j)];
       ne.Add(x, target(static_cast<Eigen::Index>(i), c));
     }
@@ -99,7 +101,7 @@ std::optional<EffectFit> FitHysteresisFamily(const Context& cx, const Eigen::Mat
       for (int j = 0; j < kRelays; ++j) v += r.beta(j) * g.state[static_cast<std::size_t>(j)];
       e.pred(static_cast<Eigen::Index>(i), c) = v;
     }
-    sse_w += r.sse * cx.weight(c);
+    sse_w += r.sse * cx.weight(c) * cx.search_stride;
   }
   e.train_sse_w = sse_w;
   const double log_n = std::log(std::max<double>(2.0, static_cast<double>(cx.n_train)));
