@@ -34,8 +34,8 @@ if [ ! -f "$BUILD/CMakeCache.txt" ]; then
 fi
 log "building the harnesses (progress below)"
 cmake --build "$BUILD" -j "$(nproc)" --target fuzzers
-declare -A dict=([recording]=csv [cal_file]=json [sensor]=json [profile]=json [ati]=xml)
-[ ${#names[@]} -gt 0 ] || names=(recording cal_file ati sensor profile modbus)
+declare -A dict=([recording]=csv [cal_file]=json [sensor]=json [profile]=json [ati]=xml [payload]=json)
+[ ${#names[@]} -gt 0 ] || names=(recording cal_file ati sensor profile modbus payload rdt)
 mkdir -p "$BUILD/findings"
 status=0
 printf '\n%-10s %10s %8s %8s %8s  %s\n' harness execs exec/s cov ft result

@@ -43,6 +43,17 @@ if [ -x "$B/bench_modbus" ]; then
       }'
 fi
 
+# --- RDT streaming (issue 14): records/s per client next to the sample rate, same run ---------
+if [ -x "$B/bench_rdt" ]; then
+  section "RDT over UDP loopback: records/s of the slowest client vs the sampling rate (one run)"
+  FTSTACK_BENCH_SECONDS=${BENCH_RDT_SECONDS:-1} "$B/bench_rdt" --benchmark_format=csv 2>/dev/null |
+    awk -F, 'NR==1 { for (i = 1; i <= NF; ++i) { h=$i; gsub(/"/,"",h); col[h]=i }; next }
+      $1 ~ /BM_/ { n=$1; gsub(/"/,"",n); split(n, p, "/");
+        printf "  %d client(s), %-9s  %10.0f records/s  sampling %9.0f Hz  ratio %.3f  gaps %d  overruns %d\n",
+          p[2], (p[3] == 0 ? "unpaced" : p[3] " Hz"), $col["records_per_s"], $col["sample_hz"],
+          $col["records_per_s"] / $col["sample_hz"], $col["gaps"], $col["overruns"] }'
+fi
+
 # --- crossed-strip pivot (issue 3): one solve, exact elastica vs Wittrick, same run ------------
 if [ -x "$B/bench_pivot" ]; then
   section "crossed-strip pivot: one solve (CPU us) and Newton iterations, exact vs Wittrick (one run)"
@@ -107,4 +118,15 @@ if [ -x "$B/bench_cal" ]; then
         printf "  %-16s %7.0f ms wall, %7.0f ms CPU  (%d rows, %d blocks, %s)\n",
         n, $col["real_time"], $col["cpu_time"], $col["rows"], $col["blocks"], l }
       END { if (t["BM_FitLinear1M"] > 0) printf "  auto (linear + quadratic) / linear only = %.2f\n", t["BM_FitAuto1M"] / t["BM_FitLinear1M"] }'
+fi
+
+# --- design explorer (issue 13): us per design, ms per panda-base sweep (acceptance: < 60 s) -----
+if [ -x "$B/bench_design" ]; then
+  section "ftsim design: one design evaluated (CPU us) and the panda-base sweep + refinement (one run)"
+  "$B/bench_design" --benchmark_format=csv 2>/dev/null |
+    awk -F, 'NR==1 { for (i = 1; i <= NF; ++i) { h=$i; gsub(/"/,"",h); col[h]=i }; next }
+      $1 ~ /BM_/ { n=$1; gsub(/"/,"",n); sub(/\/iterations:[0-9]+/,"",n)
+        printf "  %-22s %10.1f %s CPU", n, $col["cpu_time"], $col["time_unit"]
+        if (col["evaluations"] && $col["evaluations"] != "") printf "  (%d designs)", $col["evaluations"]
+        printf "\n" }'
 fi

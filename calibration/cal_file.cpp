@@ -87,6 +87,16 @@ fw::FixedCalibration ToFixed(const CalFile& file, const hal::AdcInfo& adc, fw::L
   return fixed;
 }
 
+std::string AxisList(std::uint8_t axes) {
+  std::string s;
+  for (std::size_t a = 0; a < 6; ++a) {
+    if ((axes & (1u << a)) == 0) continue;
+    if (!s.empty()) s += ", ";
+    s += kAxisNames[a];
+  }
+  return s;
+}
+
 nlohmann::json ToJson(const CalFile& f) {
   using nlohmann::json;
   const std::size_t n = f.cal.channel_count;
@@ -112,6 +122,14 @@ nlohmann::json ToJson(const CalFile& f) {
   j["bias"] = f.cal.bias;
   j["rated"] = f.rated;
   j["uncertainty"] = f.uncertainty;
+  if (f.cal.invalid_axes != 0) {
+    j["schema"] = kCalSchemaV3;
+    json names = json::array();
+    for (std::size_t a = 0; a < 6; ++a) {
+      if ((f.cal.invalid_axes & (1u << a)) != 0) names.push_back(kAxisNames[a]);
+    }
+    j["invalid_axes"] = names;
+  }
   if (f.cal.product_count > 0) {
     json terms = json::array();
     json pm = json::array();
@@ -177,9 +195,10 @@ nlohmann::json ToJson(const CalFile& f) {
 
 CalFile FromJson(const nlohmann::json& j, const std::string& path) {
   if (!j.is_object()) throw CalFileError(path + ": not a JSON object");
-  if (!j.contains("schema") || (j["schema"] != kCalSchema && j["schema"] != kCalSchemaV1)) {
+  if (!j.contains("schema") ||
+      (j["schema"] != kCalSchema && j["schema"] != kCalSchemaV1 && j["schema"] != kCalSchemaV3)) {
     throw CalFileError(path + ": schema is not '" + std::string(kCalSchema) + "' (or '" +
-                       kCalSchemaV1 + "')");
+                       kCalSchemaV1 + "', '" + kCalSchemaV3 + "')");
   }
   if (!j.contains("crc32") || !j["crc32"].is_string()) {
     throw CalFileError(path + ": no crc32 field");
@@ -234,6 +253,27 @@ CalFile FromJson(const nlohmann::json& j, const std::string& path) {
   vec("bias", 6, f.cal.bias.data(), true);
   vec("rated", 6, f.rated.data(), true);
   vec("uncertainty", 6, f.uncertainty.data(), false);
+  if (j.contains("invalid_axes") || j["schema"] == kCalSchemaV3) {
+    // Only with schema 3, so that no reader that ignores the field ever sees it.
+    if (j["schema"] != kCalSchemaV3 || !j.contains("invalid_axes")) {
+      throw CalFileError(path + ": invalid_axes and schema '" + kCalSchemaV3 + "' go together");
+    }
+    const auto& a = j["invalid_axes"];
+    if (!a.is_array() || a.empty()) {
+      throw CalFileError(path + ": invalid_axes must list axis names (Fx … Mz)");
+    }
+    for (const auto& name : a) {
+      std::size_t axis = 6;
+      for (std::size_t i = 0; i < 6; ++i) {
+        if (name.is_string() && name.get<std::string>() == kAxisNames[i]) axis = i;
+      }
+      if (axis == 6 || (f.cal.invalid_axes & (1u << axis)) != 0) {
+        throw CalFileError(path + ": invalid_axes: " + name.dump() +
+                           " is not an axis name (Fx … Mz) or is listed twice");
+      }
+      f.cal.invalid_axes = static_cast<std::uint8_t>(f.cal.invalid_axes | (1u << axis));
+    }
+  }
   if (j.contains("model")) {
     const auto& model = j["model"];
     const auto& terms = model.at("products");
@@ -301,9 +341,9 @@ CalFile FromJson(const nlohmann::json& j, const std::string& path) {
   f.adc.full_scale_nvv = adc.at("full_scale_nvv").get<std::int64_t>();
   for (const auto& [key, value] : j.items()) {
     static const char* kKnown[] = {
-        "schema",      "serial",      "date",   "source",     "channels",   "input_unit",
-        "units",       "adc",         "matrix", "offset_mvv", "bias",       "rated",
-        "uncertainty", "fixed_point", "crc32",  "model",      "temperature"};
+        "schema",      "serial",      "date",   "source",     "channels",    "input_unit",
+        "units",       "adc",         "matrix", "offset_mvv", "bias",        "rated",
+        "uncertainty", "fixed_point", "crc32",  "model",      "temperature", "invalid_axes"};
     bool known = false;
     for (const char* k : kKnown) known = known || key == k;
     if (!known) f.extra[key] = value;
@@ -335,10 +375,9 @@ CalFile LoadCalFile(const std::string& path) {
   return ParseCalFile(ss.str(), path);
 }
 
-CalFile ParseCalFile(const std::string& text, const std::string& path) {
-  nlohmann::json j;
+nlohmann::json ParseJsonText(const std::string& text, const std::string& path) {
   try {
-    j = nlohmann::json::parse(text);
+    return nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     // Turn the byte offset into line:column.
     std::size_t line = 1;
@@ -356,6 +395,10 @@ CalFile ParseCalFile(const std::string& text, const std::string& path) {
   } catch (const nlohmann::json::exception& e) {  // e.g. a number out of double's range
     throw CalFileError(path + ": not valid JSON (corrupt): " + e.what());
   }
+}
+
+CalFile ParseCalFile(const std::string& text, const std::string& path) {
+  const nlohmann::json j = ParseJsonText(text, path);
   try {
     return FromJson(j, path);
   } catch (const nlohmann::json::exception& e) {

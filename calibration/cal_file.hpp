@@ -24,6 +24,14 @@ class CalFileError : public std::runtime_error {
 inline constexpr const char* kCalSchema = "ftstack-cal/2";
 /// The older schema still accepted.
 inline constexpr const char* kCalSchemaV1 = "ftstack-cal/1";
+/// Written instead of kCalSchema when the file flags axes invalid ("invalid_axes": a rig that
+/// never excited them): a reader older than the field refuses the file rather than serve them.
+inline constexpr const char* kCalSchemaV3 = "ftstack-cal/3";
+
+/// Names of the six axes in files and messages: Fx Fy Fz Mx My Mz.
+inline constexpr const char* kAxisNames[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
+/// "Mz" or "Mx, Mz" for a bit set of axes.
+[[nodiscard]] std::string AxisList(std::uint8_t axes);
 
 /// The contents of a calibration file.
 struct CalFile {
@@ -57,6 +65,8 @@ struct CalFile {
 [[nodiscard]] CalFile LoadCalFile(const std::string& path);
 /// The same for a file's text already in memory; `path` only names it in messages.
 [[nodiscard]] CalFile ParseCalFile(const std::string& text, const std::string& path);
+/// Parses JSON text; throws CalFileError naming `path` and, for syntax errors, line:column.
+[[nodiscard]] nlohmann::json ParseJsonText(const std::string& text, const std::string& path);
 /// Writes atomically: temporary file, fsync, rename over `path`, fsync of the directory.
 void SaveCalFile(const std::string& path, const CalFile& file);
 /// The same for any text.

@@ -1,15 +1,19 @@
 #include "daemon/daemon.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
 
 #include "calibration/cal_file.hpp"
+#include "calibration/payload_file.hpp"
 #include "daemon/hardware_adc.hpp"
+#include "daemon/realtime.hpp"
 #include "measurement/recording.hpp"
 
 namespace ftstack::daemon {
@@ -44,10 +48,37 @@ void LoadSlot(const std::string& path, const char* name, const hal::AdcInfo& adc
               std::array<double, 6>* rated) {
   try {
     *slot = SlotFromFile(path, adc, rated);
+    if (slot->fixed.invalid_axes != 0) {
+      std::fprintf(stderr,
+                   "ftd: calibration slot %s (%s) flags axis %s invalid (not calibrated): served "
+                   "as NaN / 0 with status bit 10\n",
+                   name, path.c_str(), cal::AxisList(slot->fixed.invalid_axes).c_str());
+    }
   } catch (const std::exception& e) {
     *slot = fw::CalSlot{};
     std::fprintf(stderr, "ftd: calibration slot %s refused: %s\n", name, e.what());
   }
+}
+
+/// Loads `path` as gravity compensation's payload into `cfg`; a refused file stops ftd (FtdError):
+/// unlike a calibration, a robot relying on compensation must not run with none.
+void LoadPayload(const std::string& path, fw::DeviceConfig* cfg) {
+  cal::PayloadFile p;
+  try {
+    p = cal::LoadPayloadFile(path);
+  } catch (const std::exception& e) {
+    throw FtdError(std::string("--payload refused: ") + e.what());
+  }
+  if (fw::MakeFixedPayload(p.mass_kg, p.com_m, p.force_bias_n, p.moment_bias_nm, &cfg->payload) !=
+      fw::PayloadStatus::kOk) {
+    throw FtdError("--payload " + path + ": outside what the firmware accepts (0 < mass ≤ " +
+                   std::to_string(fw::kMaxPayloadMassKg) + " kg, |m·c| ≤ 100 kg·m)");
+  }
+  cfg->payload_crc = p.crc32;
+  std::fprintf(stderr,
+               "ftd: payload %s: %.4g kg at (%.1f, %.1f, %.1f) mm; gravity compensation off "
+               "until holding 28 = 1\n",
+               path.c_str(), p.mass_kg, p.com_m[0] * 1e3, p.com_m[1] * 1e3, p.com_m[2] * 1e3);
 }
 
 /// A hardware converter (HX711 over GPIO, ADS131M over SPI); needs a calibration file.
@@ -184,6 +215,8 @@ void Ftd::Start() {
   for (const std::int32_t r : cfg.rated_lsb) any_zero = any_zero || r == 0;
   if (any_zero) cfg.rated_lsb = {};  // no complete rating: overload rule off
 
+  if (!opt_.payload.empty()) LoadPayload(opt_.payload, &cfg);
+
   core_ = std::make_unique<fw::WrenchCore>();
   device_ = std::make_unique<fw::Device>(adc, *core_);
   switch (device_->Start(cfg)) {
@@ -218,35 +251,100 @@ void Ftd::Start() {
                      std::system_category().message(errno) + ")");
     }
   }
-  if (!opt_.log.empty()) {
-    std::FILE* f = std::fopen(opt_.log.c_str(), "w");
-    if (f == nullptr) {
-      throw FtdError(opt_.log + ": cannot write: " + std::system_category().message(errno));
-    }
-    std::fclose(f);
-    ring_.resize(kLogRingCapacity);
-  }
+  if (!opt_.rdt.empty()) StartRdt();
+  if (!opt_.log.empty()) PrepareLog();
 
   stop_ = false;
   start_us_ = fw::MonotonicUs();
   stop_us_ = 0;
   running_ = true;
+  // Memory first (before the threads' stacks), then the sampling thread's policy; one line says
+  // what the system granted. A benchmark run (--unpaced) never asks: it would hog a core.
+  const std::string memory = opt_.paced ? LockMemory() : "memory not locked (--unpaced)";
   threads_.emplace_back([this] { SamplingLoop(); });
+  pthread_setname_np(threads_.back().native_handle(), "ftd-sampler");
+  bool rt = false;
+  const std::string sched = opt_.paced ? MakeRealtime(threads_.back().native_handle(), &rt)
+                                       : "default scheduler (--unpaced)";
+  realtime_ = "sampling thread: " + sched + ", " + memory;
+  std::fprintf(stderr, "ftd: %s%s\n", realtime_.c_str(),
+               rt ? "" : " — samples may be late under load (late_samples counts them)");
   if (tcp_) threads_.emplace_back([this] { tcp_->Run(stop_); });
   if (rtu_) threads_.emplace_back([this] { rtu_->Run(stop_); });
+  if (rdt_) threads_.emplace_back([this] { rdt_->Run(stop_); });
+}
+
+void Ftd::PrepareLog() {
+  std::FILE* f = std::fopen(opt_.log.c_str(), "w");
+  if (f == nullptr) {
+    throw FtdError(opt_.log + ": cannot write: " + std::system_category().message(errno));
+  }
+  std::fclose(f);
+  ring_.resize(kLogRingCapacity);
+}
+
+void Ftd::StartRdt() {
+  RdtOptions ro;
+  try {
+    ParseHostPort(opt_.rdt, &ro.host, &ro.port);
+  } catch (const FtdError& e) {  // its message names --modbus-tcp
+    const std::string m = e.what();
+    throw FtdError("--rdt" + m.substr(m.find(' ')));
+  }
+  if (!(opt_.rdt_counts_per_n > 0) || !(opt_.rdt_counts_per_nm > 0) ||
+      !std::isfinite(opt_.rdt_counts_per_n) || !std::isfinite(opt_.rdt_counts_per_nm)) {
+    throw FtdError("--rdt-counts-per-n and --rdt-counts-per-nm must be positive");
+  }
+  ro.counts_per_n = opt_.rdt_counts_per_n;
+  ro.counts_per_nm = opt_.rdt_counts_per_nm;
+  ro.buffer_records = opt_.rdt_buffer;
+  ro.status_mask = opt_.rdt_status_mask;
+  rdt_ = std::make_unique<RdtServer>(ro, map_.get());
+  std::string error;
+  if (!rdt_->Open(&error)) throw FtdError("RDT on " + opt_.rdt + ": " + error);
+  std::fprintf(stderr, "ftd: serving RDT on %s:%u (%g counts/N, %g counts/N·m)\n", ro.host.c_str(),
+               static_cast<unsigned>(rdt_->port()), ro.counts_per_n, ro.counts_per_nm);
+}
+
+void Ftd::BackOff(std::uint32_t pause_us) {
+  // In slices, so that Stop() is not kept waiting for a whole pause.
+  const std::uint64_t until = fw::MonotonicUs() + pause_us;
+  for (std::uint64_t now = fw::MonotonicUs(); now < until && !stop_.load(std::memory_order_relaxed);
+       now = fw::MonotonicUs()) {
+    const std::uint64_t slice = std::min<std::uint64_t>(until - now, 10000);
+    timespec ts{static_cast<time_t>(slice / 1000000), static_cast<long>(slice % 1000000) * 1000};
+    nanosleep(&ts, nullptr);
+  }
 }
 
 void Ftd::SamplingLoop() {
   bool published = false;
+  const std::uint32_t period_us = device_->sample_period_us();
+  std::uint32_t backoff_us = 0;
   while (!stop_.load(std::memory_order_relaxed)) {
+    const std::uint64_t t0 = fw::MonotonicUs();
     const hal::Status s = device_->Step(&published);
     if (s == hal::Status::kEndOfData || s == hal::Status::kNotConfigured ||
         s == hal::Status::kUnavailable) {
       ended_ = true;
       return;
     }
-    if (s != hal::Status::kOk) continue;
+    if (s != hal::Status::kOk) {
+      // The step published the fault (bit 3, and bit 8 once no sample comes); an error that
+      // returns at once must not turn this loop into a busy one: pause, doubling from one
+      // period up to kMaxBackoffUs, until a step succeeds.
+      adc_errors_.fetch_add(1, std::memory_order_relaxed);
+      if (fw::MonotonicUs() - t0 < period_us) {
+        backoff_us = backoff_us == 0 ? std::max<std::uint32_t>(period_us, 1)
+                                     : std::min(2 * backoff_us, kMaxBackoffUs);
+        backoffs_.fetch_add(1, std::memory_order_relaxed);
+        BackOff(backoff_us);
+      }
+      continue;
+    }
+    backoff_us = 0;
     samples_.fetch_add(1, std::memory_order_relaxed);
+    if (published && rdt_) rdt_->Publish(device_->last_published());
     if (!published || ring_.empty()) continue;
     const std::uint64_t head = ring_head_.load(std::memory_order_relaxed);
     if (head - ring_tail_.load(std::memory_order_acquire) >= ring_.size()) {
@@ -326,6 +424,9 @@ FtdStats Ftd::stats() const {
   s.logged_rows = logged_rows_;
   s.log_dropped = log_dropped_.load(std::memory_order_relaxed);
   s.sampling_ended = ended_.load(std::memory_order_relaxed);
+  s.adc_errors = adc_errors_.load(std::memory_order_relaxed);
+  s.backoffs = backoffs_.load(std::memory_order_relaxed);
+  s.realtime = realtime_;
   return s;
 }
 

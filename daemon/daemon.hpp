@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "daemon/backend.hpp"
+#include "daemon/rdt_server.hpp"
 #include "firmware/device.hpp"
 #include "firmware/modbus_server.hpp"
 #include "firmware/register_map.hpp"
@@ -35,10 +36,16 @@ struct FtdOptions {
   std::optional<std::array<double, 6>> sim_wrench;  ///< constant applied wrench, N and N·m
   std::string replay;                               ///< recording whose wrench columns are played
   unsigned rate_hz = 1000;
-  std::string cal;         ///< calibration file for slot 0 ("" = built-in)
-  std::string cal_b;       ///< calibration file for slot 1 ("" = none)
-  std::string modbus_tcp;  ///< HOST:PORT ("" = no TCP server)
-  std::string modbus_rtu;  ///< serial device ("" = no RTU server)
+  std::string cal;      ///< calibration file for slot 0 ("" = built-in)
+  std::string cal_b;    ///< calibration file for slot 1 ("" = none)
+  std::string payload;  ///< payload file for gravity compensation ("" = none)
+  std::string rdt;      ///< HOST:PORT of the RDT server ("" = none)
+  double rdt_counts_per_n = 1e6;
+  double rdt_counts_per_nm = 1e6;
+  unsigned rdt_buffer = 4;                 ///< records per packet in buffered RDT modes
+  std::uint32_t rdt_status_mask = 0xFFFF;  ///< status bits copied into RDT records
+  std::string modbus_tcp;                  ///< HOST:PORT ("" = no TCP server)
+  std::string modbus_rtu;                  ///< serial device ("" = no RTU server)
   unsigned baud = 19200;
   char parity = 'N';
   unsigned unit_id = 1;
@@ -47,7 +54,15 @@ struct FtdOptions {
   std::string spidev;
   std::uint64_t seed = 1;
   bool paced = true;  ///< simulated ADC follows the wall clock (false: as fast as possible)
+  /// Simulated ADC: hold the sampling thread sim_stall_ms on every sim_stall_every-th sample
+  /// (0: never) — a deterministic stand-in for a preempted sampler (--sim-stall EVERY:MS).
+  unsigned sim_stall_every = 0;
+  double sim_stall_ms = 0;
 };
+
+/// Longest pause of the sampling loop after a backend call that failed at once (the back-off
+/// doubles from one sample period up to this).
+inline constexpr std::uint32_t kMaxBackoffUs = 100000;
 
 /// Parses "HOST:PORT"; throws FtdError naming the bad part.
 void ParseHostPort(const std::string& text, std::string* host, std::uint16_t* port);
@@ -64,6 +79,9 @@ struct FtdStats {
   std::uint64_t logged_rows = 0;
   std::uint64_t log_dropped = 0;  ///< samples the logger could not keep up with
   bool sampling_ended = false;    ///< replay finished or the ADC failed for good
+  std::uint64_t adc_errors = 0;   ///< failed sampling steps (timeouts, read errors)
+  std::uint64_t backoffs = 0;     ///< pauses after a step that failed at once (no busy loop)
+  std::string realtime;           ///< the sampling thread's scheduling and memory, one line
 };
 
 /// The running daemon. Start() spawns the threads; Stop() (or the destructor) joins them.
@@ -87,11 +105,16 @@ class Ftd {
   [[nodiscard]] fw::Device& device() { return *device_; }
   [[nodiscard]] fw::RegisterMap& register_map() { return *map_; }
   [[nodiscard]] const fw::ServerCounters* tcp_counters() const;
+  /// The RDT server (nullptr without --rdt).
+  [[nodiscard]] const RdtServer* rdt() const { return rdt_.get(); }
   /// One status line (no newline): sequence, wrench, status bits, sample rate, clients.
   [[nodiscard]] std::string StatusLine() const;
 
  private:
   void SamplingLoop();
+  void StartRdt();
+  void PrepareLog();  ///< checks that --log can be written, sizes the log ring
+  void BackOff(std::uint32_t pause_us);
 
   FtdOptions opt_;
   SimulatorFactory simulator_ = nullptr;
@@ -101,6 +124,7 @@ class Ftd {
   std::unique_ptr<fw::RegisterMap> map_;
   std::unique_ptr<fw::ModbusTcpServer> tcp_;
   std::unique_ptr<fw::ModbusRtuServer> rtu_;
+  std::unique_ptr<RdtServer> rdt_;
   std::unique_ptr<RecordingWriter> writer_;
 
   // Single-producer (sampling thread) single-consumer (DrainLog) ring of published samples.
@@ -117,6 +141,9 @@ class Ftd {
   std::atomic<bool> stop_{false};
   std::atomic<bool> ended_{false};
   std::atomic<std::uint64_t> samples_{0};
+  std::atomic<std::uint64_t> adc_errors_{0};
+  std::atomic<std::uint64_t> backoffs_{0};
+  std::string realtime_;
   std::uint64_t start_us_ = 0;
   std::uint64_t stop_us_ = 0;  ///< when Stop was called (0 while running)
   std::vector<std::thread> threads_;

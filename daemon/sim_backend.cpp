@@ -39,6 +39,8 @@ class SimulatedBackend final : public AdcBackend {
     }
     params.seed = opt.seed;
     params.realtime = opt.paced;
+    params.stall_every = opt.sim_stall_every;
+    params.stall_us = static_cast<std::uint32_t>(opt.sim_stall_ms * 1000.0);
     adc_ = std::make_unique<hal::sim::SimAdc>(*sensor_, params);
   }
   hal::Adc& adc() override { return *adc_; }

@@ -36,6 +36,10 @@ void WrenchCore::ComputeTareOffset() {
   const std::size_t n = cal_.channel_count;
   bool clipped = false;
   for (std::size_t r = 0; r < kAxes; ++r) {
+    if ((cal_.invalid_axes & (1u << r)) != 0) {
+      tare_offset_[r] = 0;  // an axis the calibration does not determine stays 0
+      continue;
+    }
     std::int64_t acc = cal_.bias[r];
     for (std::size_t c = 0; c < n; ++c) acc += cal_.coef[r][c] * tare_counts_[c];
     for (std::size_t k = 0; k < cal_.extra_count; ++k) acc += cal_.coef[r][n + k] * tare_extra_[k];
@@ -87,7 +91,7 @@ void WrenchCore::ExtraFeatures(const std::array<std::int32_t, kMaxChannels>& cou
         f[k] = dt_mdegc;
         break;
       case FeatureKind::kProduct: {
-        // |x̃| < 2^32 each: the product fits int64; the loader sized the shift.
+        // The loader proved |x̃_a·x̃_b| + 2^(shift−1) ≤ 2^63 − 1 (RawProductFits): no overflow.
         const std::int64_t xa = static_cast<std::int64_t>(counts[e.a]) - cal_.zero[e.a];
         const std::int64_t xb = static_cast<std::int64_t>(counts[e.b]) - cal_.zero[e.b];
         f[k] = RoundShift(xa * xb, e.shift);
@@ -128,6 +132,10 @@ void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts,
   }
   const std::size_t n = cal_.channel_count;
   for (std::size_t r = 0; r < kAxes; ++r) {
+    if ((cal_.invalid_axes & (1u << r)) != 0) {
+      y[r] = 0;  // not determined by the calibration: never a value (status bit 10)
+      continue;
+    }
     // The loader guarantees |acc| < 2^62 for every x between the rails.
     std::int64_t acc = tare_active_ ? 0 : cal_.bias[r];
     for (std::size_t c = 0; c < n; ++c) acc += cal_.coef[r][c] * x[c];
@@ -192,6 +200,7 @@ void WrenchCore::Process(const hal::AdcSample& in, bool simulated, CoreOutput& o
     return;
   }
 
+  if (cal_.invalid_axes != 0) out.status |= kStatusAxisInvalid;
   const bool usable = !any_saturated && !any_error && !bridge_fault;
   bool temp_range = false;
   const std::int32_t dt_mdegc = DeltaT(in.temperature_mdegc, in.has_temperature, &temp_range);

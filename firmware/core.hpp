@@ -28,7 +28,7 @@ struct CoreOutput {
   bool structural_valid = false;
   /// A bridge is saturated and got there by ramping through its range: the load drove it there.
   bool saturated_by_load = false;
-  std::uint16_t status = 0;           ///< StatusBit set that the core decides (0, 2, 3, 4, 5, 7)
+  std::uint16_t status = 0;  ///< StatusBit set that the core decides (0, 2, 3, 4, 5, 7, 10)
   bool arithmetic_saturated = false;  ///< an intermediate value was clamped this sample
   bool updated = false;               ///< the wrench was recomputed (false while holding)
 };

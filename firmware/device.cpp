@@ -43,6 +43,9 @@ DeviceStatus Device::Start(const DeviceConfig& config) {
   last_.publish_period_us = sample_period_us_;
   last_.sample_period_us = sample_period_us_;
   last_.publish_time_us = clock_();
+  start_us_ = last_.publish_time_us;
+  stamped_ = false;
+  last_stamp_us_ = 0;
   last_sample_us_.store(last_.publish_time_us, std::memory_order_release);
   previous_read_us_ = 0;
   late_samples_ = 0;
@@ -70,6 +73,8 @@ void Device::ApplySettings() {
   }
   if (s.decimation >= 1 && s.decimation <= kMaxDecimation) active_.decimation = s.decimation;
   active_.transform = s.transform;
+  active_.gravity_umps2 = s.gravity_umps2;
+  active_.gravity_comp = s.gravity_comp && config_.payload.present;
   if (s.tare_generation != active_.tare_generation) {
     active_.tare_generation = s.tare_generation;
     if (s.tare_kind == 1) {
@@ -102,6 +107,16 @@ hal::Status Device::Step(bool* published) {
   ++samples_;
   const std::uint64_t now_us = clock_();
   last_sample_us_.store(now_us, std::memory_order_release);
+  // The sample's time is when it was read, on the device's monotonic clock since Start — not
+  // the backend's count × period, which stays regular while the sampler falls behind. Strictly
+  // increasing: a sample read within the microsecond of the previous one (a catch-up burst) is
+  // stamped one microsecond after it.
+  std::uint64_t since_start_us = now_us - start_us_;
+  if (stamped_ && since_start_us <= last_stamp_us_) since_start_us = last_stamp_us_ + 1;
+  stamped_ = true;
+  last_stamp_us_ = since_start_us;
+  p.timestamp_us = static_cast<std::uint32_t>(since_start_us);
+  p.timestamp_wraps = static_cast<std::uint16_t>(since_start_us >> 32);
   if (previous_read_us_ != 0 && now_us - previous_read_us_ > 3ull * sample_period_us_ / 2) {
     // Read late: the periods skipped (rounded) are deadlines missed. The status bit says so in
     // the next publication; the counter keeps them.
@@ -133,9 +148,20 @@ hal::Status Device::Step(bool* published) {
   sticky_status_ = 0;
   if ((status & kStatusCalInvalid) == 0) {
     bool sat = false;
-    ApplyToolTransform(active_.transform, p.wrench, &d.sample.wrench, &sat);
+    WrenchLsb sensor = p.wrench;
+    if (active_.gravity_comp) {  // payload weight and moment off, in the sensor frame
+      CompensateGravity(config_.payload, active_.gravity_umps2, p.wrench, &sensor, &sat);
+      status |= kStatusPayloadComp;
+    }
+    ApplyToolTransform(active_.transform, sensor, &d.sample.wrench, &sat);
     if (sat) status |= kStatusSaturated;  // the tool-frame wrench was clipped
+    // An axis the calibration does not determine taints every tool-frame axis it enters.
+    d.sample.invalid_axes = ToolFrameInvalidAxes(active_.transform, p.invalid_axes);
+    for (std::size_t i = 0; i < kAxes; ++i) {
+      if ((d.sample.invalid_axes & (1u << i)) != 0) d.sample.wrench[i] = 0;
+    }
   }
+  d.peaks_invalid_axes = p.invalid_axes;
   if (p.has_temperature && (p.temperature_mdegc < config_.temp_min_mdegc ||
                             p.temperature_mdegc > config_.temp_max_mdegc)) {
     status |= kStatusTempRange;
@@ -148,6 +174,8 @@ hal::Status Device::Step(bool* published) {
   d.publish_period_us = sample_period_us_ * active_.decimation;
   d.sample_period_us = sample_period_us_;
   d.late_samples = late_samples_;
+  d.payload_mass_ug = config_.payload.present ? config_.payload.mass_ug : 0;
+  d.payload_crc = config_.payload_crc;
   d.publish_time_us = now_us;
   last_ = d;
   published_.Write(d);

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "firmware/core.hpp"
+#include "firmware/gravity_comp.hpp"
 #include "firmware/overload.hpp"
 #include "firmware/sampler.hpp"
 #include "firmware/seqlock.hpp"
@@ -28,6 +29,9 @@ struct DeviceSample {
   std::uint32_t publish_period_us = 0;  ///< expected time between publications
   std::uint32_t sample_period_us = 0;   ///< expected time between samples (the stale limit's unit)
   std::uint32_t late_samples = 0;       ///< samples read late since start (missed deadlines)
+  std::int64_t payload_mass_ug = 0;     ///< payload of gravity compensation, µg (0: none)
+  std::uint32_t payload_crc = 0;        ///< CRC-32 of its payload file (input registers 79–80)
+  std::uint8_t peaks_invalid_axes = 0;  ///< bit r: peak r is not a value (sensor frame)
 };
 
 /// One calibration slot as the device holds it.
@@ -43,9 +47,11 @@ struct DeviceSettings {
   std::uint16_t decimation = 1;     ///< publish every N-th sample, 1 … kMaxDecimation
   std::uint8_t cal_slot = 0;
   FixedToolTransform transform{};
-  std::uint32_t tare_generation = 0;   ///< +1 per tare / clear-tare command
-  std::uint8_t tare_kind = 0;          ///< 1 = tare now, 2 = clear tare (the latest wins)
-  std::uint32_t clear_generation = 0;  ///< +1 per "clear peaks and overload counter"
+  std::uint32_t tare_generation = 0;            ///< +1 per tare / clear-tare command
+  std::uint8_t tare_kind = 0;                   ///< 1 = tare now, 2 = clear tare (the latest wins)
+  std::uint32_t clear_generation = 0;           ///< +1 per "clear peaks and overload counter"
+  std::array<std::int32_t, 3> gravity_umps2{};  ///< gravity in the sensor frame, µm/s²
+  bool gravity_comp = false;                    ///< subtract the payload (needs one)
 };
 
 inline constexpr std::uint16_t kMaxDecimation = 1000;
@@ -63,6 +69,8 @@ struct DeviceConfig {
   /// Start even when the initial slot holds no calibration: the device then samples and serves
   /// with kStatusCalInvalid and an invalid wrench (a field device comes up and says why).
   bool allow_uncalibrated = false;
+  FixedPayload payload{};         ///< gravity compensation's payload (present: loaded)
+  std::uint32_t payload_crc = 0;  ///< CRC-32 of the payload file
 };
 
 /// Why Device::Start failed.
@@ -93,6 +101,7 @@ class Device {
   void WriteSettings(const DeviceSettings& s) { settings_.Write(s); }
   [[nodiscard]] const DeviceSettings& initial_settings() const { return initial_settings_; }
 
+  [[nodiscard]] bool payload_present() const { return config_.payload.present; }
   [[nodiscard]] bool slot_present(std::size_t slot) const {
     return slot < kCalSlots && config_.slots[slot].present;
   }
@@ -131,6 +140,9 @@ class Device {
   std::uint32_t publish_sequence_ = 0;
   std::uint64_t samples_ = 0;
   std::atomic<std::uint64_t> last_sample_us_{0};
+  std::uint64_t start_us_ = 0;       ///< device clock at Start: the samples' time origin
+  std::uint64_t last_stamp_us_ = 0;  ///< time given to the previous sample, since Start
+  bool stamped_ = false;
   std::uint64_t previous_read_us_ = 0;  ///< 0 until the first sample
   std::uint32_t late_samples_ = 0;
 };

@@ -1,5 +1,6 @@
 #include "firmware/fixed_calibration.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -19,6 +20,8 @@ const char* ToString(LoadStatus s) {
       return "worst-case output overflows int32 (matrix too large for the ADC range)";
     case LoadStatus::kBadTerms:
       return "second-order term or temperature range unusable";
+    case LoadStatus::kFeatureOverflow:
+      return "a second-order feature's product could pass 2^63 (ADC rails too wide)";
   }
   return "unknown";
 }
@@ -55,6 +58,16 @@ bool AccumulatorFits(const std::array<std::int64_t, kMaxFeatures>& coef, std::in
     if (__builtin_add_overflow(total, term, &total)) return false;
   }
   return total <= kAccLimit;
+}
+
+/// Exact check with integers that the core's raw product of a second-order feature cannot leave
+/// int64: |a|·|b| + 2^(shift−1) (RoundShift's half) ≤ 2^63 − 1 for |a| ≤ amax, |b| ≤ bmax.
+bool RawProductFits(std::uint64_t amax, std::uint64_t bmax, std::uint8_t shift) {
+  std::uint64_t p = 0;
+  if (__builtin_mul_overflow(amax, bmax, &p)) return false;
+  const std::uint64_t half = shift > 0 ? std::uint64_t{1} << (shift - 1) : 0;
+  if (__builtin_add_overflow(p, half, &p)) return false;
+  return p <= static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
 }
 
 }  // namespace
@@ -119,7 +132,8 @@ LoadStatus LoadCalibration(const FloatCalibration& cal, const hal::AdcInfo& adc,
   // Integer zero of the product features and its rounding e_c = zero_c − offset_c (counts).
   std::array<double, kMaxChannels> offset_counts{};
   std::array<double, kMaxChannels> e{};
-  std::array<double, kMaxChannels> xmax{};  // bound on |counts − zero|
+  std::array<double, kMaxChannels> xmax{};             // bound on |counts − zero|
+  std::array<std::uint64_t, kMaxChannels> xmax_int{};  // the same, exact
   for (std::size_t c = 0; c < n; ++c) {
     offset_counts[c] = cal.offset_mvv[c] * counts_per_mvv;
     double z = std::nearbyint(offset_counts[c]);
@@ -128,6 +142,9 @@ LoadStatus LoadCalibration(const FloatCalibration& cal, const hal::AdcInfo& adc,
     fixed.zero[c] = static_cast<std::int32_t>(z);
     e[c] = z - offset_counts[c];
     xmax[c] = std::fmax(max_c - z, z - min_c);
+    const std::int64_t zi = fixed.zero[c];
+    xmax_int[c] = static_cast<std::uint64_t>(
+        std::max(std::int64_t{adc.max_counts} - zi, zi - std::int64_t{adc.min_counts}));
   }
   // Temperature in m°C.
   double dt_max = 0.0;  // bound on |ΔT|, m°C
@@ -157,6 +174,9 @@ LoadStatus LoadCalibration(const FloatCalibration& cal, const hal::AdcInfo& adc,
     const ProductTerm& t = cal.products[k];
     const double bound = xmax[t.a] * xmax[t.b];
     const std::uint8_t sh = ProductShift(bound);
+    if (!RawProductFits(xmax_int[t.a], xmax_int[t.b], sh)) {
+      return finish(LoadStatus::kFeatureOverflow);
+    }
     product_index[k] = count;
     fixed.extra[count - n] = FixedFeature{FeatureKind::kProduct, t.a, t.b, sh};
     fbound[count++] = 2.0 * (std::ceil(std::ldexp(bound, -sh)) + 1.0);
@@ -167,6 +187,9 @@ LoadStatus LoadCalibration(const FloatCalibration& cal, const hal::AdcInfo& adc,
       if (cal.gain_slope_per_c[c] == 0.0) continue;
       const double bound = xmax[c] * dt_max;
       const std::uint8_t sh = ProductShift(bound);
+      if (!RawProductFits(xmax_int[c], static_cast<std::uint64_t>(dt_max), sh)) {
+        return finish(LoadStatus::kFeatureOverflow);
+      }
       temp_product_index[c] = count;
       fixed.extra[count - n] =
           FixedFeature{FeatureKind::kTempProduct, static_cast<std::uint8_t>(c), 0, sh};
@@ -257,6 +280,7 @@ LoadStatus LoadCalibration(const FloatCalibration& cal, const hal::AdcInfo& adc,
     rep.worst_case_error_lsb[r] = err;
     rep.worst_case_error_si[r] = err * lsb;
   }
+  fixed.invalid_axes = static_cast<std::uint8_t>(cal.invalid_axes & ((1u << kAxes) - 1));
   fixed.valid = true;
   *out = fixed;
   return finish(LoadStatus::kOk);

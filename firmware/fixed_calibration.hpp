@@ -47,6 +47,9 @@ struct FloatCalibration {
   double temp_max_c = 80.0;
   std::array<double, kMaxChannels> bias_slope_mvv_per_c{};  ///< α: zero drift, mV/V per °C
   std::array<double, kMaxChannels> gain_slope_per_c{};      ///< γ: sensitivity drift, 1 per °C
+  /// Bit r set: axis r was not determined by the calibration (its rig never excited it); the
+  /// core outputs 0 for it and the device never serves it as a value (status bit 10).
+  std::uint8_t invalid_axes = 0;
 };
 
 /// Kinds of the integer features after the N bridge channels.
@@ -84,6 +87,7 @@ struct FixedCalibration {
   std::int32_t temp_ref_mdegc = 0;                ///< ΔT origin, m°C
   std::int32_t temp_min_mdegc = 0;                ///< compensated range, m°C
   std::int32_t temp_max_mdegc = 0;
+  std::uint8_t invalid_axes = 0;  ///< bit r: axis r not calibrated (see FloatCalibration)
   bool valid = false;
 };
 
@@ -95,6 +99,9 @@ enum class LoadStatus : std::uint8_t {
   kBadAdcScaling,    ///< ADC info without a usable full scale or rails
   kOutputOverflow,   ///< some input between the rails would drive an axis past int32
   kBadTerms,         ///< product term out of range, or temperature range/reference unusable
+  /// A second-order feature's raw product (x̃_a·x̃_b or x̃·ΔT, plus its rounding half) could pass
+  /// int64 for inputs between the rails (ADC rails too wide for the product terms).
+  kFeatureOverflow,
 };
 
 [[nodiscard]] const char* ToString(LoadStatus s);

@@ -12,12 +12,33 @@ namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
-[[nodiscard]] bool HoldingMapped(std::uint32_t a) { return a < kHoldTransform + 12u; }
+[[nodiscard]] bool HoldingMapped(std::uint32_t a) { return a < kHoldingRegisterSpan; }
+[[nodiscard]] bool HoldingMount(std::uint32_t a) { return a >= kHoldMount && a < kHoldMount + 12u; }
 
-/// Holding registers 5 … 9: reserved. They read 0 and accept 0 (so that a PLC's block read or
-/// write of 0 … 21 works); any other value is refused with 03.
+[[nodiscard]] ToolTransformParams ParamsOf(const std::array<std::uint16_t, 12>& regs) {
+  ToolTransformParams p{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    p.d_m[i] = UnpackFloat32(&regs[2 * i]);
+    p.r_deg[i] = UnpackFloat32(&regs[6 + 2 * i]);
+  }
+  return p;
+}
+
+/// Holding registers 5 … 9 and 29: reserved. They read 0 and accept 0 (so that a PLC's block
+/// read or write of 0 … 29 works); any other value is refused with 03.
 [[nodiscard]] bool HoldingReserved(std::uint32_t a) {
-  return a > kHoldUnlock && a < kHoldTransform;
+  return (a > kHoldUnlock && a < kHoldTransform) || a == kHoldReserved29;
+}
+
+[[nodiscard]] bool InGravity(std::uint32_t a) { return a >= kHoldGravity && a < kHoldGravity + 6u; }
+
+/// A write [addr, end) touching the float block [first, first + 2·floats) covers whole floats.
+[[nodiscard]] bool WholeFloats(std::uint32_t addr, std::uint32_t end, std::uint32_t first,
+                               std::uint32_t floats) {
+  const std::uint32_t block_end = first + 2u * floats;
+  const std::uint32_t lo = addr > first ? addr : first;
+  const std::uint32_t hi = end < block_end ? end : block_end;
+  return (lo - first) % 2 == 0 && (hi - first) % 2 == 0;
 }
 
 [[nodiscard]] float LsbToSi(std::int32_t v, std::size_t axis) {
@@ -59,13 +80,16 @@ void BuildInputRegisters(const DeviceSample& d, const hal::AdcInfo& adc, std::ui
   // the wrench registers read NaN and 0, never a held or clipped value.
   const bool cal_ok = (status & (kStatusCalInvalid | kStatusSaturated)) == 0;
   for (std::size_t i = 0; i < kAxes; ++i) {
-    PackFloat32(cal_ok ? LsbToSi(s.wrench[i], i) : kNaN, &r[kInWrenchFloat + 2 * i]);
+    // An axis the calibration does not determine (status bit 10) is never a value either.
+    const bool axis_ok = cal_ok && (s.invalid_axes & (1u << i)) == 0;
+    const bool peak_ok = (d.peaks_invalid_axes & (1u << i)) == 0;
+    PackFloat32(axis_ok ? LsbToSi(s.wrench[i], i) : kNaN, &r[kInWrenchFloat + 2 * i]);
     // Forces are already mN; moments go from 10 µN·m to mN·m, rounded to nearest.
     const std::int32_t v =
         i < 3 ? s.wrench[i]
               : static_cast<std::int32_t>(RoundDiv(s.wrench[i], kMomentLsbPerMilliNm));
-    PackI32(cal_ok ? v : 0, &r[kInWrenchInt + 2 * i]);
-    PackFloat32(LsbToSi(d.peaks_lsb[i], i), &r[kInPeaks + 2 * i]);
+    PackI32(axis_ok ? v : 0, &r[kInWrenchInt + 2 * i]);
+    PackFloat32(peak_ok ? LsbToSi(d.peaks_lsb[i], i) : kNaN, &r[kInPeaks + 2 * i]);
   }
   PackFloat32(s.has_temperature ? static_cast<float>(s.temperature_mdegc * 1e-3) : kNaN,
               &r[kInTemperature]);
@@ -84,6 +108,9 @@ void BuildInputRegisters(const DeviceSample& d, const hal::AdcInfo& adc, std::ui
   PackU32(d.cal_crc, &r[kInCalCrc]);
   PackU32(d.late_samples, &r[kInLateSamples]);
   r[kInTimestampWraps] = s.timestamp_wraps;
+  PackFloat32(static_cast<float>(static_cast<double>(d.payload_mass_ug) * 1e-9),
+              &r[kInPayloadMass]);
+  PackU32(d.payload_crc, &r[kInPayloadCrc]);
 }
 
 RegisterMap::RegisterMap(Device& device) : device_(device), settings_(device.initial_settings()) {}
@@ -145,8 +172,19 @@ ModbusException RegisterMap::ReadHolding(std::uint16_t addr, std::uint16_t count
       case kHoldUnlock:
         v = unlocked ? 1 : 0;
         break;
+      case kHoldGravityComp:
+        v = settings_.gravity_comp ? 1 : 0;
+        break;
       default:
-        v = HoldingReserved(a) ? 0 : transform_regs_[a - kHoldTransform];
+        if (HoldingReserved(a)) {
+          v = 0;
+        } else if (InGravity(a)) {
+          v = gravity_regs_[a - kHoldGravity];
+        } else if (HoldingMount(a)) {
+          v = mount_regs_[a - kHoldMount];
+        } else {
+          v = transform_regs_[a - kHoldTransform];
+        }
         break;
     }
     out[i] = v;
@@ -166,7 +204,11 @@ ModbusException RegisterMap::WriteHolding(std::uint16_t addr, const std::uint16_
   const bool unlocked = UnlockedLocked(now_us);
   DeviceSettings next = settings_;
   std::array<std::uint16_t, 12> next_transform = transform_regs_;
+  std::array<std::uint16_t, 12> next_mount = mount_regs_;
+  std::array<std::uint16_t, 6> next_gravity = gravity_regs_;
   bool transform_written = false;
+  bool mount_written = false;
+  bool gravity_written = false;
   bool unlock_written = false;
   for (std::uint32_t a = addr; a < end; ++a) {
     const std::uint16_t v = values[a - addr];
@@ -200,38 +242,57 @@ ModbusException RegisterMap::WriteHolding(std::uint16_t addr, const std::uint16_
         if (v != kUnlockKey) return ModbusException::kIllegalDataValue;
         unlock_written = true;
         break;
-      default:  // 5 … 9 reserved, 10 … 21 tool transform
+      case kHoldGravityComp:
+        if (v > 1 || (v == 1 && !device_.payload_present())) {
+          return ModbusException::kIllegalDataValue;
+        }
+        next.gravity_comp = v == 1;
+        break;
+      default:  // 5 … 9, 29 reserved, 10 … 21 tool transform, 22 … 27 gravity, 30 … 41 mount
         if (HoldingReserved(a)) {
           if (v != 0) return ModbusException::kIllegalDataValue;
           break;
         }
+        if (InGravity(a)) {  // not protected: a robot writes it as it moves
+          next_gravity[a - kHoldGravity] = v;
+          gravity_written = true;
+          break;
+        }
         if (!unlocked) return ModbusException::kIllegalDataValue;
-        next_transform[a - kHoldTransform] = v;
-        transform_written = true;
+        if (HoldingMount(a)) {
+          next_mount[a - kHoldMount] = v;
+          mount_written = true;
+        } else {
+          next_transform[a - kHoldTransform] = v;
+          transform_written = true;
+        }
         break;
     }
   }
-  if (transform_written) {
+  if (transform_written || mount_written) {
     // A float is two registers: a write must cover whole floats.
-    constexpr std::uint32_t kFirst = kHoldTransform;
-    constexpr std::uint32_t kEnd = kFirst + 12u;
-    const std::uint32_t first = addr > kFirst ? addr : kFirst;
-    const std::uint32_t last = end < kEnd ? end : kEnd;
-    if ((first - kFirst) % 2 != 0 || (last - kFirst) % 2 != 0) {
+    if ((transform_written && !WholeFloats(addr, end, kHoldTransform, 6)) ||
+        (mount_written && !WholeFloats(addr, end, kHoldMount, 6))) {
       return ModbusException::kIllegalDataValue;
     }
-    ToolTransformParams p{};
+    if (MakeMountedToolTransform(ParamsOf(next_transform), ParamsOf(next_mount), &next.transform) !=
+        TransformStatus::kOk) {
+      return ModbusException::kIllegalDataValue;
+    }
+  }
+  if (gravity_written) {
+    if (!WholeFloats(addr, end, kHoldGravity, 3)) return ModbusException::kIllegalDataValue;
     for (std::size_t i = 0; i < 3; ++i) {
-      p.d_m[i] = UnpackFloat32(&next_transform[2 * i]);
-      p.r_deg[i] = UnpackFloat32(&next_transform[6 + 2 * i]);
-    }
-    if (MakeToolTransform(p, &next.transform) != TransformStatus::kOk) {
-      return ModbusException::kIllegalDataValue;
+      if (!GravityToFixed(UnpackFloat32(&next_gravity[2 * i]), &next.gravity_umps2[i])) {
+        return ModbusException::kIllegalDataValue;
+      }
     }
   }
   // Everything validated: commit.
   settings_ = next;
   transform_regs_ = next_transform;
+  mount_regs_ = next_mount;
+  gravity_regs_ = next_gravity;
   if (unlock_written) {
     unlock_armed_ = true;
     unlock_until_us_ = now_us + kUnlockDurationUs;

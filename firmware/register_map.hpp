@@ -1,4 +1,4 @@
-// The Modbus register map, version 1 (docs/spec/modbus-map.md): input image, holding registers.
+// The Modbus register map, version 2 (docs/spec/modbus-map.md): input image, holding registers.
 #pragma once
 
 #include <array>
@@ -9,9 +9,10 @@
 
 namespace ftstack::fw {
 
-inline constexpr std::uint16_t kMapVersion = 1;
-inline constexpr std::uint16_t kInputRegisterCount = 77;   ///< input registers 0 … 76
-inline constexpr std::uint16_t kHoldingRegisterSpan = 22;  ///< holding 0 … 21 (5 … 9 reserved)
+inline constexpr std::uint16_t kMapVersion = 2;
+inline constexpr std::uint16_t kInputRegisterCount = 85;  ///< input registers 0 … 84
+/// Holding 0 … 41: 5 … 9 and 29 reserved.
+inline constexpr std::uint16_t kHoldingRegisterSpan = 42;
 
 /// Input register addresses (0-based protocol addresses).
 enum InputRegister : std::uint16_t {
@@ -31,6 +32,9 @@ enum InputRegister : std::uint16_t {
   kInCalCrc = 72,          ///< uint32
   kInLateSamples = 74,     ///< uint32, missed sampling deadlines since start
   kInTimestampWraps = 76,  ///< uint16, wraps of the 32-bit µs timestamp (its bits 32–47)
+  kInPayloadMass = 77,     ///< float32 kg, payload of gravity compensation (0: none). Map v2
+  kInPayloadCrc = 79,      ///< uint32, CRC-32 of the payload file (0: none). Map v2
+  kInReserved81 = 81,      ///< 81 … 84 reserved, read 0. Map v2
 };
 
 /// Holding register addresses.
@@ -40,7 +44,11 @@ enum HoldingRegister : std::uint16_t {
   kHoldDecimation = 2,
   kHoldCalSlot = 3,  ///< protected
   kHoldUnlock = 4,
-  kHoldTransform = 10,  ///< float32 × 6 (Dx Dy Dz m, Rx Ry Rz deg), protected, 10 … 21
+  kHoldTransform = 10,    ///< float32 × 6 (Dx Dy Dz m, Rx Ry Rz deg), protected, 10 … 21
+  kHoldGravity = 22,      ///< float32 × 3, gravity in the sensor frame, m/s², 22 … 27. Map v2
+  kHoldGravityComp = 28,  ///< 0 off, 1 on (needs a payload). Map v2
+  kHoldReserved29 = 29,   ///< reserved, reads 0. Map v2
+  kHoldMount = 30,  ///< float32 × 6 mount transform (same layout), protected, 30 … 41. Map v2
 };
 
 /// Values of the command register.
@@ -83,16 +91,17 @@ class RegisterMap {
  public:
   explicit RegisterMap(Device& device);
 
-  /// Function 04. 02 when [addr, addr+count) leaves 0 … 73.
+  /// Function 04. 02 when [addr, addr+count) leaves 0 … 84; reserved 81 … 84 read 0.
   [[nodiscard]] ModbusException ReadInput(std::uint16_t addr, std::uint16_t count,
                                           std::uint16_t* out);
-  /// Function 03. 02 when any address is outside 0 … 21; reserved 5 … 9 read 0.
+  /// Function 03. 02 when any address is outside 0 … 41; reserved 5 … 9 and 29 read 0.
   [[nodiscard]] ModbusException ReadHolding(std::uint16_t addr, std::uint16_t count,
                                             std::uint16_t* out);
   /// Functions 06 and 16. 02 for an address outside the map; 03 for a value out of range, an
-  /// unknown command, a non-zero value in a reserved register (5–9), a protected register (3,
-  /// 10–21) while locked, or a write covering only one half of a tool-transform float. On any
-  /// exception nothing changes.
+  /// unknown command, a non-zero value in a reserved register (5–9, 29), a protected register (3,
+  /// 10–21, 30–41) while locked, a write covering only one half of a float (10–27, 30–41), a
+  /// gravity component that is not finite or beyond ±20 m/s², or gravity compensation on (28 = 1)
+  /// without a payload. On any exception nothing changes.
   [[nodiscard]] ModbusException WriteHolding(std::uint16_t addr, const std::uint16_t* values,
                                              std::uint16_t count);
 
@@ -107,6 +116,8 @@ class RegisterMap {
   Device& device_;
   DeviceSettings settings_{};
   std::array<std::uint16_t, 12> transform_regs_{};
+  std::array<std::uint16_t, 12> mount_regs_{};
+  std::array<std::uint16_t, 6> gravity_regs_{};
   std::uint64_t unlock_until_us_ = 0;
   bool unlock_armed_ = false;
 };

@@ -37,6 +37,7 @@ hal::Status Sampler::Step(PublishedSample& out) {
   p.has_temperature = sample_.has_temperature;
   p.temperature_mdegc = sample_.temperature_mdegc;
   p.status = core_out_.status;
+  p.invalid_axes = core_.calibration().invalid_axes;
   last_ = p;
   out = p;
   return hal::Status::kOk;

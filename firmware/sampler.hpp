@@ -11,8 +11,10 @@ namespace ftstack::fw {
 
 /// One published sample: everything a Modbus reply or a log row is made of.
 struct PublishedSample {
-  std::uint32_t sequence = 0;         ///< +1 per published sample, wraps
-  std::uint32_t timestamp_us = 0;     ///< conversion time since start, wraps every 2^32 µs
+  std::uint32_t sequence = 0;  ///< +1 per published sample, wraps
+  /// Time since start, wraps every 2^32 µs: the backend's conversion time from Sampler, replaced
+  /// by Device with the monotonic time the sample was read.
+  std::uint32_t timestamp_us = 0;
   std::uint16_t timestamp_wraps = 0;  ///< how often timestamp_us wrapped (bits 32–47 of the time)
   WrenchLsb wrench{};                 ///< mN and 10 µN·m
   std::uint8_t channel_count = 0;
@@ -20,6 +22,9 @@ struct PublishedSample {
   std::int32_t temperature_mdegc = 0;                        ///< m°C, valid if has_temperature
   bool has_temperature = false;
   std::uint16_t status = 0;  ///< StatusBit set
+  /// Bit r: wrench axis r is not a value (the calibration does not determine it; status bit
+  /// 10). Sensor frame from Sampler; the frame of `wrench` once Device published it.
+  std::uint8_t invalid_axes = 0;
 };
 
 /// Drives one ADC through the core. Call Step() in the sampling thread's loop.

@@ -17,6 +17,10 @@ enum StatusBit : std::uint16_t {
   kStatusSimulated = 1u << 7,    ///< simulated ADC backend
   kStatusStale = 1u << 8,        ///< no new sample within 2 sample periods
   kStatusLate = 1u << 9,         ///< a sample was read > 1.5 periods after the previous one
+  /// The calibration flags an axis invalid (its rig never excited it): that axis's wrench
+  /// registers read NaN / 0 (in the tool frame: every axis the transform mixes it into).
+  kStatusAxisInvalid = 1u << 10,
+  kStatusPayloadComp = 1u << 12,  ///< the payload's weight and moment (and bias) are subtracted
 };
 
 }  // namespace ftstack::fw

@@ -6,51 +6,61 @@
 
 namespace ftstack::fw {
 
-TransformStatus MakeToolTransform(const ToolTransformParams& params, FixedToolTransform* out) {
+namespace {
+
+using Mat = double[kAxes][kAxes];
+
+[[nodiscard]] TransformStatus Validate(const ToolTransformParams& p) {
   for (std::size_t i = 0; i < 3; ++i) {
-    if (!std::isfinite(params.d_m[i]) || !std::isfinite(params.r_deg[i])) {
-      return TransformStatus::kNotFinite;
-    }
-    if (std::fabs(params.d_m[i]) > kMaxToolOffsetM ||
-        std::fabs(params.r_deg[i]) > kMaxToolAngleDeg) {
+    if (!std::isfinite(p.d_m[i]) || !std::isfinite(p.r_deg[i])) return TransformStatus::kNotFinite;
+    if (std::fabs(p.d_m[i]) > kMaxToolOffsetM || std::fabs(p.r_deg[i]) > kMaxToolAngleDeg) {
       return TransformStatus::kOutOfRange;
     }
   }
-  FixedToolTransform t{};
-  bool zero = true;
+  return TransformStatus::kOk;
+}
+
+[[nodiscard]] bool IsZero(const ToolTransformParams& p) {
   for (std::size_t i = 0; i < 3; ++i) {
-    if (params.d_m[i] != 0.0f || params.r_deg[i] != 0.0f) zero = false;
+    if (p.d_m[i] != 0.0f || p.r_deg[i] != 0.0f) return false;
   }
-  if (zero) {
-    *out = t;
-    return TransformStatus::kOk;
-  }
+  return true;
+}
+
+/// 6×6 matrix in output LSB (mN, 10 µN·m). mount = false: the tool transform
+/// [Rᵀ 0; −Rᵀ[D]× Rᵀ]; mount = true: [R 0; [D]×R R].
+void FloatMatrix(const ToolTransformParams& p, bool mount, Mat& m) {
   constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
-  const double cx = std::cos(params.r_deg[0] * kDegToRad),
-               sx = std::sin(params.r_deg[0] * kDegToRad);
-  const double cy = std::cos(params.r_deg[1] * kDegToRad),
-               sy = std::sin(params.r_deg[1] * kDegToRad);
-  const double cz = std::cos(params.r_deg[2] * kDegToRad),
-               sz = std::sin(params.r_deg[2] * kDegToRad);
+  const double cx = std::cos(p.r_deg[0] * kDegToRad), sx = std::sin(p.r_deg[0] * kDegToRad);
+  const double cy = std::cos(p.r_deg[1] * kDegToRad), sy = std::sin(p.r_deg[1] * kDegToRad);
+  const double cz = std::cos(p.r_deg[2] * kDegToRad), sz = std::sin(p.r_deg[2] * kDegToRad);
   // R = Rz·Ry·Rx.
   const double r[3][3] = {{cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx},
                           {sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx},
                           {-sy, cy * sx, cy * cx}};
-  const double d[3] = {params.d_m[0], params.d_m[1], params.d_m[2]};
+  const double d[3] = {p.d_m[0], p.d_m[1], p.d_m[2]};
   // Skew matrix of D: (D × F)_i = Σ_j dx[i][j] F_j.
   const double dx[3][3] = {{0, -d[2], d[1]}, {d[2], 0, -d[0]}, {-d[1], d[0], 0}};
   // Moments in 10 µN·m per (m · mN): 1 m · 1 mN = 1e-3 N·m = 100 LSB.
   const double lever_lsb = 1e-3 / kMomentLsbNm;
-  double m[kAxes][kAxes] = {};
+  for (std::size_t i = 0; i < kAxes; ++i) {
+    for (std::size_t j = 0; j < kAxes; ++j) m[i][j] = 0.0;
+  }
   for (std::size_t i = 0; i < 3; ++i) {
     for (std::size_t j = 0; j < 3; ++j) {
-      m[i][j] = r[j][i];          // Rᵀ on forces
-      m[i + 3][j + 3] = r[j][i];  // Rᵀ on moments
-      double rdx = 0.0;           // (Rᵀ·[D]×)_ij
-      for (std::size_t k = 0; k < 3; ++k) rdx += r[k][i] * dx[k][j];
-      m[i + 3][j] = -lever_lsb * rdx;
+      const double rot = mount ? r[i][j] : r[j][i];
+      m[i][j] = rot;
+      m[i + 3][j + 3] = rot;
+      double lever = 0.0;
+      for (std::size_t k = 0; k < 3; ++k) {
+        lever += mount ? dx[i][k] * r[k][j] : r[k][i] * dx[k][j];  // [D]×R or Rᵀ[D]×
+      }
+      m[i + 3][j] = (mount ? 1.0 : -1.0) * lever_lsb * lever;
     }
   }
+}
+
+void Quantize(const Mat& m, FixedToolTransform* t) {
   for (std::size_t row = 0; row < kAxes; ++row) {
     double sum_abs = 0.0;
     for (std::size_t j = 0; j < kAxes; ++j) sum_abs += std::fabs(m[row][j]);
@@ -60,12 +70,54 @@ TransformStatus MakeToolTransform(const ToolTransformParams& params, FixedToolTr
     if (s > 62) s = 62;
     if (s < 0) s = 0;
     const double scale = std::ldexp(1.0, s);
-    for (std::size_t j = 0; j < kAxes; ++j) t.coef[row][j] = std::llround(m[row][j] * scale);
-    t.shift[row] = static_cast<std::uint8_t>(s);
+    for (std::size_t j = 0; j < kAxes; ++j) t->coef[row][j] = std::llround(m[row][j] * scale);
+    t->shift[row] = static_cast<std::uint8_t>(s);
   }
-  t.identity = false;
+  t->identity = false;
+}
+
+}  // namespace
+
+TransformStatus MakeToolTransform(const ToolTransformParams& params, FixedToolTransform* out) {
+  return MakeMountedToolTransform(params, ToolTransformParams{}, out);
+}
+
+TransformStatus MakeMountedToolTransform(const ToolTransformParams& tool,
+                                         const ToolTransformParams& mount,
+                                         FixedToolTransform* out) {
+  const TransformStatus st = Validate(tool);
+  if (st != TransformStatus::kOk) return st;
+  const TransformStatus sm = Validate(mount);
+  if (sm != TransformStatus::kOk) return sm;
+  FixedToolTransform t{};
+  if (IsZero(tool) && IsZero(mount)) {
+    *out = t;
+    return TransformStatus::kOk;
+  }
+  Mat a{}, b{}, m{};
+  FloatMatrix(tool, false, a);
+  FloatMatrix(mount, true, b);
+  for (std::size_t i = 0; i < kAxes; ++i) {
+    for (std::size_t j = 0; j < kAxes; ++j) {
+      double acc = 0.0;
+      for (std::size_t k = 0; k < kAxes; ++k) acc += a[i][k] * b[k][j];
+      m[i][j] = acc;
+    }
+  }
+  Quantize(m, &t);
   *out = t;
   return TransformStatus::kOk;
+}
+
+std::uint8_t ToolFrameInvalidAxes(const FixedToolTransform& t, std::uint8_t sensor_invalid) {
+  if (t.identity || sensor_invalid == 0) return sensor_invalid;
+  std::uint8_t out = 0;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    for (std::size_t j = 0; j < kAxes; ++j) {
+      if ((sensor_invalid & (1u << j)) != 0 && t.coef[r][j] != 0) out |= 1u << r;
+    }
+  }
+  return out;
 }
 
 void ApplyToolTransform(const FixedToolTransform& t, const WrenchLsb& in, WrenchLsb* out,

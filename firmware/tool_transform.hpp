@@ -1,5 +1,5 @@
-// Tool transform: moves the wrench from the sensor origin to a tool point and frame, in fixed
-// point.
+// Tool and mount transforms: move the wrench from the sensor origin to a tool or base point and
+// frame, in fixed point.
 #pragma once
 
 #include <array>
@@ -42,9 +42,25 @@ enum class TransformStatus : std::uint8_t {
 [[nodiscard]] TransformStatus MakeToolTransform(const ToolTransformParams& params,
                                                 FixedToolTransform* out);
 
+/// The mount transform (holding registers 30–41): the sensor's pose in the base frame of the
+/// machine it sits under — origin D_m (m) of the sensor frame in the base frame, orientation
+/// R_m = Rz·Ry·Rx (rotations about the fixed base axes). It reports the wrench in the base frame,
+/// about the base origin:  F_base = R_m·F,  M_base = R_m·M + D_m × (R_m·F).
+/// With both set, the mount applies first and the tool transform is then read in the base frame
+/// (its D and R give the tool frame in base coordinates): W_out = T_tool · T_mount · W_sensor.
+/// A zero mount leaves the tool transform exactly as before (map version 1 behaviour).
+[[nodiscard]] TransformStatus MakeMountedToolTransform(const ToolTransformParams& tool,
+                                                       const ToolTransformParams& mount,
+                                                       FixedToolTransform* out);
+
 /// Applies a transform to one wrench (integer only). Sets *saturated if an axis was clamped to
 /// int32.
 void ApplyToolTransform(const FixedToolTransform& t, const WrenchLsb& in, WrenchLsb* out,
                         bool* saturated);
+
+/// The tool-frame axes that depend on any sensor-frame axis in `sensor_invalid` (bit per axis):
+/// row r is invalid when a non-zero coefficient takes an invalid axis into it.
+[[nodiscard]] std::uint8_t ToolFrameInvalidAxes(const FixedToolTransform& t,
+                                                std::uint8_t sensor_invalid);
 
 }  // namespace ftstack::fw

@@ -181,6 +181,65 @@ void HoldCycle(Builder& b, const Wrench& r, SeededRandom& rng) {
   }
 }
 
+// A sensor under a robot's base (issue 13). Loads are fractions of the rated range per axis: on
+// a sensor rated at the Panda base figures (300 N, 300 N, 410 N, 280, 280, 190 N·m) they are
+// those figures. The arm's weight presses down (Fz < 0, 43 % of rated); reaching out tilts.
+Wrench Scaled(const Wrench& frac, const Wrench& r) { return frac.cwiseProduct(r); }
+
+Wrench BaseStatic() { return Axis(2, -0.43); }
+
+// Reach in direction a (rad): lateral force along a, tilting moment about the perpendicular axis.
+Wrench Reach(double a, double f_xy, double f_z, double m_xy, double m_z) {
+  Wrench w = Wrench::Zero();
+  w << f_xy * std::cos(a), f_xy * std::sin(a), -f_z, -m_xy * std::sin(a), m_xy * std::cos(a), m_z;
+  return w;
+}
+
+// Pick-and-place: four reach-pick-return moves in random directions, combined share < 0.9.
+void BasePickCycle(Builder& b, const Wrench& r, SeededRandom& rng) {
+  b.Start();
+  b.Ramp(Scaled(BaseStatic(), r), 1.0);
+  b.Hold(1.0);
+  for (int i = 0; i < 4; ++i) {
+    const double a = rng.Uniform(0.0, 2.0 * std::numbers::pi);
+    const double mz = rng.Uniform(-0.2, 0.2);
+    b.Ramp(Scaled(Reach(a, 0.25, 0.53, 0.35, mz), r), 0.6);
+    b.Hold(0.4);
+    b.Ramp(Scaled(BaseStatic(), r), 0.6);
+    b.Hold(0.5);
+  }
+}
+
+// Slow tilting: the arm reaches out and holds (tilt share 0.55: inside the rating).
+void BaseTiltCycle(Builder& b, const Wrench& r, SeededRandom& rng) {
+  b.Start();
+  b.Ramp(Scaled(BaseStatic(), r), 1.0);
+  for (int i = 0; i < 2; ++i) {
+    const double a = rng.Uniform(0.0, 2.0 * std::numbers::pi);
+    b.Ramp(Scaled(Reach(a, 0.05, 0.45, 0.55, 0.0), r), 4.0);
+    b.Hold(3.0);
+    b.Ramp(Scaled(BaseStatic(), r), 4.0);
+    b.Hold(1.0);
+  }
+}
+
+// Emergency stop during a fast move: within 20 ms every component reaches its rated value (the
+// Panda figures all at once: combined share 2, an overload), then rings down at 8 Hz (halving
+// each half period) to the static load.
+void BaseEstopCycle(Builder& b, const Wrench& r, SeededRandom& rng) {
+  BasePickCycle(b, r, rng);
+  const double a = rng.Uniform(0.0, 2.0 * std::numbers::pi);
+  b.Ramp(Scaled(Reach(a, 0.3, 0.5, 0.3, 0.2), r), 0.3);
+  const Wrench base = Scaled(BaseStatic(), r);
+  const Wrench peak = Scaled(Reach(a, 1.0, 1.0, 1.0, 1.0), r);
+  b.Ramp(peak, 0.02);
+  b.Hold(0.03);
+  double amp = -0.5;
+  for (int i = 0; i < 6; ++i, amp *= -0.5) b.Ramp(base + amp * (peak - base), 1.0 / 16.0);
+  b.Ramp(base, 0.1);
+  b.Hold(3.0);
+}
+
 using CycleFn = void (*)(Builder&, const Wrench&, SeededRandom&);
 
 // Lab temperature: a slow wander of ±0.4 K around 22 °C.
@@ -467,6 +526,15 @@ LoadProfile MakeProfile(const std::string& spec, const Wrench& rated, std::uint6
   if (spec == "thermal")
     return Generated("thermal", RigCycle, 200.0, rated, seed, duration_s, true);
   if (spec == "hold") return Generated("hold", HoldCycle, 100.0, rated, seed, duration_s, false);
+  if (spec == "base-pick") {
+    return Generated("base-pick", BasePickCycle, 200.0, rated, seed, duration_s, false);
+  }
+  if (spec == "base-tilt") {
+    return Generated("base-tilt", BaseTiltCycle, 200.0, rated, seed, duration_s, false);
+  }
+  if (spec == "base-estop") {
+    return Generated("base-estop", BaseEstopCycle, 1000.0, rated, seed, duration_s, false);
+  }
   std::string path = spec;
   if (path.rfind("file:", 0) == 0) path = path.substr(5);
   if (EndsWith(path, ".json")) {
@@ -478,7 +546,8 @@ LoadProfile MakeProfile(const std::string& spec, const Wrench& rated, std::uint6
   }
   if (EndsWith(path, ".csv")) return FromCsv(path, duration_s);
   throw ProfileError("unknown profile '" + spec +
-                     "' (rig, taps, thermal, hold, or a .json keyframe / .csv recording file)");
+                     "' (rig, taps, thermal, hold, base-pick, base-tilt, base-estop, or a .json "
+                     "keyframe / .csv recording file)");
 }
 
 }  // namespace ftstack::sim

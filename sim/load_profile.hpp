@@ -75,6 +75,12 @@ class LoadProfile {
 ///   thermal  the rig sequence while the body warms by ≈ 8 K: an ambient rise plus self-heating
 ///            that follows the load intensity (correlated with the load sequence)
 ///   hold     sustained loads of 40–60 s each followed by 40–60 s unloaded (≈ 500 s at 100 Hz)
+///   base-pick, base-tilt, base-estop
+///            a sensor under a robot's base: the arm's weight (Fz −43 % of rated) with four
+///            pick-and-place reaches (≈ 10 s, 200 Hz); slow tilting to 55 % of the tilt rating
+///            (≈ 24 s, 200 Hz); pick-and-place then an emergency stop in which every component
+///            reaches its rated value within 20 ms and rings down at 8 Hz (≈ 14 s, 1 kHz). On a
+///            sensor rated at the Panda base figures (300/410 N, 280/190 N·m) these are them.
 ///   PATH     (or file:PATH) a JSON keyframe file (schema "ftstack-profile/1": {"keyframes":
 ///            [{"t_s", "wrench": [6], "temp_C"}], "rate_hz"}) or a recording CSV with t and the
 ///            wrench columns (temp_C optional)

@@ -77,6 +77,9 @@ Status SimAdc::DoRead(AdcSample& out) {
   const double t_s = static_cast<double>(index_) / info_.rate_hz;
   const std::uint64_t timestamp_us = index_ * 1000000ULL / info_.rate_hz;
   ++index_;
+  if (params_.stall_every != 0 && params_.stall_us != 0 && index_ % params_.stall_every == 0) {
+    SleepUntilNs(MonotonicNs() + std::int64_t{params_.stall_us} * 1000);
+  }
   if (fault_ == SimFault::kStuck && last_.channel_count == n) {
     out = last_;
     out.timestamp_us = timestamp_us;

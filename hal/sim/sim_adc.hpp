@@ -44,6 +44,10 @@ struct SimAdcParams {
   /// kInvalidArgument, so the noise of the counts always matches the configuration.
   std::uint16_t required_gain = 0;
   std::uint32_t required_rate_hz = 0;
+  /// Stall: Read holds its caller stall_us on every stall_every-th sample (0: never), as if the
+  /// sampling thread were preempted there — deterministic late samples for tests.
+  std::uint32_t stall_every = 0;
+  std::uint32_t stall_us = 0;
 };
 
 /// Simulated ratiometric delta-sigma ADC. counts = round(mV/V · max_counts / full_scale_mvv +

@@ -219,5 +219,46 @@ TEST(CalFileFormat, ExtendedTermsRoundTripAndCrcIsZlibs) {
   }
 }
 
+/// A JSON calibration with its CRC recomputed after an edit.
+nlohmann::json WithCrc(nlohmann::json j) {
+  j["crc32"] = "0x00000000";
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%08x", ContentCrc(j));
+  j["crc32"] = buf;
+  return j;
+}
+
+TEST(CalFile, InvalidAxesTravelOnlyWithSchema3) {
+  CalFile f;
+  f.cal.channel_count = 6;
+  f.adc = DefaultAdc(6);
+  f.rated = {200, 200, 400, 10, 10, 8};
+  for (std::size_t r = 0; r < 6; ++r) f.cal.matrix[r][r] = 100.0;
+  // Without flags: schema 2 and no field (files of before read and write unchanged).
+  EXPECT_EQ(ToJson(f)["schema"], kCalSchema);
+  EXPECT_FALSE(ToJson(f).contains("invalid_axes"));
+  f.cal.invalid_axes = (1u << 3) | (1u << 5);
+  const nlohmann::json j = ToJson(f);
+  EXPECT_EQ(j["schema"], kCalSchemaV3);  // a reader without the field refuses the file
+  EXPECT_EQ(j["invalid_axes"], nlohmann::json::array({"Mx", "Mz"}));
+  const CalFile g = FromJson(j, "mem");
+  EXPECT_EQ(g.cal.invalid_axes, (1u << 3) | (1u << 5));
+  EXPECT_EQ(ToJson(g), j);
+  // Into the fixed-point form the board loads.
+  EXPECT_EQ(ToFixed(g, g.adc).invalid_axes, (1u << 3) | (1u << 5));
+  // The field without schema 3, schema 3 without the field, unknown or repeated names: refused.
+  nlohmann::json bad = j;
+  bad["schema"] = kCalSchema;
+  EXPECT_THROW((void)FromJson(WithCrc(bad), "mem"), CalFileError);
+  bad = j;
+  bad.erase("invalid_axes");
+  EXPECT_THROW((void)FromJson(WithCrc(bad), "mem"), CalFileError);
+  bad = j;
+  bad["invalid_axes"] = {"Mz", "Mq"};
+  EXPECT_THROW((void)FromJson(WithCrc(bad), "mem"), CalFileError);
+  bad["invalid_axes"] = {"Mz", "Mz"};
+  EXPECT_THROW((void)FromJson(WithCrc(bad), "mem"), CalFileError);
+}
+
 }  // namespace
 }  // namespace ftstack::cal

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
+#include <vector>
 
 #include "calibration/cal_file.hpp"
 #include "calibration/model.hpp"
@@ -203,6 +205,75 @@ TEST(FixedTerms, LoaderRefusesWhatCouldOverflowAndAcceptsUpToTheEdge) {
     ExpectWithinBound(
         edge, core, rep, rng, 300, [](int s) { return s % 2 == 0 ? 60000 : -10000; }, {}, nullptr);
   }
+}
+
+/// A one-channel calibration with one square term x̃² on Fz, for an ADC with full int32 rails,
+/// whose integer zero sits `xmax` counts below the positive rail: the core's raw product at that
+/// rail is xmax².
+Case SquareTermCase(std::int64_t xmax) {
+  Case c;
+  c.adc.channel_count = 1;
+  c.adc.min_counts = std::numeric_limits<std::int32_t>::min();
+  c.adc.max_counts = std::numeric_limits<std::int32_t>::max();
+  c.adc.full_scale_nvv = 2147483647;  // 1e6 counts per mV/V
+  c.cal.channel_count = 1;
+  const std::int64_t zero = std::int64_t{c.adc.max_counts} - xmax;
+  c.cal.offset_mvv[0] = static_cast<double>(zero) / fw::CountsPerMvv(c.adc);
+  c.cal.product_count = 1;
+  c.cal.products[0] = {0, 0};
+  c.cal.product_matrix[2][0] = 1e-5;  // N per (mV/V)²: ≈ 92 N at the rail
+  c.cal.bias[2] = 0.25;
+  return c;
+}
+
+TEST(FixedTerms, RawProductOfASecondOrderFeatureIsBoundedExactlyAtTheEdge) {
+  // The core computes x̃_a·x̃_b in int64 and rounds it by 2^(shift−1) before the shift; shift is
+  // 37 for products between 2^62 and 2^63. Edge, in exact integers (independent of the loader):
+  // X² + 2^36 ≤ 2^63 − 1 < (X + 1)² + 2^36.
+  constexpr std::int64_t kEdge = 3037000488;
+  using U128 = unsigned __int128;
+  const U128 limit = (U128{1} << 63) - 1;
+  ASSERT_LE(U128(kEdge) * U128(kEdge) + (U128{1} << 36), limit);
+  ASSERT_GT(U128(kEdge + 1) * U128(kEdge + 1) + (U128{1} << 36), limit);
+
+  const Case inside = SquareTermCase(kEdge);
+  fw::FixedCalibration fixed{};
+  fw::LoadReport rep{};
+  ASSERT_EQ(fw::LoadCalibration(inside.cal, inside.adc, &fixed, &rep), fw::LoadStatus::kOk);
+  ASSERT_EQ(std::int64_t{inside.adc.max_counts} - fixed.zero[0], kEdge);
+  ASSERT_EQ(fixed.extra_count, 1);
+  ASSERT_EQ(fixed.extra[0].shift, 37);
+  fw::WrenchCore core;
+  core.SetCalibration(fixed);
+  // Exact against long double: y = q·(mV/V − offset)² + bias, at the rails, the zero and between.
+  const long double cpm = static_cast<long double>(inside.adc.max_counts) / 2147.483647L;
+  std::mt19937_64 rng(9);
+  std::uniform_int_distribution<std::int32_t> u(inside.adc.min_counts, inside.adc.max_counts);
+  std::vector<std::int32_t> inputs = {inside.adc.max_counts, inside.adc.max_counts - 1,
+                                      inside.adc.min_counts, fixed.zero[0], fixed.zero[0] + 1};
+  for (int i = 0; i < 200; ++i) inputs.push_back(u(rng));
+  for (const std::int32_t counts : inputs) {
+    std::array<std::int32_t, hal::kMaxChannels> x{};
+    x[0] = counts;
+    fw::WrenchLsb y{};
+    bool sat = false;
+    core.Apply(x, y, &sat);
+    ASSERT_FALSE(sat) << counts;
+    const long double d = counts / cpm - static_cast<long double>(inside.cal.offset_mvv[0]);
+    const long double ref_lsb = (1e-5L * d * d + 0.25L) / static_cast<long double>(fw::AxisLsb(2));
+    EXPECT_LE(std::fabs(static_cast<double>(y[2] - ref_lsb)), rep.worst_case_error_lsb[2])
+        << "counts " << counts;
+    EXPECT_LE(rep.worst_case_error_lsb[2], 2.0);
+  }
+  // One count wider: the raw product at the rail could wrap. Refused, `fixed` untouched.
+  const Case outside = SquareTermCase(kEdge + 1);
+  fw::FixedCalibration untouched{};
+  EXPECT_EQ(fw::LoadCalibration(outside.cal, outside.adc, &untouched, nullptr),
+            fw::LoadStatus::kFeatureOverflow);
+  EXPECT_FALSE(untouched.valid);
+  // Far outside (a full 32-bit span: x̃² ≈ 2^64) likewise.
+  EXPECT_EQ(fw::LoadCalibration(SquareTermCase(4294967295LL).cal, outside.adc, &untouched, nullptr),
+            fw::LoadStatus::kFeatureOverflow);
 }
 
 TEST(FixedTerms, BadTermsAreRefused) {

@@ -3,6 +3,8 @@
 
 #include <sys/wait.h>
 #include <unistd.h>
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -26,8 +28,9 @@ struct CliRun {
   std::string out;
 };
 
-CliRun Ftcal(const std::string& args) {
-  const std::string cmd = std::string(FTSTACK_BIN_DIR) + "/ftcal " + args + " 2>&1";
+/// Runs one of the built programs with `args`; exit code and stdout + stderr.
+CliRun Tool(const std::string& name, const std::string& args) {
+  const std::string cmd = std::string(FTSTACK_BIN_DIR) + "/" + name + " " + args + " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   std::string out;
   char buf[4096];
@@ -35,6 +38,7 @@ CliRun Ftcal(const std::string& args) {
   const int status = p != nullptr ? pclose(p) : -1;
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
 }
+CliRun Ftcal(const std::string& args) { return Tool("ftcal", args); }
 
 class FtcalCli : public ::testing::Test {
  protected:
@@ -94,6 +98,89 @@ TEST_F(FtcalCli, DesignFitVerifyApply) {
   for (std::size_t i = 0; i < ref.size(); ++i) ASSERT_NEAR(got[i], ref[i], 0.2) << i;
 }
 
+TEST_F(FtcalCli, FitWithoutSensorNeedsTheRatedRangeAndTakesNothingFromDesign) {
+  CliRun r = Ftcal("design --sensor builtin --rate-hz 50 --simulate " + P("rig.csv"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  // Neither --sensor nor --rated: refused in one line naming both (it used to take the built-in
+  // sensor's rating and converter silently, through a variable shared with design's default).
+  r = Ftcal("fit --in " + P("rig.csv") + " --out " + P("cal.json"));
+  EXPECT_NE(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("--rated"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--sensor"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(P("cal.json")));
+  // --rated alone: that rating, and the generic converter the help names (not the built-in
+  // sensor's ADS131M at gain 128), said on stdout.
+  r = Ftcal("fit --in " + P("rig.csv") + " --out " + P("cal.json") +
+            " --rated 400,400,800,20,20,16");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("converter: generic 24-bit"), std::string::npos) << r.out;
+  const ftstack::cal::CalFile cal = ftstack::cal::LoadCalFile(P("cal.json"));
+  const std::array<double, 6> rated = {400, 400, 800, 20, 20, 16};
+  EXPECT_EQ(cal.rated, rated);
+  EXPECT_EQ(cal.adc.full_scale_nvv, 3906250);  // ±3.90625 mV/V
+  EXPECT_EQ(cal.adc.max_counts, (1 << 23) - 1);
+  // --sensor builtin: its converter, not the generic one.
+  r = Ftcal("fit --in " + P("rig.csv") + " --out " + P("cal_b.json") + " --sensor builtin");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(r.out.find("converter: generic"), std::string::npos) << r.out;
+  EXPECT_NE(ftstack::cal::LoadCalFile(P("cal_b.json")).adc.full_scale_nvv, 3906250);
+}
+
+/// Runs ftsim (the record helper's generator, with its effects) and fits its "real" output.
+CliRun Ftsim(const std::string& args) { return Tool("ftsim", args); }
+
+/// Copies the keyframe profile `in` (ftcal design --out) with Mz replaced by f(row's wrench).
+template <typename MzOf>
+void RewriteMz(const std::string& in, const std::string& out, MzOf mz_of) {
+  ftstack::Recording prof = ftstack::ReadRecording(in);
+  const std::vector<double> fx = prof.Column("Fx");
+  std::vector<double>& mz = prof.Column("Mz");
+  for (std::size_t i = 0; i < mz.size(); ++i) mz[i] = mz_of(fx[i]);
+  ftstack::WriteRecording(out, prof);
+}
+
+TEST_F(FtcalCli, ARigThatNeverLoadsAnAxisIsRefusedNamingIt) {
+  // The rig's load sequence as designed, then played by the simulator (ftsim record, an
+  // independent generator of the bridges) without Mz — and with Mz only ever tied to Fx.
+  CliRun r = Ftcal("design --sensor builtin --out " + P("profile.csv"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  RewriteMz(P("profile.csv"), P("no_mz.csv"), [](double) { return 0.0; });
+  RewriteMz(P("profile.csv"), P("tied.csv"), [](double fx) { return 0.04 * fx; });
+  r = Ftsim("record --sensor builtin --profile " + P("no_mz.csv") + " --rate-hz 100 --out " +
+            P("rig.csv"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  // Before: exit 0, an Mz row of zeros with uncertainty 0, and verify said OK.
+  r = Ftcal("fit --in " + P("rig.csv") + " --out " + P("cal.json") + " --sensor builtin");
+  EXPECT_NE(r.code, 0) << r.out;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;  // one line
+  EXPECT_NE(r.out.find("axis Mz not excited"), std::string::npos) << r.out;
+  for (const char* other : {"Fx:", "Fy:", "Fz:", "Mx:", "My:"}) {
+    EXPECT_EQ(r.out.find(other), std::string::npos) << other << " named: " << r.out;
+  }
+  EXPECT_FALSE(fs::exists(P("cal.json")));
+  // Asked for: written with Mz flagged invalid (schema 3), said on stdout; verify never says OK
+  // alone (exit 3, INCOMPLETE naming Mz).
+  r = Ftcal("fit --in " + P("rig.csv") + " --out " + P("cal.json") +
+            " --sensor builtin --allow-unexcited");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("flagged invalid"), std::string::npos) << r.out;
+  const ftstack::cal::CalFile cal = ftstack::cal::LoadCalFile(P("cal.json"));
+  EXPECT_EQ(cal.cal.invalid_axes, 1u << 5);
+  r = Ftcal("verify " + P("cal.json"));
+  EXPECT_EQ(r.code, 3) << r.out;
+  EXPECT_NE(r.out.find("INCOMPLETE: axis Mz flagged invalid"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find(": OK"), std::string::npos) << r.out;
+  // Mz loaded only in proportion to Fx (a lever that never changes): the load set lacks the
+  // rank to tell them apart, so both are named.
+  r = Ftsim("record --sensor builtin --profile " + P("tied.csv") + " --rate-hz 100 --out " +
+            P("tied_rig.csv"));
+  ASSERT_EQ(r.code, 0) << r.out;
+  r = Ftcal("fit --in " + P("tied_rig.csv") + " --out " + P("tied.json") + " --sensor builtin");
+  EXPECT_NE(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("axes Fx, Mz not excited"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("independent of the other axes 0.0 %"), std::string::npos) << r.out;
+}
+
 TEST_F(FtcalCli, ImportAtiThenInstallIntoSlots) {
   const std::string ati = ftstack::test::TestDataPath("ati/FT11712.cal");
   CliRun r = Ftcal("import-ati " + ati + " --out " + P("ati.json"));
@@ -118,17 +205,6 @@ TEST_F(FtcalCli, ImportAtiThenInstallIntoSlots) {
   r = Ftcal("active --slots " + P("dev"));
   EXPECT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("slot A: serial FT11712"), std::string::npos) << r.out;
-}
-
-/// Runs ftsim (the record helper's generator, with its effects) and fits its "real" output.
-CliRun Ftsim(const std::string& args) {
-  const std::string cmd = std::string(FTSTACK_BIN_DIR) + "/ftsim " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (p != nullptr && std::fgets(buf, sizeof buf, p) != nullptr) out += buf;
-  const int status = p != nullptr ? pclose(p) : -1;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
 }
 
 TEST_F(FtcalCli, RecordingsFromFtsimWithEffectsPickTheRightModelAtTheNoiseFloor) {

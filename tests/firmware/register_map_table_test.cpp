@@ -217,6 +217,8 @@ const std::vector<UnitRule>& UnitRules() {
                                               {"°C", "_c", "°C"},
                                               {"m", "_m", "m"},
                                               {"deg", "_deg", "deg"},
+                                              {"kg", "_kg", "kg"},
+                                              {"m/s²", "_mps2", "m/s²"},
                                               {"samples", "", "samples"},
                                               {"", "", ""}};
   return rules;
@@ -232,7 +234,7 @@ struct Expected {
 std::map<std::string, Expected> ReferenceInputValues(
     const std::array<std::int32_t, hal::kMaxChannels>& counts, const LoadReport& report) {
   std::map<std::string, Expected> e;
-  e["map_version"] = {1, 0, "uint16"};
+  e["map_version"] = {2, 0, "uint16"};
   e["status"] = {0, 0, "uint16"};
   e["sequence"] = {3, 0, "uint32"};
   e["timestamp_us"] = {0.002, 1e-12, "uint32"};  // third sample at 1 kHz, in s after scaling
@@ -256,6 +258,9 @@ std::map<std::string, Expected> ReferenceInputValues(
   e["cal_crc32"] = {static_cast<double>(0xCAFEF00Du), 0, "uint32"};
   e["late_samples"] = {0, 0, "uint32"};
   e["timestamp_wraps"] = {0, 0, "uint16"};
+  e["payload_mass_kg"] = {2.375, 2.375 * 6e-8, "float32"};  // the payload CodeCheck loads
+  e["payload_crc32"] = {static_cast<double>(0x0BADC0DEu), 0, "uint32"};
+  for (int a = 81; a <= 84; ++a) e["reserved_" + std::to_string(a)] = {0, 0, "uint16"};
   return e;
 }
 
@@ -274,6 +279,12 @@ class CodeCheck : public maptest::RegisterMapTest {
   std::vector<std::string> Run(const std::vector<Tag>& tags) {
     SetUp();
     cfg_.slots[1] = cfg_.slots[0];  // so that slot 1 can be selected
+    // A payload, so that gravity compensation can be switched on (holding 28 = 1).
+    if (MakeFixedPayload(2.375, {0.01, 0.02, 0.03}, {0, 0, 0}, {0, 0, 0}, &cfg_.payload) !=
+        PayloadStatus::kOk) {
+      return {"payload refused"};
+    }
+    cfg_.payload_crc = 0x0BADC0DEu;
     StartDevice();
     adc_.counts = {400000, -300000, 1000000, 50000, -60000, 70000};
     Step(3);
@@ -353,7 +364,7 @@ class CodeCheck : public maptest::RegisterMapTest {
       if (t.table != "holding") continue;
       for (int i = 0; i < t.registers; ++i) covered.insert(t.address + i);
     }
-    for (int a = 0; a < 40; ++a) {
+    for (int a = 0; a < 50; ++a) {
       std::uint16_t v = 0;
       const bool readable =
           map_->ReadHolding(static_cast<std::uint16_t>(a), 1, &v) == ModbusException::kNone;
@@ -438,7 +449,7 @@ TEST(RegisterMapTable, MarkdownAndCsvListTheSameTags) {
   const auto md = ParseMarkdown(ReadText("docs/spec/modbus-map.md"), &errors);
   const auto csv = ParseCsv(ReadText("docs/spec/modbus-map.csv"), &errors);
   EXPECT_TRUE(errors.empty()) << Join(errors);
-  EXPECT_EQ(md.size(), 57u);  // 41 input tags, 16 holding tags
+  EXPECT_EQ(md.size(), 74u);  // 47 input tags, 27 holding tags (16 + 5 gravity + 6 mount)
   const auto diffs = CompareTables(md, csv);
   EXPECT_TRUE(diffs.empty()) << Join(diffs);
 }

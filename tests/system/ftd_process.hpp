@@ -21,14 +21,17 @@ extern char** environ;
 namespace ftstack::test {
 
 /// A child ftd process. Its stderr goes to a file; with --modbus-tcp 127.0.0.1:0 the port it bound
-/// is read from its "serving Modbus TCP on HOST:PORT" line.
+/// is read from its "serving Modbus TCP on HOST:PORT" line. `wrapper` (absolute path first) runs
+/// ftd through a program that execs it, e.g. setpriv, so that the PID stays ftd's.
 class FtdProcess {
  public:
-  explicit FtdProcess(std::vector<std::string> args, bool want_tcp = true) {
+  explicit FtdProcess(std::vector<std::string> args, bool want_tcp = true,
+                      std::vector<std::string> wrapper = {}) {
     char tmpl[] = "/tmp/ftd_test_stderr_XXXXXX";
     const int fd = mkstemp(tmpl);
     stderr_path_ = tmpl;
-    std::vector<std::string> argv_s{std::string(FTSTACK_BIN_DIR) + "/ftd"};
+    std::vector<std::string> argv_s = wrapper;
+    argv_s.push_back(std::string(FTSTACK_BIN_DIR) + "/ftd");
     argv_s.insert(argv_s.end(), args.begin(), args.end());
     std::vector<char*> argv;
     for (std::string& a : argv_s) argv.push_back(a.data());

@@ -29,6 +29,10 @@ struct Tmp {
   std::string operator/(const std::string& f) const { return (dir / f).string(); }
 };
 
+/// The generator's rated range (ftcal fit needs --sensor or --rated; a counts recording has no
+/// sensor description).
+const std::string kRated = " --rated 40,40,80,2,2,1.5";
+
 int RunFtcal(const std::string& args, const std::string& err) {
   const std::string cmd = std::string(FTSTACK_BIN_DIR) + "/ftcal " + args + " >/dev/null 2>" + err;
   const int rc = std::system(cmd.c_str());
@@ -177,7 +181,7 @@ TEST(FtcalUnits, DeclaredTenBitCountsFitAndApplyAsWellAsPlainLeastSquares) {
     Write(test, rows, true, true, mod);
     const std::string cal = tmp / "cal.json";
     const std::string model = mod == 0 ? " --model linear" : "";  // split 3: model chosen by CV
-    ASSERT_EQ(RunFtcal("fit --in " + train + " --out " + cal + model, tmp / "fit.err"), 0)
+    ASSERT_EQ(RunFtcal("fit --in " + train + " --out " + cal + model + kRated, tmp / "fit.err"), 0)
         << Slurp(tmp / "fit.err");
     const std::string text = Slurp(cal);
     EXPECT_NE(text.find("\"input_unit\": \"mV/V\""), std::string::npos) << text.substr(0, 400);
@@ -209,7 +213,8 @@ TEST(FtcalUnits, UndeclaredCountsAreRefusedWithOneLineNamingLineAndColumn) {
   const std::vector<Row> rows = Generate(5);
   const std::string train = tmp / "undeclared.csv";
   Write(train, rows, false, false, 0);
-  EXPECT_EQ(RunFtcal("fit --in " + train + " --out " + (tmp / "cal.json"), tmp / "fit.err"), 1);
+  EXPECT_EQ(
+      RunFtcal("fit --in " + train + " --out " + (tmp / "cal.json") + kRated, tmp / "fit.err"), 1);
   const std::string err = Slurp(tmp / "fit.err");
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
   // First data row is line 3 (one metadata line, the header); b0 is field 10.
@@ -229,7 +234,7 @@ TEST(FtcalUnits, UndeclaredCountsAreRefusedWithOneLineNamingLineAndColumn) {
   EXPECT_FALSE(fs::exists(tmp / "cal.json"));
   // Declared on the command line instead, the same file fits.
   EXPECT_EQ(RunFtcal("fit --in " + train + " --out " + (tmp / "cal.json") +
-                         " --converter bits=10,coding=unsigned,gain=200",
+                         " --converter bits=10,coding=unsigned,gain=200" + kRated,
                      tmp / "fit2.err"),
             0)
       << Slurp(tmp / "fit2.err");
@@ -240,7 +245,7 @@ TEST(FtcalUnits, ApplyRefusesOutOfRangeCodesAndFlagsSaturatedRows) {
   const std::vector<Row> rows = Generate(7);
   Write(tmp / "train.csv", rows, true, false, 1);
   ASSERT_EQ(RunFtcal("fit --in " + (tmp / "train.csv") + " --out " + (tmp / "cal.json") +
-                         " --model linear",
+                         " --model linear" + kRated,
                      tmp / "fit.err"),
             0);
   // A code beyond 10 bits: refused with one line, no output written.

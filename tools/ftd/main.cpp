@@ -22,6 +22,21 @@ void OnSignal(int) { g_stop = true; }
 }  // namespace
 
 namespace {
+/// The --rdt options (ATI Net F/T RDT server).
+void AddRdtOptions(CLI::App& app, ftstack::daemon::FtdOptions& opt) {
+  app.add_option("--rdt", opt.rdt,
+                 "serve ATI Net F/T RDT over UDP on HOST:PORT (ATI's port: 49152; 0: any free)");
+  app.add_option("--rdt-counts-per-n", opt.rdt_counts_per_n, "RDT counts per N (Fx Fy Fz)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--rdt-counts-per-nm", opt.rdt_counts_per_nm, "RDT counts per N·m (Tx Ty Tz)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--rdt-buffer", opt.rdt_buffer, "RDT records per packet in buffered mode")
+      ->check(CLI::Range(1u, 40u));
+  app.add_option("--rdt-status-mask", opt.rdt_status_mask,
+                 "status bits copied into RDT records (default 0xFFFF: all)")
+      ->check(CLI::Range(0u, 0xFFFFu));
+}
+
 int Run(int argc, char** argv) {
   using namespace ftstack;
   CLI::App app{"ftd — force/torque sensor daemon (firmware main loop on a board or host)"};
@@ -40,9 +55,12 @@ int Run(int argc, char** argv) {
   app.add_option("--cal", opt.cal,
                  "calibration file, slot 0 (default: the simulated sensor's own)");
   app.add_option("--cal-b", opt.cal_b, "calibration file for slot 1 (holding register 3)");
+  app.add_option("--payload", opt.payload,
+                 "payload file (ftcal payload) for gravity compensation (holding 22–28)");
   app.add_option("--modbus-tcp", opt.modbus_tcp,
                  "serve Modbus TCP on HOST:PORT (port 0: any free)");
   app.add_option("--modbus-rtu", opt.modbus_rtu, "serve Modbus RTU on a serial DEVICE");
+  AddRdtOptions(app, opt);
   app.add_option("--baud", opt.baud, "RTU baud rate")->check(CLI::Range(300u, 4000000u));
   app.add_option("--parity", parity, "RTU parity N|E|O")->check(CLI::IsMember({"N", "E", "O"}));
   app.add_option("--unit-id", opt.unit_id, "Modbus unit id")->check(CLI::Range(1u, 247u));
@@ -56,6 +74,10 @@ int Run(int argc, char** argv) {
   app.add_option("--print-hz", print_hz,
                  "rate of reading lines on stdout (default: 5, or 0 when stderr is a terminal and "
                  "shows the status line)");
+  std::string sim_stall;
+  app.add_option("--sim-stall", sim_stall,
+                 "simulated ADC: hold the sampling thread MS ms on every EVERY-th sample, "
+                 "EVERY:MS (tests the late-sample counter)");
   app.add_flag("--unpaced", unpaced, "run the simulated ADC as fast as possible (benchmarks)");
   app.get_option("--sim-wrench")->excludes(app.get_option("--replay"));
   CLI11_PARSE(app, argc, argv);
@@ -66,6 +88,20 @@ int Run(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ftd: --sim-wrench: %s\n", e.what());
     return 2;
+  }
+  if (!sim_stall.empty()) {
+    unsigned every = 0;
+    double ms = 0;
+    char tail = 0;
+    if (std::sscanf(sim_stall.c_str(), "%u:%lf%c", &every, &ms, &tail) != 2 || every < 1 ||
+        !(ms > 0 && ms <= 10000)) {
+      std::fprintf(stderr,
+                   "ftd: --sim-stall '%s': expected EVERY:MS (EVERY >= 1, 0 < MS <= 10000)\n",
+                   sim_stall.c_str());
+      return 2;
+    }
+    opt.sim_stall_every = every;
+    opt.sim_stall_ms = ms;
   }
 
   std::signal(SIGINT, OnSignal);
@@ -129,6 +165,11 @@ int Run(int argc, char** argv) {
                static_cast<unsigned long long>(st.samples), st.elapsed_s,
                st.elapsed_s > 0 ? static_cast<double>(st.samples) / st.elapsed_s : 0.0,
                st.log_dropped > 0 ? " — log dropped samples" : "");
+  if (st.adc_errors > 0) {
+    std::fprintf(stderr, "ftd: %llu failed ADC steps, %llu back-off pauses\n",
+                 static_cast<unsigned long long>(st.adc_errors),
+                 static_cast<unsigned long long>(st.backoffs));
+  }
   return 0;
 }
 }  // namespace

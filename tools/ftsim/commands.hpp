@@ -9,5 +9,7 @@ namespace ftstack::tools {
 void AddPivotCommand(CLI::App& app);
 /// `ftsim record …` — recordings with known physics and injected effects (docs/spec/cli.md).
 void AddRecordCommand(CLI::App& app);
+/// `ftsim design …` — sensor-body design explorer (docs/spec/cli.md, docs/design.md).
+void AddDesignCommand(CLI::App& app);
 
 }  // namespace ftstack::tools

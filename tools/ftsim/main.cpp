@@ -8,6 +8,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   ftstack::tools::AddPivotCommand(app);
   ftstack::tools::AddRecordCommand(app);
+  ftstack::tools::AddDesignCommand(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

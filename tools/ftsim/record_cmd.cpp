@@ -50,9 +50,9 @@ void AddRecordCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "record", "simulated recording of a load profile, with injected effects (docs/effects.md)");
   cmd->add_option("--sensor", opt->sensor, "sensor description JSON, or 'builtin'");
-  cmd->add_option(
-      "--profile", opt->profile,
-      "rig | taps | thermal | hold | PROFILE.json (keyframes) | REC.csv (wrench columns)");
+  cmd->add_option("--profile", opt->profile,
+                  "rig | taps | thermal | hold | base-pick | base-tilt | base-estop | PROFILE.json "
+                  "(keyframes) | REC.csv (wrench columns)");
   cmd->add_option("--out", opt->out, "the 'real' recording (effects, noise, quantisation)")
       ->required();
   cmd->add_option("--sim-out", opt->sim_out, "the model's noise-free prediction without effects");
