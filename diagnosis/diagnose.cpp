@@ -409,15 +409,33 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
     const double cost_new = Score(cx, rest, &lagged->pred).hold_sse + lagged->n_params * log_hold;
     if (thermal || cost_new < cost_old) claimed[k] = std::move(*lagged);
   }
+  // A time-based partner of a load effect that one offset per load hold explains as well (a misfit
+  // of the first effect's shape left from hold to hold, which a time curve follows) is not
+  // claimed: the data cannot tell it from the first effect's remainder.
+  std::vector<Confounding> partner_conf;
+  if (claimed.size() == 2 && !IsTimeBased(claimed[0].name)) {
+    const Mat rest = cx.resid - claimed[0].pred;
+    partner_conf.push_back(CheckConfounders(cx, rest, claimed[1], options.z_claim));
+    const auto& with = partner_conf.back().with;
+    if (std::find(with.begin(), with.end(), "hold_offsets") != with.end()) {
+      r.dropped.push_back(claimed[1].name + ": " + partner_conf.back().words);
+      claimed.pop_back();
+      partner_conf.clear();
+    }
+  }
   Mat cum = Mat::Zero(cx.n, cx.nc);
-  for (auto& f : claimed) {
+  for (std::size_t k = 0; k < claimed.size(); ++k) {
+    EffectFit& f = claimed[k];
     ClaimedEffect ce;
     ce.hold_rms_before = HoldRms(cx, cx.resid, &cum);
     cum += f.pred;
     ce.hold_rms_after = HoldRms(cx, cx.resid, &cum);
     ce.rms_after = ChannelRms(cx.resid - cum);
     // Each effect is tested against its confounders on what the other claimed effects leave.
-    const Confounding conf = CheckConfounders(cx, cx.resid - (cum - f.pred), f, options.z_claim);
+    const Confounding conf =
+        k == 1 && !partner_conf.empty()
+            ? partner_conf.front()
+            : CheckConfounders(cx, cx.resid - (cum - f.pred), f, options.z_claim);
     ce.confounded_with = conf.with;
     ce.confounding = conf.words;
     ce.fit = std::move(f);
@@ -482,6 +500,7 @@ nlohmann::json ToJson(const Report& r) {
     effects.push_back(ej);
   }
   j["effects"] = effects;
+  if (!r.dropped.empty()) j["not_claimed"] = r.dropped;
   j["holdout"] = {{"rms_before", r.hold_rms_before},
                   {"rms_after", r.hold_rms_after},
                   {"rows", r.cx.n_hold},

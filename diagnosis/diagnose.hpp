@@ -56,6 +56,9 @@ struct Report {
   std::string verdict = "none";
   std::vector<ClaimedEffect> effects;
   std::vector<CandidateScore> candidates;  ///< every single effect tried, best score first
+  /// Partners of a pair left unclaimed, with the reason (a time-based partner that one offset
+  /// per load hold explains as well, diagnosis.md "not_claimed").
+  std::vector<std::string> dropped;
   double hold_rms_before = 0.0;
   double hold_rms_after = 0.0;
   Eigen::MatrixXd model;               ///< n × N: the claimed effects' total prediction

@@ -86,6 +86,11 @@ struct EffectSpec {
 /// hysteresis as one rate-independent operator (Dahl or play, width searched) per bridge.
 [[nodiscard]] std::optional<EffectFit> FitHysteresisOperator(const Context& cx,
                                                              const Eigen::MatrixXd& target);
+/// hysteresis in the load path: one operator (Dahl or play, width searched) or a
+/// Prandtl–Ishlinskii sum of plays of fixed widths on each reference wrench axis, mapped to the
+/// bridges by the sensitivity cx.sens (effects/hysteresis_axes.cpp).
+[[nodiscard]] std::optional<EffectFit> FitHysteresisAxes(const Context& cx,
+                                                         const Eigen::MatrixXd& target);
 /// hysteresis of general rate-independent shape: the one-operator fit or a Preisach superposition
 /// of relays (thresholds on 8 quantiles of each bridge's load, weights fitted per bridge; this
 /// class contains Prandtl–Ishlinskii sums of play operators), whichever has the lower training

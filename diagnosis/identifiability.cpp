@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <map>
 
@@ -71,31 +72,82 @@ bool IsTimeBased(const std::string& name) {
          name.rfind("thermal", 0) == 0;
 }
 
+namespace {
+
+/// Wrench of every row quantised to 0.5 % of each axis's range.
+std::vector<std::array<long long, 6>> LoadKeys(const DiagData& d, int n) {
+  std::array<double, 6> step{};
+  for (int a = 0; a < 6; ++a) {
+    const double range = d.wrench.col(a).maxCoeff() - d.wrench.col(a).minCoeff();
+    step[static_cast<std::size_t>(a)] = range > 0 ? 0.005 * range : 1.0;
+  }
+  std::vector<std::array<long long, 6>> keys(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    for (int a = 0; a < 6; ++a) {
+      keys[static_cast<std::size_t>(i)][static_cast<std::size_t>(a)] =
+          std::llround(d.wrench(i, a) / step[static_cast<std::size_t>(a)]);
+    }
+  }
+  return keys;
+}
+
+/// One group per load hold (a run of ≥ 0.25 s at one quantised load) together with the movement
+/// that leads into it; a new group also at every segment start.
+std::vector<int> HoldGroups(const Context& cx, int* groups) {
+  const auto keys = LoadKeys(*cx.data, cx.n);
+  const int min_run = std::max(3, static_cast<int>(std::lround(0.25 * cx.rate_hz)));
+  std::vector<int> g(static_cast<std::size_t>(cx.n), 0);
+  int id = 0;
+  int run = 1;
+  bool counted = false;  // the current run already opened a group
+  for (int i = 1; i < cx.n; ++i) {
+    const bool restart = !cx.restart.empty() && cx.restart[static_cast<std::size_t>(i)] != 0;
+    if (restart) {
+      ++id;
+      run = 1;
+      counted = true;
+    } else if (keys[static_cast<std::size_t>(i)] == keys[static_cast<std::size_t>(i - 1)]) {
+      ++run;
+    } else {
+      run = 1;
+      counted = false;
+    }
+    if (run >= min_run && !counted) {
+      counted = true;
+      // The hold began min_run − 1 rows ago: the group changes after the previous hold.
+      if (i > min_run) ++id;
+      for (int k = std::max(0, i - min_run + 1); k <= i; ++k) g[static_cast<std::size_t>(k)] = id;
+    }
+    g[static_cast<std::size_t>(i)] = id;
+  }
+  *groups = id + 1;
+  if (*groups < 2 || *groups * 20 > cx.n) {
+    *groups = 0;
+    return {};
+  }
+  return g;
+}
+
+}  // namespace
+
 std::vector<int> ConfounderGroups(const Context& cx, const std::string& name, int* groups) {
   const DiagData& d = *cx.data;
   std::vector<int> g;
   *groups = 0;
+  if (name == "hold_offsets") return d.has_wrench() ? HoldGroups(cx, groups) : g;
   if (name == "segment_offsets") {
     if (cx.segments < 2 || d.segment.size() != static_cast<std::size_t>(cx.n)) return g;
     *groups = cx.segments;
     return d.segment;
   }
   if (name == "load_function" && d.has_wrench()) {
-    std::array<double, 6> step{};
-    for (int a = 0; a < 6; ++a) {
-      const double range = d.wrench.col(a).maxCoeff() - d.wrench.col(a).minCoeff();
-      step[static_cast<std::size_t>(a)] = range > 0 ? 0.005 * range : 1.0;
-    }
+    const auto keys = LoadKeys(d, cx.n);
     std::map<std::array<long long, 6>, int> seen;
     g.resize(static_cast<std::size_t>(cx.n));
     for (int i = 0; i < cx.n; ++i) {
-      std::array<long long, 6> key{};
-      for (int a = 0; a < 6; ++a) {
-        key[static_cast<std::size_t>(a)] =
-            std::llround(d.wrench(i, a) / step[static_cast<std::size_t>(a)]);
-      }
       g[static_cast<std::size_t>(i)] =
-          seen.emplace(key, static_cast<int>(seen.size())).first->second;
+          seen.emplace(keys[static_cast<std::size_t>(i)], static_cast<int>(seen.size()))
+              .first->second;
     }
     if (seen.size() < 2 || static_cast<int>(seen.size()) * 20 > cx.n) return {};
     *groups = static_cast<int>(seen.size());
@@ -106,7 +158,10 @@ std::vector<int> ConfounderGroups(const Context& cx, const std::string& name, in
 Confounding CheckConfounders(const Context& cx, const Mat& target, const EffectFit& fit,
                              double z_claim) {
   Confounding out;
-  if (!IsTimeBased(fit.name)) return out;
+  // Hysteresis depends on the load's history: where every load is held once (static poses, no
+  // return to a load from the other side) an offset per load or per recording mimics it.
+  const bool history = fit.name == "hysteresis";
+  if (!IsTimeBased(fit.name) && !history) return out;
   const EffectSpec* spec = FindEffect(fit.name);
   if (spec == nullptr) return out;
   double delta_alone = 0.0;
@@ -149,18 +204,28 @@ Confounding CheckConfounders(const Context& cx, const Mat& target, const EffectF
     return *z_rest > z_claim && delta > 0.0;
   };
   std::vector<std::string> words;
-  for (const char* name : {"segment_offsets", "load_function"}) {
+  for (const char* name : {"segment_offsets", "load_function", "hold_offsets"}) {
+    if (history && std::string(name) == "hold_offsets") continue;  // hysteresis is one
     int groups = 0;
     const std::vector<int> g = ConfounderGroups(cx, name, &groups);
     if (g.empty()) continue;
     double z_rest = 0.0;
     const auto offsets = [&](const Mat& y) { return GroupOffsets(cx, y, g, groups); };
-    if (beyond(offsets, groups * cx.nc, &z_rest)) continue;
+    const bool identified = beyond(offsets, groups * cx.nc, &z_rest);
+    if (std::getenv("FTDIAG_DEBUG") != nullptr) {
+      std::fprintf(stderr, "confounder %s (%d groups) for %s: z_rest %.1f -> %s\n", name, groups,
+                   fit.name.c_str(), z_rest, identified ? "identified" : "confounded");
+    }
+    if (identified) continue;
     out.with.push_back(name);
+    const std::string what = name;
     words.push_back(
-        std::string(name == std::string("segment_offsets")
-                        ? Fmt("one offset per joined recording (%.0f segments)", groups, 0)
-                        : Fmt("one offset per distinct static load (%.0f loads)", groups, 0)) +
+        (what == "segment_offsets"
+             ? Fmt("one offset per joined recording (%.0f segments)", groups, 0)
+         : what == "load_function"
+             ? Fmt("one offset per distinct static load (%.0f loads)", groups, 0)
+             : Fmt("one offset per load hold (%.0f holds: a function of the load's history)",
+                   groups, 0)) +
         Fmt(" explains it as well: beyond that, the effect improves the held-out rows "
             "by z = %.1f only (alone z = %.1f)",
             z_rest, z_alone));

@@ -11,8 +11,9 @@ namespace ftstack::diag {
 
 /// What a claimed effect could not be told apart from.
 struct Confounding {
-  std::vector<std::string> with;  ///< "segment_offsets", "load_function", "zero_drift"
-  std::string words;              ///< one sentence for a person
+  std::vector<std::string>
+      with;           ///< "segment_offsets", "load_function", "hold_offsets", "zero_drift"
+  std::string words;  ///< one sentence for a person
 };
 
 /// True for the effects whose shape is a function of time (zero_drift, excitation_drift,
@@ -28,6 +29,8 @@ struct Confounding {
 ///  - segment_offsets: one offset per channel and joined recording (≥ 2 segments);
 ///  - load_function: one offset per channel and distinct static load (the wrench quantised to
 ///    0.5 % of each axis's range; only where loads are held, ≤ rows/20 distinct loads);
+///  - hold_offsets: one offset per channel and load hold (a run of ≥ 0.25 s at one load, with the
+///    movement into it): any function of the load's history (a hysteresis or creep misfit);
 ///  - zero_drift, for thermal effects when the temperature is monotone in time (|Spearman ρ| >
 ///    0.95).
 [[nodiscard]] Confounding CheckConfounders(const Context& cx, const Eigen::MatrixXd& target,

@@ -51,11 +51,30 @@ RelayGrid MakeGrid(const double* x, std::size_t n) {
   return g;
 }
 
+/// The lower training BIC of two fits (either may be absent).
+std::optional<EffectFit> LowerBic(const Context& cx, std::optional<EffectFit> a,
+                                  std::optional<EffectFit> b) {
+  if (!a) return b;
+  if (!b) return a;
+  const double log_n = std::log(std::max<double>(2.0, static_cast<double>(cx.n_train)));
+  return a->train_sse_w + a->n_params * log_n <= b->train_sse_w + b->n_params * log_n ? a : b;
+}
+
+std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Eigen::MatrixXd& target);
+
 }  // namespace
 
 std::optional<EffectFit> FitHysteresisFamily(const Context& cx, const Eigen::MatrixXd& target) {
-  auto single = FitHysteresisOperator(cx, target);
-  if (cx.n < 4 * kRelays) return single;
+  // In the load path (operators on the wrench axes, seen through the sensitivity) or in each
+  // bridge (one operator, or a Preisach sum of relays): the lowest training BIC.
+  auto best = LowerBic(cx, FitHysteresisAxes(cx, target), FitHysteresisOperator(cx, target));
+  if (cx.n < 4 * kRelays) return best;
+  return LowerBic(cx, best, FitHysteresisPreisach(cx, target));
+}
+
+namespace {
+
+std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Eigen::MatrixXd& target) {
   const auto n = static_cast<std::size_t>(cx.n);
   EffectFit e;
   e.name = "hysteresis";
@@ -104,10 +123,6 @@ std::optional<EffectFit> FitHysteresisFamily(const Context& cx, const Eigen::Mat
     sse_w += r.sse * cx.weight(c) * cx.search_stride;
   }
   e.train_sse_w = sse_w;
-  const double log_n = std::log(std::max<double>(2.0, static_cast<double>(cx.n_train)));
-  if (single && single->train_sse_w + single->n_params * log_n <= sse_w + e.n_params * log_n) {
-    return single;
-  }
   e.params["relay_levels"] = kLevels;
   e.params["loop_half_height_mvv"] = weights;
   e.sigma["loop_half_height_mvv"] = sigmas;
@@ -133,4 +148,5 @@ std::optional<EffectFit> FitHysteresisFamily(const Context& cx, const Eigen::Mat
   return e;
 }
 
+}  // namespace
 }  // namespace ftstack::diag
