@@ -59,8 +59,48 @@ struct AxisOperators {
   }
 };
 
-/// Whitened least squares of target ≈ S · (β_axis · z) over the training rows (every stride-th):
-/// XᵀWX = Σ G(k,l)·z_k z_l with G = SᵀWS, so a row costs p² and not N·p².
+/// The training rows grouped in runs of one wrench: rate-independent operators change state only
+/// when the load moves, so every statistic is accumulated once per run (a hold of 600 rows costs
+/// one step). Per run: its first row, the (every stride-th) training rows' count, Σ SᵀW·y (6) and
+/// Σ yᵀW·y.
+struct Runs {
+  std::vector<int> first;
+  std::vector<double> count;
+  Mat swy;  ///< runs × 6
+  double yy = 0.0;
+  double rows = 0.0;
+  int stride = 1;
+};
+
+Runs MakeRuns(const Context& cx, const Mat& target, int stride) {
+  const Mat& w = cx.data->wrench;
+  Runs r;
+  r.stride = stride;
+  std::vector<double> acc;
+  for (int i = 0; i < cx.n; ++i) {
+    const bool restart = !cx.restart.empty() && cx.restart[static_cast<std::size_t>(i)] != 0;
+    if (i == 0 || restart || w.row(i) != w.row(i - 1)) {
+      r.first.push_back(i);
+      r.count.push_back(0.0);
+      acc.resize(acc.size() + 6, 0.0);
+    }
+    if (!cx.train[static_cast<std::size_t>(i)] || i % stride != 0) continue;
+    double* sw = acc.data() + acc.size() - 6;
+    for (int c = 0; c < cx.nc; ++c) {
+      const double wy = cx.weight(c) * target(i, c);
+      r.yy += wy * target(i, c);
+      for (int a = 0; a < 6; ++a) sw[a] += cx.sens(c, a) * wy;
+    }
+    r.count.back() += 1.0;
+    r.rows += 1.0;
+  }
+  r.swy = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>>(
+      acc.data(), static_cast<Eigen::Index>(r.first.size()), 6);
+  return r;
+}
+
+/// Whitened least squares of target ≈ S · (β_axis · z) over the runs' training rows:
+/// XᵀWX = Σ G(k,l)·z_k z_l with G = SᵀWS, so a run costs p² and not N·p².
 struct AxisFit {
   Eigen::VectorXd beta;
   Mat cov_unit;
@@ -68,7 +108,7 @@ struct AxisFit {
   double rows = 0.0;
 };
 
-AxisFit Solve(const Context& cx, const Mat& target, AxisOperators ops, int stride) {
+AxisFit Solve(const Context& cx, const Runs& runs, AxisOperators ops) {
   const DiagData& d = *cx.data;
   const int p = ops.p();
   const int na = static_cast<int>(ops.axes.size());
@@ -77,21 +117,25 @@ AxisFit Solve(const Context& cx, const Mat& target, AxisOperators ops, int strid
   const Mat g = s_ax.transpose() * cx.weight.asDiagonal() * s_ax;
   Mat zz = Mat::Zero(p, p);
   Eigen::VectorXd zy = Eigen::VectorXd::Zero(p);
-  double yy = 0.0;
-  double rows = 0.0;
   std::vector<double> z(static_cast<std::size_t>(p));
-  Eigen::VectorXd swy(na);
   ops.Reset();
-  for (int i = 0; i < cx.n; ++i) {
+  for (std::size_t k = 0; k < runs.first.size(); ++k) {
+    const int i = runs.first[k];
     const bool restart = !cx.restart.empty() && cx.restart[static_cast<std::size_t>(i)] != 0;
     ops.Step(d.wrench, i, restart, z.data());
-    if (!cx.train[static_cast<std::size_t>(i)] || i % stride != 0) continue;
-    const Eigen::Map<const Eigen::VectorXd> zv(z.data(), p);
-    zz.selfadjointView<Eigen::Lower>().rankUpdate(zv);
-    swy = s_ax.transpose() * (cx.weight.array() * target.row(i).transpose().array()).matrix();
-    for (int f = 0; f < p; ++f) zy(f) += zv(f) * swy(f / ops.per_axis);
-    yy += (target.row(i).array().square() * cx.weight.transpose().array()).sum();
-    rows += 1.0;
+    const double m = runs.count[k];
+    if (m == 0.0) continue;
+    // Lower triangle by hand (a small dynamic rankUpdate costs more); relays are often 0.
+    double* zz_data = zz.data();
+    for (int f = 0; f < p; ++f) {
+      const double zf = m * z[static_cast<std::size_t>(f)];
+      if (zf == 0.0) continue;
+      double* col = zz_data + static_cast<std::ptrdiff_t>(f) * p;
+      for (int h = f; h < p; ++h) col[h] += zf * z[static_cast<std::size_t>(h)];
+      zy(f) += z[static_cast<std::size_t>(f)] *
+               runs.swy(static_cast<Eigen::Index>(k),
+                        ops.axes[static_cast<std::size_t>(f / ops.per_axis)]);
+    }
   }
   zz = zz.selfadjointView<Eigen::Lower>();
   Mat xtx(p, p);
@@ -102,25 +146,29 @@ AxisFit Solve(const Context& cx, const Mat& target, AxisOperators ops, int strid
   AxisFit out;
   out.cov_unit = ridge.ldlt().solve(Mat::Identity(p, p));
   out.beta = out.cov_unit * zy;
-  out.sse_w = std::max(0.0, yy - 2.0 * out.beta.dot(zy) + out.beta.dot(xtx * out.beta)) * stride;
-  out.rows = rows * stride;
+  out.sse_w =
+      std::max(0.0, runs.yy - 2.0 * out.beta.dot(zy) + out.beta.dot(xtx * out.beta)) * runs.stride;
+  out.rows = runs.rows * runs.stride;
   return out;
 }
 
-Mat Predict(const Context& cx, AxisOperators ops, const Eigen::VectorXd& beta) {
+Mat Predict(const Context& cx, const Runs& runs, AxisOperators ops, const Eigen::VectorXd& beta) {
   const int p = ops.p();
   Mat pred(cx.n, cx.nc);
   std::vector<double> z(static_cast<std::size_t>(p));
   Eigen::VectorXd dw(6);
   ops.Reset();
-  for (int i = 0; i < cx.n; ++i) {
-    const bool restart = !cx.restart.empty() && cx.restart[static_cast<std::size_t>(i)] != 0;
-    ops.Step(cx.data->wrench, i, restart, z.data());
+  for (std::size_t k = 0; k < runs.first.size(); ++k) {
+    const int i0 = runs.first[k];
+    const int i1 = k + 1 < runs.first.size() ? runs.first[k + 1] : cx.n;
+    const bool restart = !cx.restart.empty() && cx.restart[static_cast<std::size_t>(i0)] != 0;
+    ops.Step(cx.data->wrench, i0, restart, z.data());
     dw.setZero();
     for (int f = 0; f < p; ++f)
       dw(ops.axes[static_cast<std::size_t>(f / ops.per_axis)]) +=
           beta(f) * z[static_cast<std::size_t>(f)];
-    pred.row(i) = (cx.sens * dw).transpose();
+    const Eigen::RowVectorXd row = (cx.sens * dw).transpose();
+    for (int i = i0; i < i1; ++i) pred.row(i) = row;
   }
   return pred;
 }
@@ -174,7 +222,7 @@ std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Mat& target)
     if (range(k) > 0 && cx.sens.col(k).norm() > 0) axes.push_back(k);
   }
   if (axes.empty()) return std::nullopt;
-  const int st = cx.search_stride;
+  const Runs runs = MakeRuns(cx, target, cx.search_stride);
   const double pen = std::log(std::max(2.0, static_cast<double>(cx.n_train) * cx.nc));
   // One operator per axis, width (fraction of each axis's range) searched; Dahl or play.
   std::vector<double> grid;
@@ -185,11 +233,11 @@ std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Mat& target)
   std::string variant;
   for (bool play : {false, true}) {
     const auto f = [&](double v) {
-      return Solve(cx, target, OneOperator(axes, range, std::exp(v), play), st).sse_w;
+      return Solve(cx, runs, OneOperator(axes, range, std::exp(v), play)).sse_w;
     };
     const double lw = MinimizeOnGrid(f, grid, 10, nullptr);
     AxisOperators o = OneOperator(axes, range, std::exp(lw), play);
-    const double cost = Solve(cx, target, o, st).sse_w + (o.p() + 1) * pen;
+    const double cost = Solve(cx, runs, o).sse_w + (o.p() + 1) * pen;
     if (cost < best_cost) {
       best_cost = cost;
       best = o;
@@ -208,7 +256,7 @@ std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Mat& target)
       pi.dahl.push_back(wf * range(a));
     }
   }
-  const double pi_cost = Solve(cx, target, pi, st).sse_w + pi.p() * pen;
+  const double pi_cost = Solve(cx, runs, pi).sse_w + pi.p() * pen;
   bool use_pi = pi_cost < best_cost;
   if (use_pi) {
     best = pi;
@@ -219,20 +267,21 @@ std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Mat& target)
   }
   // Preisach: relays on a grid of each axis's load levels (contains loops of any shape there).
   const AxisOperators relays = AxisRelays(d, axes);
-  if (cx.n > 20 * relays.p() &&
-      Solve(cx, target, relays, st).sse_w + relays.p() * pen < best_cost) {
+  if (cx.n > 20 * relays.p() && Solve(cx, runs, relays).sse_w + relays.p() * pen < best_cost) {
     best = relays;
     use_pi = true;
     variant =
         "Preisach: weighted sum of 28 relays (thresholds on 8 quantiles of the axis's load) on "
         "each wrench axis, through the sensitivity";
   }
-  const AxisFit fit = Solve(cx, target, best, 1);
+  // Final weights from every st-th training row too (the operators' states change only at load
+  // reversals and threshold crossings, so little is lost on long records); predictions on all.
+  const AxisFit fit = Solve(cx, runs, best);
   EffectFit e;
   e.name = "hysteresis";
   e.variant = variant;
   e.n_params = best.p() + (use_pi ? 0 : 1);
-  e.pred = Predict(cx, best, fit.beta);
+  e.pred = Predict(cx, runs, best, fit.beta);
   e.train_sse_w = fit.sse_w;
   const double var = fit.rows > best.p() ? fit.sse_w / (fit.rows - best.p()) : 0.0;
   // Loop half-height per axis (N or N·m): the largest reading difference at one load.
