@@ -27,8 +27,8 @@ TEST_P(DiagSim, DiagnosesTheConcealedEffect) {
   SCOPED_TRACE("case " + c.effect + " seed " + std::to_string(c.seed) + " size " +
                std::to_string(r.size_sigma) + " σ; claimed: " + named);
   // The right effect(s) named as identified. Extra effects claimed beside them are penalised by
-  // the scorecard (diag_scorecard, --min-pass); here they are reported: known over-claims remain
-  // (zero_drift beside the simulator's hysteresis and misalignment, issue 12 closing note).
+  // the scorecard (diag_scorecard, --min-pass); here they are reported: a known over-claim remains
+  // (zero_drift beside the simulator's misalignment: hold offsets do not explain it as well).
   EXPECT_TRUE(r.named_right);
   if (r.extra > 0) std::printf("note: %d extra effect(s) claimed: %s\n", r.extra, named.c_str());
   EXPECT_TRUE(r.located);
