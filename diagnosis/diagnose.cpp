@@ -226,6 +226,26 @@ bool FitPair(const Context& cx, const Mat& target, const EffectSpec& a, const Ef
   return true;
 }
 
+/// A time-based partner of a load effect that one offset per load hold explains as well (a misfit
+/// of the first effect's shape left from hold to hold, which a time curve follows) is not
+/// claimed: the data cannot tell it from the first effect's remainder. Returns the partner's
+/// confounding when it stays (empty otherwise).
+std::vector<Confounding> DropUnidentifiedPartner(const Context& cx, double z_claim,
+                                                 std::vector<EffectFit>* claimed,
+                                                 std::vector<std::string>* dropped) {
+  std::vector<Confounding> partner_conf;
+  if (claimed->size() != 2 || IsTimeBased((*claimed)[0].name)) return partner_conf;
+  const Mat rest = cx.resid - (*claimed)[0].pred;
+  partner_conf.push_back(CheckConfounders(cx, rest, (*claimed)[1], z_claim));
+  const auto& with = partner_conf.back().with;
+  if (std::find(with.begin(), with.end(), "hold_offsets") != with.end()) {
+    dropped->push_back((*claimed)[1].name + ": " + partner_conf.back().words);
+    claimed->pop_back();
+    partner_conf.clear();
+  }
+  return partner_conf;
+}
+
 }  // namespace
 
 Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
@@ -409,20 +429,8 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
     const double cost_new = Score(cx, rest, &lagged->pred).hold_sse + lagged->n_params * log_hold;
     if (thermal || cost_new < cost_old) claimed[k] = std::move(*lagged);
   }
-  // A time-based partner of a load effect that one offset per load hold explains as well (a misfit
-  // of the first effect's shape left from hold to hold, which a time curve follows) is not
-  // claimed: the data cannot tell it from the first effect's remainder.
-  std::vector<Confounding> partner_conf;
-  if (claimed.size() == 2 && !IsTimeBased(claimed[0].name)) {
-    const Mat rest = cx.resid - claimed[0].pred;
-    partner_conf.push_back(CheckConfounders(cx, rest, claimed[1], options.z_claim));
-    const auto& with = partner_conf.back().with;
-    if (std::find(with.begin(), with.end(), "hold_offsets") != with.end()) {
-      r.dropped.push_back(claimed[1].name + ": " + partner_conf.back().words);
-      claimed.pop_back();
-      partner_conf.clear();
-    }
-  }
+  const std::vector<Confounding> partner_conf =
+      DropUnidentifiedPartner(cx, options.z_claim, &claimed, &r.dropped);
   Mat cum = Mat::Zero(cx.n, cx.nc);
   for (std::size_t k = 0; k < claimed.size(); ++k) {
     EffectFit& f = claimed[k];
