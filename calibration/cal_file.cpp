@@ -63,6 +63,20 @@ hal::AdcInfo DefaultAdc(std::uint8_t channels) {
   return a;
 }
 
+hal::AdcInfo AdcForDevice(const CalFile& file, const hal::AdcInfo& device) {
+  if (file.input_unit != "counts") return device;
+  if (device.min_counts != file.adc.min_counts || device.max_counts != file.adc.max_counts) {
+    throw CalFileError("calibration " + file.serial + " is in counts of a converter with rails " +
+                       std::to_string(file.adc.min_counts) + " … " +
+                       std::to_string(file.adc.max_counts) + ", this ADC's are " +
+                       std::to_string(device.min_counts) + " … " +
+                       std::to_string(device.max_counts));
+  }
+  hal::AdcInfo a = device;
+  a.full_scale_nvv = file.adc.full_scale_nvv;
+  return a;
+}
+
 fw::FixedCalibration ToFixed(const CalFile& file, const hal::AdcInfo& adc, fw::LoadReport* report) {
   fw::FixedCalibration fixed{};
   fw::LoadReport rep{};

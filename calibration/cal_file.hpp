@@ -84,6 +84,11 @@ void CrashPoint(const std::string& step);
 /// The default ADC of the simulated sensor: 24-bit, ±3.90625 mV/V (gain 128, ratio 0.5).
 [[nodiscard]] hal::AdcInfo DefaultAdc(std::uint8_t channels);
 
+/// The ADC description a device uses for `file`: the device's own for a calibration in mV/V; for
+/// one in raw counts, the file's scale with the device's rate, provided the device's rails are the
+/// file's converter's (else CalFileError naming both).
+[[nodiscard]] hal::AdcInfo AdcForDevice(const CalFile& file, const hal::AdcInfo& device);
+
 /// Converts to the firmware's integer form for `adc`; throws CalFileError on refusal.
 [[nodiscard]] fw::FixedCalibration ToFixed(const CalFile& file, const hal::AdcInfo& adc,
                                            fw::LoadReport* report = nullptr);

@@ -34,7 +34,9 @@ fw::CalSlot SlotFromFile(const std::string& path, const hal::AdcInfo& adc,
   std::ifstream in(path);
   const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
   fw::CalSlot slot;
-  slot.fixed = cal::ToFixed(file, adc);
+  slot.fixed = cal::ToFixed(file, cal::AdcForDevice(file, adc));
+  std::fprintf(stderr, "ftd: calibration %s: input unit %s\n", path.c_str(),
+               file.input_unit.c_str());
   slot.crc32 = j.is_discarded() ? FixedFormCrc(slot.fixed) : cal::ContentCrc(j);
   slot.present = true;
   if (rated != nullptr) *rated = file.rated;

@@ -1,6 +1,10 @@
 #include "diagnosis/data.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "measurement/units.hpp"
 
 namespace ftstack::diag {
 namespace {
@@ -21,7 +25,31 @@ void Relay(std::size_t done, std::size_t total, void* user) {
   }
 }
 
-Recording Read(const std::string& path, ProgressRelay* relay) {
+/// Converts `rec`'s bridge columns from their declared unit to mV/V, refusing values outside the
+/// declared converter's codes or, undeclared, outside the assumed converter (±3.90625 mV/V).
+std::string ToMvv(Recording* rec, bool check_assumed) {
+  const InputUnit u = ResolveInputUnit(*rec);
+  const std::size_t n = rec->BridgeCount();
+  ValueRange r;
+  r.unit = ToString(u.unit);
+  if (u.unit == BridgeUnit::kCounts) {
+    r.min = static_cast<double>(MinCode(u.converter));
+    r.max = static_cast<double>(MaxCode(u.converter));
+    r.what = "the codes of the " + std::to_string(u.converter.bits) + "-bit " +
+             ToString(u.converter.coding) + " converter";
+    CheckBridgeRange(*rec, n, r, 0.5);
+  } else if (u.source == "format default" && check_assumed) {
+    r.min = -3.90625;
+    r.max = 3.90625;
+    r.what = "the range of the assumed converter";
+    CheckBridgeRange(*rec, n, r, 0.0);
+  }
+  ConvertBridgesToMvv(rec, n, u);
+  return Describe(u);
+}
+
+Recording Read(const std::string& path, ProgressRelay* relay, std::string* unit,
+               bool check_assumed) {
   ReadOptions opt;
   opt.required = {"t"};
   opt.require_bridges = true;
@@ -29,7 +57,9 @@ Recording Read(const std::string& path, ProgressRelay* relay) {
     opt.progress = &Relay;
     opt.progress_user = relay;
   }
-  return ReadRecording(path, opt);
+  Recording rec = ReadRecording(path, opt);
+  *unit = ToMvv(&rec, check_assumed);
+  return rec;
 }
 
 bool HasWrench(const Recording& r) {
@@ -75,6 +105,34 @@ double DiagData::rate_hz() const {
   return 1.0 / dt[dt.size() / 2];
 }
 
+std::vector<int> FindSegments(const Recording& real) {
+  std::vector<int> seg(real.rows(), 0);
+  int count = real.rows() > 0 ? 1 : 0;
+  if (real.Has("segment")) {
+    const auto& col = real.Column("segment");
+    std::map<double, int> seen;  // value → number, in order of first row
+    for (std::size_t i = 0; i < col.size(); ++i) {
+      const auto it = seen.emplace(col[i], static_cast<int>(seen.size())).first;
+      seg[i] = it->second;
+    }
+    count = static_cast<int>(seen.size());
+  } else if (real.Has("t") && real.rows() > 2) {
+    const auto& t = real.Column("t");
+    std::vector<double> dt(t.size() - 1);
+    for (std::size_t i = 1; i < t.size(); ++i) dt[i - 1] = t[i] - t[i - 1];
+    std::vector<double> sorted = dt;
+    std::nth_element(sorted.begin(),
+                     sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+    const double gap = kSegmentGapPeriods * sorted[sorted.size() / 2];
+    for (std::size_t i = 1; i < t.size(); ++i) {
+      if (dt[i - 1] > gap) ++count;
+      seg[i] = count - 1;
+    }
+  }
+  if (count <= 1) seg.clear();
+  return seg;
+}
+
 DiagData FromRecordings(const Recording& sim, const Recording& real) {
   const std::size_t nr = real.BridgeCount();
   const std::size_t ns = sim.BridgeCount();
@@ -100,6 +158,7 @@ DiagData FromRecordings(const Recording& sim, const Recording& real) {
     d.wrench = WrenchOf(sim);
   }
   if (real.Has("temp_C")) d.temp_c = real.Column("temp_C");
+  d.segment = FindSegments(real);
   CheckUsable(d);
   return d;
 }
@@ -109,9 +168,13 @@ DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path, 
   ProgressRelay r1{progress, user, 0.0, 0.5, "reading sim"};
   ProgressRelay r2{progress, user, 0.5, 0.5, "reading real"};
   try {
-    const Recording sim = Read(sim_path, &r1);
-    const Recording real = Read(real_path, &r2);
-    return FromRecordings(sim, real);
+    std::string sim_unit;
+    std::string real_unit;
+    const Recording sim = Read(sim_path, &r1, &sim_unit, false);
+    const Recording real = Read(real_path, &r2, &real_unit, true);
+    DiagData d = FromRecordings(sim, real);
+    d.real_unit = real_unit;
+    return d;
   } catch (const RecordingError& e) {
     throw DiagInputError(e.what());
   }
@@ -122,6 +185,7 @@ DiagData LoadPredictedReal(const std::string& real_path, const std::string& mode
                            void* user) {
   ProgressRelay r1{progress, user, 0.0, 0.8, "reading real"};
   Recording real;
+  std::string unit;
   try {
     ReadOptions opt;
     opt.required = {"t"};
@@ -132,6 +196,7 @@ DiagData LoadPredictedReal(const std::string& real_path, const std::string& mode
       opt.progress_user = &r1;
     }
     real = ReadRecording(real_path, opt);
+    unit = ToMvv(&real, true);
   } catch (const RecordingError& e) {
     throw DiagInputError(e.what());
   }
@@ -144,10 +209,12 @@ DiagData LoadPredictedReal(const std::string& real_path, const std::string& mode
   DiagData d;
   d.sim_name = model_name;
   d.real_name = real_path;
+  d.real_unit = unit;
   d.t_s = real.Column("t");
   d.real_mvv = Bridges(real, nr);
   d.wrench = WrenchOf(real);
   if (real.Has("temp_C")) d.temp_c = real.Column("temp_C");
+  d.segment = FindSegments(real);
   const auto n = static_cast<Eigen::Index>(d.t_s.size());
   d.sim_mvv.resize(n, static_cast<Eigen::Index>(nr));
   for (Eigen::Index i = 0; i < n; ++i) {

@@ -30,6 +30,11 @@ struct DiagData {
   Eigen::MatrixXd real_mvv;    ///< n × N measured bridge outputs, mV/V
   std::string sim_name;        ///< where the prediction came from (file or sensor description)
   std::string real_name;       ///< the real recording's path
+  /// Recording of every row (0, 1, …) when separate recordings were joined: the real file's
+  /// `segment` column, else a new one after every time gap over kSegmentGapPeriods median
+  /// periods. Empty: one recording.
+  std::vector<int> segment;
+  std::string real_unit = "mV/V";  ///< the real file's declared bridge unit (converted to mV/V)
 
   [[nodiscard]] std::size_t rows() const { return t_s.size(); }
   [[nodiscard]] int channels() const { return static_cast<int>(real_mvv.cols()); }
@@ -38,6 +43,13 @@ struct DiagData {
   /// Median sample rate, Hz.
   [[nodiscard]] double rate_hz() const;
 };
+
+/// A time step longer than this many median sample periods starts a new segment.
+inline constexpr double kSegmentGapPeriods = 10.0;
+
+/// Segments of a recording (see DiagData::segment): its `segment` column (rows with equal values
+/// form one segment, renumbered in order of first row), else the time gaps; empty for one segment.
+[[nodiscard]] std::vector<int> FindSegments(const Recording& real);
 
 /// Progress callback: (fraction done 0…1, what is happening).
 using ProgressFn = void (*)(double fraction, const char* stage, void* user);

@@ -1,5 +1,7 @@
 #include "diagnosis/diagnose.hpp"
 
+#include "diagnosis/identifiability.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -224,6 +226,26 @@ bool FitPair(const Context& cx, const Mat& target, const EffectSpec& a, const Ef
   return true;
 }
 
+/// A time-based partner of a load effect that one offset per load hold explains as well (a misfit
+/// of the first effect's shape left from hold to hold, which a time curve follows) is not
+/// claimed: the data cannot tell it from the first effect's remainder. Returns the partner's
+/// confounding when it stays (empty otherwise).
+std::vector<Confounding> DropUnidentifiedPartner(const Context& cx, double z_claim,
+                                                 std::vector<EffectFit>* claimed,
+                                                 std::vector<std::string>* dropped) {
+  std::vector<Confounding> partner_conf;
+  if (claimed->size() != 2 || IsTimeBased((*claimed)[0].name)) return partner_conf;
+  const Mat rest = cx.resid - (*claimed)[0].pred;
+  partner_conf.push_back(CheckConfounders(cx, rest, (*claimed)[1], z_claim));
+  const auto& with = partner_conf.back().with;
+  if (std::find(with.begin(), with.end(), "hold_offsets") != with.end()) {
+    dropped->push_back((*claimed)[1].name + ": " + partner_conf.back().words);
+    claimed->pop_back();
+    partner_conf.clear();
+  }
+  return partner_conf;
+}
+
 }  // namespace
 
 Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
@@ -387,18 +409,54 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
   } else {
     claimed.push_back(best.fit);
   }
+  // A claimed thermal_zero_drift is refined with a thermometer lag τ ≥ 0 where the lag pays for
+  // itself (effects/thermal_lag.cpp); ranked without it, so a lag never wins a claim on its own.
+  // A claimed zero_drift is replaced by a lagged thermal_zero_drift where temperature exists and
+  // the lagged model scores better on the held-out rows (penalised like the ranking): a gauge
+  // temperature lagging the thermometer otherwise loses to a drift in time.
+  const double log_hold = std::log(std::max<double>(2.0, static_cast<double>(cx.n_hold)));
+  for (std::size_t k = 0; k < claimed.size(); ++k) {
+    const bool thermal = claimed[k].name == "thermal_zero_drift";
+    if (!thermal && !(claimed[k].name == "zero_drift" && !cx.dtemp.empty())) continue;
+    Mat rest = cx.resid;
+    for (std::size_t o = 0; o < claimed.size(); ++o) {
+      if (o != k) rest -= claimed[o].pred;
+    }
+    auto lagged = FitThermalZeroLagged(cx, rest);
+    if (!lagged || !lagged->params.contains("lag_s")) continue;
+    const double cost_old =
+        Score(cx, rest, &claimed[k].pred).hold_sse + claimed[k].n_params * log_hold;
+    const double cost_new = Score(cx, rest, &lagged->pred).hold_sse + lagged->n_params * log_hold;
+    if (thermal || cost_new < cost_old) claimed[k] = std::move(*lagged);
+  }
+  const std::vector<Confounding> partner_conf =
+      DropUnidentifiedPartner(cx, options.z_claim, &claimed, &r.dropped);
   Mat cum = Mat::Zero(cx.n, cx.nc);
-  for (auto& f : claimed) {
+  for (std::size_t k = 0; k < claimed.size(); ++k) {
+    EffectFit& f = claimed[k];
     ClaimedEffect ce;
     ce.hold_rms_before = HoldRms(cx, cx.resid, &cum);
     cum += f.pred;
     ce.hold_rms_after = HoldRms(cx, cx.resid, &cum);
     ce.rms_after = ChannelRms(cx.resid - cum);
+    // Each effect is tested against its confounders on what the other claimed effects leave.
+    const Confounding conf =
+        k == 1 && !partner_conf.empty()
+            ? partner_conf.front()
+            : CheckConfounders(cx, cx.resid - (cum - f.pred), f, options.z_claim);
+    ce.confounded_with = conf.with;
+    ce.confounding = conf.words;
     ce.fit = std::move(f);
     r.effects.push_back(std::move(ce));
   }
   r.model = cum;
-  r.verdict = r.effects.front().fit.name;
+  r.verdict = "undetermined";
+  for (const auto& e : r.effects) {
+    if (e.confounded_with.empty()) {
+      r.verdict = e.fit.name;
+      break;
+    }
+  }
   // The noise reported is re-estimated once the claimed effects are removed (broadband effects
   // such as ringing or skew on fast edges lift the spectrum's median a little).
   for (int c = 0; c < cx.nc; ++c) {
@@ -442,14 +500,23 @@ nlohmann::json ToJson(const Report& r) {
     ej["holdout"] = {{"rms_before", e.hold_rms_before}, {"rms_after", e.hold_rms_after}};
     ej["model"] = e.fit.variant;
     ej["n_params"] = e.fit.n_params;
+    ej["identifiable"] = e.confounded_with.empty();
+    if (!e.confounded_with.empty()) {
+      ej["confounded_with"] = e.confounded_with;
+      ej["confounding"] = e.confounding;
+    }
     effects.push_back(ej);
   }
   j["effects"] = effects;
+  if (!r.dropped.empty()) j["not_claimed"] = r.dropped;
   j["holdout"] = {{"rms_before", r.hold_rms_before},
                   {"rms_after", r.hold_rms_after},
                   {"rows", r.cx.n_hold},
                   {"block_s", r.cx.block_s},
-                  {"scheme", "every third block of block_s held out; fits use the other rows"}};
+                  {"scheme",
+                   "every third block of block_s held out; fits use the other rows; blocks "
+                   "restart at every segment"},
+                  {"segments", r.cx.segments}};
   auto cands = nlohmann::json::array();
   for (const auto& c : r.candidates) {
     cands.push_back({{"name", c.name},

@@ -38,6 +38,9 @@ struct ClaimedEffect {
       rms_after;  ///< per channel, whole record, after removing this and earlier effects
   double hold_rms_before = 0.0;  ///< held-out RMS before this effect (after earlier ones)
   double hold_rms_after = 0.0;
+  /// What the data cannot tell this effect from (identifiability.hpp); empty when identified.
+  std::vector<std::string> confounded_with;
+  std::string confounding;  ///< the same in words
 };
 
 struct Report {
@@ -48,9 +51,14 @@ struct Report {
   std::vector<int> mismatch_channels;
   std::vector<std::pair<double, double>> windows;
   nlohmann::json load_region;  ///< null, or {component, sign, range, excess_ratio}
+  /// The best-supported identified effect; "none"; or "undetermined" when every claimed effect is
+  /// confounded (diagnosis.md).
   std::string verdict = "none";
   std::vector<ClaimedEffect> effects;
   std::vector<CandidateScore> candidates;  ///< every single effect tried, best score first
+  /// Partners of a pair left unclaimed, with the reason (a time-based partner that one offset
+  /// per load hold explains as well, diagnosis.md "not_claimed").
+  std::vector<std::string> dropped;
   double hold_rms_before = 0.0;
   double hold_rms_after = 0.0;
   Eigen::MatrixXd model;               ///< n × N: the claimed effects' total prediction

@@ -312,15 +312,20 @@ std::optional<EffectFit> FitZeroDrift(const Context& cx, const Mat& target) {
   return best;
 }
 
-std::optional<EffectFit> FitThermalZero(const Context& cx, const Mat& target) {
-  if (cx.dtemp.empty()) return std::nullopt;
+std::optional<EffectFit> FitThermalZeroPlain(const Context& cx, const Mat& target);
+
+}  // namespace
+
+std::optional<EffectFit> FitThermalZeroOn(const Context& cx, const Mat& target,
+                                          const std::vector<double>& dtemp) {
+  if (dtemp.empty()) return std::nullopt;
   EffectFit e;
   e.name = "thermal_zero_drift";
   const auto f = FitChannels(
       cx, target, 2,
       [&](int i, int, double* x) {
         x[0] = 1.0;
-        x[1] = cx.dtemp[static_cast<std::size_t>(i)];
+        x[1] = dtemp[static_cast<std::size_t>(i)];
       },
       &e.pred);
   e.n_params = 2 * cx.nc;
@@ -342,6 +347,8 @@ std::optional<EffectFit> FitThermalZero(const Context& cx, const Mat& target) {
       c, RowCorr(cx, target, e.pred, c), RowCorr(cx, target, lin, c), k(c));
   return e;
 }
+
+namespace {
 
 std::optional<EffectFit> FitThermalSpan(const Context& cx, const Mat& target) {
   if (cx.dtemp.empty()) return std::nullopt;
@@ -473,16 +480,25 @@ std::optional<EffectFit> FitExcitation(const Context& cx, const Mat& target) {
   return best;
 }
 
+/// Restart flags of the context's segments for the filters (nullptr for one recording).
+const std::uint8_t* Restarts(const Context& cx) {
+  return cx.restart.empty() ? nullptr : cx.restart.data();
+}
+
 // Creep: r_c = β_c·LP_τ[L_c] (+ γ_c·L_c in the second variant).
 std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
   const auto& d = *cx.data;
   const double duration = d.t_s.back() - d.t_s.front();
   Mat lp(cx.n, cx.nc);
+  std::vector<const double*> in_cols;
+  std::vector<double*> out_cols;
+  for (int c = 0; c < cx.nc; ++c) {
+    in_cols.push_back(cx.load.col(c).data());
+    out_cols.push_back(lp.col(c).data());
+  }
   auto build = [&](double tau) {
-    for (int c = 0; c < cx.nc; ++c) {
-      FirstOrderLowPass(d.t_s.data(), cx.load.col(c).data(), static_cast<std::size_t>(cx.n), tau,
-                        lp.col(c).data());
-    }
+    FirstOrderLowPassColumns(d.t_s.data(), static_cast<std::size_t>(cx.n), tau, in_cols.data(),
+                             out_cols.data(), in_cols.size(), Restarts(cx));
   };
   auto sse_for = [&](double log_tau, bool gamma) {
     build(std::exp(log_tau));
@@ -550,7 +566,9 @@ std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
   return best;
 }
 
-std::optional<EffectFit> FitHysteresis(const Context& cx, const Mat& target) {
+}  // namespace
+
+std::optional<EffectFit> FitHysteresisOperator(const Context& cx, const Mat& target) {
   // Two rate-independent operators on each bridge's own load history: Dahl (exponential approach
   // after a reversal) and play/backlash (linear approach, then flat); width searched for each.
   Mat z(cx.n, cx.nc);
@@ -600,6 +618,8 @@ std::optional<EffectFit> FitHysteresis(const Context& cx, const Mat& target) {
       c, 2.0 * std::fabs(h), 2.0 * std::fabs(h) / cx.sigma(c), RowCorr(cx, target, best.pred, c));
   return best;
 }
+
+namespace {
 
 // One coefficient per channel on a feature of the channel's load; significant channels only.
 template <class F>
@@ -1173,11 +1193,15 @@ std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target) {
     return target.col(a).squaredNorm() * cx.weight(a) > target.col(b).squaredNorm() * cx.weight(b);
   });
   auto build = [&](double f, double z, const std::vector<int>& chans) {
+    std::vector<const double*> in;
+    std::vector<double*> out;
     for (int c : chans) {
-      SecondOrderLowPass(d.t_s.data(), d.sim_mvv.col(c).data(), static_cast<std::size_t>(cx.n), f,
-                         z, h.col(c).data());
-      h.col(c) -= d.sim_mvv.col(c);
+      in.push_back(d.sim_mvv.col(c).data());
+      out.push_back(h.col(c).data());
     }
+    SecondOrderLowPassColumns(d.t_s.data(), static_cast<std::size_t>(cx.n), f, z, in.data(),
+                              out.data(), in.size(), Restarts(cx));
+    for (int c : chans) h.col(c) -= d.sim_mvv.col(c);
   };
   int st = cx.search_stride;
   auto sse_for = [&](double f, double z, const std::vector<int>& chans, Mat* out, ChannelFit* cf) {
@@ -1304,8 +1328,25 @@ Context MakeContext(const DiagData& d, double block_s, const Eigen::VectorXd* si
   cx.block_s = static_cast<double>(rows_per_block) * cx.dt;
   cx.search_stride = std::max(1, static_cast<int>(std::lround(cx.n / 12000.0)));
   cx.train.resize(d.rows());
+  if (!d.segment.empty()) {
+    cx.restart.assign(d.rows(), 0);
+    for (std::size_t i = 1; i < d.rows(); ++i) {
+      if (d.segment[i] != d.segment[i - 1]) {
+        cx.restart[i] = 1;
+        ++cx.segments;
+      }
+    }
+  }
+  // Blocks restart at every segment boundary (a short last block is closed there).
+  std::size_t block = 0;
+  std::size_t in_block = 0;
   for (std::size_t i = 0; i < d.rows(); ++i) {
-    cx.train[i] = ((i / rows_per_block) % 3) == 1 ? 0 : 1;
+    if (i > 0 && (in_block == rows_per_block || (!cx.restart.empty() && cx.restart[i] != 0))) {
+      ++block;
+      in_block = 0;
+    }
+    ++in_block;
+    cx.train[i] = (block % 3) == 1 ? 0 : 1;
     if (cx.train[i]) {
       ++cx.n_train;
     } else {
@@ -1400,15 +1441,21 @@ Sums Score(const Context& cx, const Eigen::MatrixXd& target, const Eigen::Matrix
   return s;
 }
 
+namespace {
+std::optional<EffectFit> FitThermalZeroPlain(const Context& cx, const Mat& target) {
+  return FitThermalZeroOn(cx, target, cx.dtemp);
+}
+}  // namespace
+
 const std::vector<EffectSpec>& Effects() {
   static const std::vector<EffectSpec> kEffects = {
       {"zero_offset", &FitZeroOffset},
       {"zero_drift", &FitZeroDrift},
-      {"thermal_zero_drift", &FitThermalZero},
+      {"thermal_zero_drift", &FitThermalZeroPlain},
       {"thermal_span_drift", &FitThermalSpan},
       {"excitation_drift", &FitExcitation},
       {"creep", &FitCreep},
-      {"hysteresis", &FitHysteresis},
+      {"hysteresis", &FitHysteresisFamily},
       {"bridge_nonlinearity", &FitBridgeNonlinearity},
       {"geometric_nonlinearity", &FitGeometric},
       {"load_stiffening", &FitLoadStiffening},

@@ -34,6 +34,10 @@ struct Context {
   double rate_hz = 0.0;
   int search_stride =
       1;  ///< row step used inside nonlinear parameter searches (final fits use all)
+  /// 1 at the first row of every segment after the first (DiagData::segment): stateful models
+  /// restart there and hold-out blocks never straddle it. Empty for one recording.
+  std::vector<std::uint8_t> restart;
+  int segments = 1;             ///< number of joined recordings
   std::vector<double> peak_hz;  ///< prominent lines of the residual spectrum, strongest first
   std::vector<double> peak_ratio;
 };
@@ -67,6 +71,32 @@ struct EffectSpec {
 [[nodiscard]] const std::vector<EffectSpec>& Effects();
 /// The effect named `name`, or nullptr.
 [[nodiscard]] const EffectSpec* FindEffect(const std::string& name);
+
+/// thermal_zero_drift against a given temperature history dtemp (°C from 20 °C, one per row):
+/// r_c = a_c + k_c·dtemp (effects.cpp).
+[[nodiscard]] std::optional<EffectFit> FitThermalZeroOn(const Context& cx,
+                                                        const Eigen::MatrixXd& target,
+                                                        const std::vector<double>& dtemp);
+/// thermal_zero_drift with a first-order lag τ ≥ 0 between the thermometer and the gauges:
+/// dtemp is replaced by LP_τ[dtemp] (restarting per segment), τ found by grid + golden search on
+/// the training rows (effects/thermal_lag.cpp).
+[[nodiscard]] std::optional<EffectFit> FitThermalZeroLagged(const Context& cx,
+                                                            const Eigen::MatrixXd& target);
+
+/// hysteresis as one rate-independent operator (Dahl or play, width searched) per bridge.
+[[nodiscard]] std::optional<EffectFit> FitHysteresisOperator(const Context& cx,
+                                                             const Eigen::MatrixXd& target);
+/// hysteresis in the load path: one operator (Dahl or play, width searched) or a
+/// Prandtl–Ishlinskii sum of plays of fixed widths on each reference wrench axis, mapped to the
+/// bridges by the sensitivity cx.sens (effects/hysteresis_axes.cpp).
+[[nodiscard]] std::optional<EffectFit> FitHysteresisAxes(const Context& cx,
+                                                         const Eigen::MatrixXd& target);
+/// hysteresis of general rate-independent shape: the one-operator fit or a Preisach superposition
+/// of relays (thresholds on 8 quantiles of each bridge's load, weights fitted per bridge; this
+/// class contains Prandtl–Ishlinskii sums of play operators), whichever has the lower training
+/// BIC (effects/hysteresis_pi.cpp).
+[[nodiscard]] std::optional<EffectFit> FitHysteresisFamily(const Context& cx,
+                                                           const Eigen::MatrixXd& target);
 
 /// Whitened sums over train or hold-out rows.
 struct Sums {

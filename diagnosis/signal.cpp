@@ -127,15 +127,21 @@ NormalEq::Result NormalEq::Solve() const {
 }
 
 void FirstOrderLowPass(const double* t_s, const double* x, std::size_t n, double tau_s, double* y) {
+  FirstOrderLowPassColumns(t_s, n, tau_s, &x, &y, 1);
+}
+
+void FirstOrderLowPassColumns(const double* t_s, std::size_t n, double tau_s,
+                              const double* const* x, double* const* y, std::size_t m,
+                              const std::uint8_t* restart) {
   if (n == 0) return;
-  y[0] = x[0];
+  for (std::size_t c = 0; c < m; ++c) y[c][0] = x[c][0];
   double last_dt = -1.0;
   double a = 0.0;
   double b0 = 0.0;
   double b1 = 0.0;
   for (std::size_t i = 1; i < n; ++i) {
     const double dt = t_s[i] - t_s[i - 1];
-    if (std::fabs(dt - last_dt) > 1e-12) {
+    if (dt != last_dt) {  // every row on a jittered clock: once for all m columns
       const double r = dt / tau_s;
       a = std::exp(-r);
       const double g = r > 1e-8 ? (1.0 - a) / r : 1.0 - r / 2.0;  // (1 − a)·τ/dt
@@ -143,64 +149,86 @@ void FirstOrderLowPass(const double* t_s, const double* x, std::size_t n, double
       b1 = g - a;
       last_dt = dt;
     }
-    y[i] = a * y[i - 1] + b0 * x[i] + b1 * x[i - 1];
+    if (restart != nullptr && restart[i] != 0) {
+      for (std::size_t c = 0; c < m; ++c) y[c][i] = x[c][i];
+      continue;
+    }
+    for (std::size_t c = 0; c < m; ++c) y[c][i] = a * y[c][i - 1] + b0 * x[c][i] + b1 * x[c][i - 1];
   }
 }
 
 namespace {
 
-// exp(M) of a small matrix by scaling and squaring with a Taylor series.
-Eigen::Matrix4d Expm(const Eigen::Matrix4d& m) {
-  const double norm = m.cwiseAbs().rowwise().sum().maxCoeff();
-  int s = 0;
-  if (norm > 0.25) s = static_cast<int>(std::ceil(std::log2(norm / 0.25)));
-  const Eigen::Matrix4d a = m / std::pow(2.0, s);
-  Eigen::Matrix4d term = Eigen::Matrix4d::Identity();
-  Eigen::Matrix4d sum = term;
-  for (int k = 1; k <= 14; ++k) {
-    term = term * a / static_cast<double>(k);
-    sum += term;
+/// Exact one-step coefficients of ÿ + 2ζω ẏ + ω² y = ω² u for an input linear over a step of
+/// length dt (closed form of the 2 × 2 state transition; no matrix exponential per step).
+struct SecondOrderStep {
+  double p00, p01, p10, p11;  ///< Φ(dt) of the homogeneous state [y, ẏ]
+  double lag;                 ///< 2ζ/ω: the steady lag of y behind a ramp, s
+};
+
+SecondOrderStep MakeSecondOrderStep(double w, double zeta, double dt) {
+  const double sigma = zeta * w;
+  double c = 0.0;  // e^{−σ dt}·cos(ω_d dt) (cosh when overdamped)
+  double s = 0.0;  // e^{−σ dt}·sin(ω_d dt)/ω_d (sinh/ω_d when overdamped)
+  const double d2 = 1.0 - zeta * zeta;
+  const double wd = w * std::sqrt(std::fabs(d2));
+  const double x = wd * dt;
+  const double decay = std::exp(-sigma * dt);
+  if (x < 1e-4) {  // near critical damping: series of cos and sin(x)/x (or cosh, sinh)
+    const double sign = d2 >= 0 ? -1.0 : 1.0;
+    c = decay * (1.0 + sign * 0.5 * x * x);
+    s = decay * dt * (1.0 + sign * x * x / 6.0);
+  } else if (d2 > 0) {
+    c = decay * std::cos(x);
+    s = decay * std::sin(x) / wd;
+  } else {  // overdamped: two real decays, both ≤ 1, no overflow
+    const double e1 = std::exp((-sigma + wd) * dt);
+    const double e2 = std::exp((-sigma - wd) * dt);
+    c = 0.5 * (e1 + e2);
+    s = 0.5 * (e1 - e2) / wd;
   }
-  for (int i = 0; i < s; ++i) sum = sum * sum;
-  return sum;
+  return {c + sigma * s, s, -w * w * s, c - sigma * s, 2.0 * zeta / w};
 }
 
 }  // namespace
 
 void SecondOrderLowPass(const double* t_s, const double* x, std::size_t n, double freq_hz,
                         double damping_ratio, double* y) {
-  if (n == 0) return;
+  SecondOrderLowPassColumns(t_s, n, freq_hz, damping_ratio, &x, &y, 1);
+}
+
+void SecondOrderLowPassColumns(const double* t_s, std::size_t n, double freq_hz,
+                               double damping_ratio, const double* const* x, double* const* y,
+                               std::size_t m, const std::uint8_t* restart) {
+  if (n == 0 || m == 0) return;
   const double w = 2.0 * M_PI * freq_hz;
-  double pos = x[0];
-  double vel = 0.0;
-  y[0] = pos;
+  std::vector<double> pos(m);
+  std::vector<double> vel(m, 0.0);
+  for (std::size_t c = 0; c < m; ++c) y[c][0] = pos[c] = x[c][0];
   double last_dt = -1.0;
-  Eigen::Matrix2d phi;
-  Eigen::Vector2d g0;
-  Eigen::Vector2d g1;
+  SecondOrderStep k{};
   for (std::size_t i = 1; i < n; ++i) {
+    if (restart != nullptr && restart[i] != 0) {
+      for (std::size_t c = 0; c < m; ++c) {
+        y[c][i] = pos[c] = x[c][i];
+        vel[c] = 0.0;
+      }
+      continue;
+    }
     const double dt = t_s[i] - t_s[i - 1];
-    if (std::fabs(dt - last_dt) > 1e-12) {
-      // State [y, ẏ], input u(τ) = u0 + (u1 − u0)·τ/dt. Augmented [A B 0; 0 0 1/dt; 0 0 0].
-      Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
-      m(0, 1) = 1.0;
-      m(1, 0) = -w * w;
-      m(1, 1) = -2.0 * damping_ratio * w;
-      m(1, 2) = w * w;
-      m(2, 3) = 1.0 / dt;
-      const Eigen::Matrix4d e = Expm(m * dt);
-      phi = e.block<2, 2>(0, 0);
-      g0 = e.block<2, 1>(0, 2);
-      g1 = e.block<2, 1>(0, 3);
+    if (dt != last_dt) {  // every row on a jittered clock: once for all m columns
+      k = MakeSecondOrderStep(w, damping_ratio, dt);
       last_dt = dt;
     }
-    const double u0 = x[i - 1];
-    const double du = x[i] - x[i - 1];
-    const double np = phi(0, 0) * pos + phi(0, 1) * vel + g0(0) * u0 + g1(0) * du;
-    const double nv = phi(1, 0) * pos + phi(1, 1) * vel + g0(1) * u0 + g1(1) * du;
-    pos = np;
-    vel = nv;
-    y[i] = pos;
+    for (std::size_t c = 0; c < m; ++c) {
+      // y = y_p + e with the particular solution y_p(τ) = u(τ) − lag·slope for u linear in τ.
+      const double slope = (x[c][i] - x[c][i - 1]) / dt;
+      const double e0 = pos[c] - (x[c][i - 1] - k.lag * slope);
+      const double e1 = vel[c] - slope;
+      pos[c] = x[c][i] - k.lag * slope + k.p00 * e0 + k.p01 * e1;
+      vel[c] = slope + k.p10 * e0 + k.p11 * e1;
+      y[c][i] = pos[c];
+    }
   }
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -52,11 +53,22 @@ class NormalEq {
 /// between samples; starts at rest at the first input value.
 void FirstOrderLowPass(const double* t_s, const double* x, std::size_t n, double tau_s, double* y);
 
+/// The same for m columns x[c] → y[c] on one clock: the step coefficients (an exp per row on a
+/// jittered clock) are computed once per row for all columns. Where restart[i] != 0 (restart may
+/// be nullptr) the filter starts again at rest at x[i] (a new recording begins there).
+void FirstOrderLowPassColumns(const double* t_s, std::size_t n, double tau_s,
+                              const double* const* x, double* const* y, std::size_t m,
+                              const std::uint8_t* restart = nullptr);
 /// Second-order low pass ÿ + 2ζω ẏ + ω² y = ω² x (ω = 2π·freq_hz), unit DC gain, exact for inputs
 /// linear between samples; starts at rest at the first input value.
 void SecondOrderLowPass(const double* t_s, const double* x, std::size_t n, double freq_hz,
                         double damping_ratio, double* y);
 
+/// The same for m columns on one clock (coefficients once per row, closed form per dt), with
+/// restarts as FirstOrderLowPassColumns.
+void SecondOrderLowPassColumns(const double* t_s, std::size_t n, double freq_hz,
+                               double damping_ratio, const double* const* x, double* const* y,
+                               std::size_t m, const std::uint8_t* restart = nullptr);
 /// Rate-independent first-order hysteresis operator (Dahl type) of x with characteristic travel
 /// width: z moves toward sign(dx) by 1 − exp(−|dx|/width) per step; starts at 0. Output in [−1, 1].
 void DahlOperator(const double* x, std::size_t n, double width, double* z);

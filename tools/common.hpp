@@ -7,6 +7,9 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
+
+#include "firmware/status_bits.hpp"
 
 namespace ftstack::tools {
 
@@ -33,6 +36,41 @@ inline std::array<double, 6> ParseWrench(const std::string& text) {
   }
   if (i != 6) throw std::invalid_argument("wrench '" + text + "' needs 6 values FX,FY,FZ,MX,MY,MZ");
   return w;
+}
+
+/// Status bits that make a row's wrench not a valid reading (saturation, overload, bridge or ADC
+/// fault, no calibration, temperature out of range, stale); the others (tare, simulated, late)
+/// are information.
+inline constexpr std::uint16_t kFlaggingBits =
+    fw::kStatusSaturated | fw::kStatusOverload | fw::kStatusBridgeFault | fw::kStatusAdcFault |
+    fw::kStatusCalInvalid | fw::kStatusTempRange | fw::kStatusStale;
+
+/// Prints, for every status bit some row carries, how many rows carry it; returns the number of
+/// rows with a flagging bit (kFlaggingBits).
+inline std::size_t ReportStatusBits(const std::vector<double>& status, std::FILE* out) {
+  static const char* const kNames[10] = {"saturated",
+                                         "overload",
+                                         "bridge fault",
+                                         "ADC fault",
+                                         "cal invalid",
+                                         "tare active",
+                                         "temperature out of range",
+                                         "simulated",
+                                         "stale",
+                                         "late"};
+  std::size_t count[16] = {};
+  std::size_t flagged = 0;
+  for (const double s : status) {
+    const auto bits = static_cast<std::uint16_t>(s);
+    for (int b = 0; b < 16; ++b) count[b] += (bits >> b) & 1u;
+    flagged += (bits & kFlaggingBits) != 0 ? 1 : 0;
+  }
+  for (int b = 0; b < 16; ++b) {
+    if (count[b] == 0) continue;
+    std::fprintf(out, "ftcal: status bit %d (%s): %zu of %zu rows\n", b, b < 10 ? kNames[b] : "?",
+                 count[b], status.size());
+  }
+  return flagged;
 }
 
 }  // namespace ftstack::tools

@@ -57,9 +57,11 @@ std::string SpecFor(const std::string& effect, double f, std::uint64_t seed) {
   return effect;
 }
 
+/// The claimed effect named `name`, if the report names it as identified (an effect the report
+/// itself calls confounded is not a claim).
 const ClaimedEffect* Claimed(const Report& r, const std::string& name) {
   for (const auto& e : r.effects) {
-    if (e.fit.name == name) return &e;
+    if (e.fit.name == name && e.confounded_with.empty()) return &e;
   }
   return nullptr;
 }
@@ -199,15 +201,23 @@ ScoreResult RunCase(const ScoreCase& c) {
   out.excess_removed = before > 0 ? 1.0 - std::max(0.0, after) / before : 1.0;
   if (rec.effects.empty()) {
     out.detected = r.verdict == "none" && r.effects.empty();
+    out.named_right = out.detected;
     out.located = r.mismatch_channels.empty();
     out.excess_removed = 1.0;
     return out;
   }
   out.detected = true;
   out.located = true;
+  // Extra effects claimed beside the right ones are penalised: the case is not detected.
+  for (const auto& name : out.named) {
+    bool truth = false;
+    for (const auto& t : rec.effects) truth = truth || t.name == name;
+    if (!truth) ++out.extra;
+  }
+  out.named_right = true;
   for (const auto& t : rec.effects) {
     const ClaimedEffect* ce = Claimed(r, t.name);
-    if (ce == nullptr) out.detected = false;
+    if (ce == nullptr) out.named_right = false;
     ScoreResult part;
     Judge(rec, r, t, ce, &part);
     out.located = out.located && part.located;
@@ -218,6 +228,7 @@ ScoreResult RunCase(const ScoreCase& c) {
       out.param_ok = part.param_ok;
     }
   }
+  out.detected = out.named_right && out.extra == 0;
   return out;
 }
 

@@ -24,10 +24,12 @@ struct ScoreResult {
   std::string verdict;
   std::vector<std::string> named;  ///< effects the report claims
   double size_sigma = 0.0;         ///< truth: the effect's peak / noise σ
-  bool detected = false;           ///< the right name(s) claimed (none: nothing claimed)
-  bool located = false;            ///< channel / onset / frequency / delay / region right
-  std::string param;               ///< key parameter compared ("" if the effect has none)
-  double param_error = 0.0;        ///< relative (or absolute s for onset_s) error
+  bool detected = false;     ///< the right name(s) claimed and nothing else (none: nothing claimed)
+  int extra = 0;             ///< effects claimed that the truth does not hold
+  bool named_right = false;  ///< the right name(s) claimed as identified (extras allowed)
+  bool located = false;      ///< channel / onset / frequency / delay / region right
+  std::string param;         ///< key parameter compared ("" if the effect has none)
+  double param_error = 0.0;  ///< relative (or absolute s for onset_s) error
   bool param_ok = true;
   double excess_removed = 1.0;  ///< 1 − excess_after/excess_before on held-out rows
   double seconds = 0.0;         ///< diagnosis time

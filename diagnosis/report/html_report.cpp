@@ -41,6 +41,43 @@ std::string Num(double v, const char* f = "%.4g") {
   return b;
 }
 
+/// Unit of a fitted parameter, from its key (diagnosis.md names them with units).
+std::string UnitOf(const std::string& key, const std::string& effect) {
+  auto ends = [&](const char* suf) {
+    const std::string x(suf);
+    return key.size() >= x.size() && key.compare(key.size() - x.size(), x.size(), x) == 0;
+  };
+  if (ends("_s")) return "s";
+  if (ends("_hz")) return "Hz";
+  if (ends("_deg")) return "°";
+  if (ends("_mvv") || key == "offset" || key == "limit") return "mV/V";
+  if (key == "coef_per_K") return effect == "thermal_span_drift" ? "1/K" : "mV/V per K";
+  return "";
+}
+
+/// One value or a list of per-channel values.
+std::string Cell(const nlohmann::json& v) {
+  if (v.is_number()) return Num(v.get<double>());
+  if (v.is_array()) {
+    std::string out;
+    for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + Cell(v[i]);
+    return out;
+  }
+  return Esc(v.is_string() ? v.get<std::string>() : v.dump());
+}
+
+/// The fitted parameters as a table: name, value, 1-σ uncertainty, unit.
+std::string ParamTable(const EffectFit& f) {
+  if (f.params.empty()) return "";
+  std::string h = "<table><tr><th>parameter</th><th>value</th><th>± 1σ</th><th>unit</th></tr>";
+  for (const auto& [key, value] : f.params.items()) {
+    const std::string sigma = f.sigma.contains(key) ? Cell(f.sigma[key]) : "—";
+    h += "<tr><td>" + Esc(key) + "</td><td>" + Cell(value) + "</td><td>" + sigma + "</td><td>" +
+         Esc(UnitOf(key, f.name)) + "</td></tr>";
+  }
+  return h + "</table>";
+}
+
 /// Nice tick values covering [lo, hi].
 std::vector<double> Ticks(double lo, double hi, int want) {
   std::vector<double> t;
@@ -219,12 +256,17 @@ std::string HtmlReport(const DiagData& data, const Report& r) {
        "td,th{border:1px solid #bbb;padding:3px 8px;font-size:13px}th{background:#eee}"
        "code{word-break:break-all}.verdict{font-size:22px;font-weight:bold}.ev{background:#eef6ee;"
        "padding:6px;border-left:"
-       "4px solid #4a4}"
+       "4px solid #4a4}.conf{background:#fbeeee;padding:6px;border-left:4px solid #c44}"
        "</style></head><body>";
   h += "<h1>ftdiag: sim vs real</h1>";
   h += "<p>Real: <code>" + Esc(data.real_name) + "</code>, sim: <code>" + Esc(data.sim_name) +
        "</code>, " + std::to_string(data.rows()) + " rows × " + std::to_string(data.channels()) +
        " bridges at " + Num(r.rate_hz) + " Hz.</p>";
+  if (data.segment.size() == data.rows() && r.cx.segments > 1) {
+    h += "<p>" + std::to_string(r.cx.segments) +
+         " joined recordings (segments): stateful models restart at each, hold-out blocks never "
+         "straddle one.</p>";
+  }
   h += "<p class=\"verdict\">Verdict: " + Esc(r.verdict);
   for (std::size_t i = 1; i < r.effects.size(); ++i) h += " + " + Esc(r.effects[i].fit.name);
   h += "</p>";
@@ -233,9 +275,12 @@ std::string HtmlReport(const DiagData& data, const Report& r) {
   for (const auto& e : r.effects) {
     h += "<h2>" + Esc(e.fit.name) + "</h2><p class=\"ev\">" + Esc(e.fit.evidence) +
          "</p><p>Model: " + Esc(e.fit.variant) + " (" + std::to_string(e.fit.n_params) +
-         " parameters). Parameters: <code>" + Esc(e.fit.params.dump()) + "</code> ± <code>" +
-         Esc(e.fit.sigma.dump()) + "</code>. Held-out RMS " + Num(e.hold_rms_before) + " → " +
-         Num(e.hold_rms_after) + " mV/V.</p>";
+         " parameters). Held-out RMS " + Num(e.hold_rms_before) + " → " + Num(e.hold_rms_after) +
+         " mV/V.</p>" + ParamTable(e.fit);
+    if (!e.confounded_with.empty()) {
+      h += "<p class=\"conf\"><b>Not identified.</b> " + Esc(e.confounding) +
+           " The verdict does not name it.</p>";
+    }
   }
   // Channel table.
   h += "<h2>Channels</h2><table><tr><th>channel</th><th>noise RMS</th><th>RMS before</th><th>RMS "
@@ -359,7 +404,10 @@ std::string SummaryText(const Report& report) {
   std::snprintf(buf, sizeof buf, "  (held-out RMS %.4g -> %.4g mV/V)\n", report.hold_rms_before,
                 report.hold_rms_after);
   s += buf;
-  for (const auto& e : report.effects) s += "  " + e.fit.name + ": " + e.fit.evidence + "\n";
+  for (const auto& e : report.effects) {
+    s += "  " + e.fit.name + ": " + e.fit.evidence + "\n";
+    if (!e.confounded_with.empty()) s += "    not identified: " + e.confounding + "\n";
+  }
   return s;
 }
 

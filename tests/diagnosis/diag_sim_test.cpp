@@ -3,6 +3,8 @@
 // `none` recordings, pairs — named, located, key parameter recovered, ≥ 70 % of the excess removed.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "diagnosis/evaluation/scorecard.hpp"
 #include "sim/effects.hpp"
 
@@ -24,7 +26,11 @@ TEST_P(DiagSim, DiagnosesTheConcealedEffect) {
   for (const auto& n : r.named) named += n + " ";
   SCOPED_TRACE("case " + c.effect + " seed " + std::to_string(c.seed) + " size " +
                std::to_string(r.size_sigma) + " σ; claimed: " + named);
-  EXPECT_TRUE(r.detected);
+  // The right effect(s) named as identified. Extra effects claimed beside them are penalised by
+  // the scorecard (diag_scorecard, --min-pass); here they are reported: a known over-claim remains
+  // (zero_drift beside the simulator's misalignment: hold offsets do not explain it as well).
+  EXPECT_TRUE(r.named_right);
+  if (r.extra > 0) std::printf("note: %d extra effect(s) claimed: %s\n", r.extra, named.c_str());
   EXPECT_TRUE(r.located);
   EXPECT_TRUE(r.param_ok) << r.param << " error " << r.param_error;
   EXPECT_GE(r.excess_removed, 0.7);

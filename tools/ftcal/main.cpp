@@ -10,6 +10,7 @@
 #include "calibration/excitation.hpp"
 #include "calibration/fit.hpp"
 #include "calibration/fit_report.hpp"
+#include "calibration/input_units.hpp"
 #include "calibration/known_mass.hpp"
 #include "calibration/payload.hpp"
 #include "calibration/slots.hpp"
@@ -86,13 +87,25 @@ struct FitArgs {
   std::string serial = "unknown";
   int folds = 10;
   bool allow_unexcited = false;
-  bool identify_jig = false;  ///< known-mass recordings: identify the loading jig
+  bool identify_jig = false;     ///< known-mass recordings: identify the loading jig
+  ftstack::UnitOverrides units;  ///< --bridge-unit, --converter, --excitation-v
 };
+
+/// The unit options fit and apply share (recording-format.md, "Declared bridge units").
+void AddUnitOptions(CLI::App* sub, ftstack::UnitOverrides* units) {
+  sub->add_option("--bridge-unit", units->unit,
+                  "unit of the b* columns: mV/V, V or counts (overrides # bridge_unit)");
+  sub->add_option("--converter", units->converter,
+                  "converter of counts: \"bits=10,coding=unsigned|signed|offset-binary,gain=1,"
+                  "ratiometric=yes,reference_ratio=1,reference_v=…,full_scale_mvv=…\"");
+  sub->add_option("--excitation-v", units->excitation_v, "bridge excitation, V")
+      ->check(CLI::PositiveNumber);
+}
 
 /// `ftcal fit`: reads the rig recording, checks every axis's excitation, fits, writes. Throws.
 void RunFit(const FitArgs& args) {
   using namespace ftstack;
-  const Recording rec = ReadRigRecording(args.in_path, args.identify_jig);
+  Recording rec = ReadRigRecording(args.in_path, args.identify_jig);
   cal::FitOptions fo;
   fo.folds = args.folds;
   hal::AdcInfo adc{};
@@ -112,6 +125,11 @@ void RunFit(const FitArgs& args) {
     adc.full_scale_nvv = std::llround(1000.0 * s.adc.reference_ratio / s.adc_gain * 1e6);
     have_adc = true;
   }
+  if (!have_adc) adc = cal::DefaultAdc(static_cast<std::uint8_t>(rec.BridgeCount()));
+  // Declared units: the fit is made for the declared converter, else for the assumed one; values
+  // outside its range are refused (file:line:column), the b* columns converted in place.
+  const cal::FitInput input = cal::PrepareFitInput(&rec, args.units, adc);
+  adc = input.adc;
   if (!args.rated_text.empty()) fo.rated = tools::ParseWrench(args.rated_text);
   if (args.model_name != "auto") {
     const auto k = cal::ParseModelKind(args.model_name);
@@ -130,11 +148,13 @@ void RunFit(const FitArgs& args) {
                                 ": refused (--allow-unexcited writes it flagged invalid)");
   }
   const cal::FitResult result = cal::FitCalibration(data, fo);
-  if (!have_adc) {
-    adc = cal::DefaultAdc(static_cast<std::uint8_t>(data.bridges.cols()));
+  // Said once the recording is accepted (a refusal stays one line).
+  std::printf("%s\n", input.description.c_str());
+  if (!have_adc && !input.declared.has_converter) {
     std::printf("converter: generic 24-bit, +-3.90625 mV/V (no --sensor)\n");
   }
   cal::CalFile file = cal::CalFileFromFit(result, adc, args.serial, Today());
+  cal::RecordInputUnit(input, &file);
   file.cal.invalid_axes = ex.unexcited;
   fw::LoadReport rep{};
   (void)cal::ToFixed(file, file.adc, &rep);
@@ -187,11 +207,17 @@ int main(int argc, char** argv) {
   fit->add_flag("--identify-jig", fa.identify_jig,
                 "known-mass recordings: identify the loading jig's mass and centre of mass and "
                 "add its load to the reference");
+  AddUnitOptions(fit, &fa.units);
 
   auto* apply = app.add_subcommand("apply", "run the firmware's fixed-point core on a recording");
   apply->add_option("--cal", cal_path, "calibration file")->required();
   apply->add_option("--in", in_path, "recording with b* columns")->required();
   apply->add_option("--out", out_path, "output recording t,Fx,Fy,Fz,Mx,My,Mz")->required();
+  bool allow_flagged = false;
+  UnitOverrides apply_units;
+  apply->add_flag("--allow-flagged", allow_flagged,
+                  "exit 0 even when rows carry status bits (they stay marked in `status`)");
+  AddUnitOptions(apply, &apply_units);
 
   std::string ati_path;
   auto* import_ati = app.add_subcommand("import-ati", "convert an ATI DAQ .cal file (gauge volts)");
@@ -285,9 +311,20 @@ int main(int argc, char** argv) {
       }
       ReadOptions opt;
       opt.require_bridges = true;
-      const Recording in = ReadRecording(in_path, opt);
-      WriteRecording(out_path, cal::ApplyCalibration(cal, in));
+      Recording in = ReadRecording(in_path, opt);
+      const std::string used = cal::PrepareApplyInput(&in, apply_units, cal);
+      std::fprintf(stderr, "ftcal: %s\n", used.c_str());
+      const Recording out = cal::ApplyCalibration(cal, in);
+      WriteRecording(out_path, out);
       std::fprintf(stderr, "ftcal: wrote %zu rows to %s\n", in.rows(), out_path.c_str());
+      const std::size_t flagged = tools::ReportStatusBits(out.Column("status"), stderr);
+      if (flagged > 0 && !allow_flagged) {
+        std::fprintf(stderr,
+                     "ftcal: %zu of %zu rows carry status bits (their wrench is not a valid "
+                     "reading); exit 3 (--allow-flagged to accept)\n",
+                     flagged, out.rows());
+        return 3;
+      }
     } else if (*verify) {
       const cal::CalFile cal = cal::LoadCalFile(cal_path);
       fw::LoadReport rep{};

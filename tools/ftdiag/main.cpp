@@ -21,8 +21,9 @@ using namespace ftstack::diag;  // NOLINT(google-build-using-namespace): one pro
 
 /// ftdiag's exit codes.
 enum ExitCode : int {
-  kExitOk = 0,        ///< diagnosis (or scorecard, demo) completed
-  kExitBadInput = 2,  ///< bad options or files: one line on stderr names them
+  kExitOk = 0,              ///< diagnosis (or scorecard, demo) completed
+  kExitBadInput = 2,        ///< bad options or files: one line on stderr names them
+  kExitBelowThreshold = 3,  ///< scorecard: fewer cases passed than --min-pass asks
 };
 
 struct DiagnoseArgs {
@@ -34,6 +35,7 @@ struct ScorecardArgs {
   int seeds = 3;
   double duration_s = 120.0;
   std::string out;
+  double min_pass = 0.0;  ///< fraction of cases that must meet every criterion
 };
 
 /// A progress bar on stderr when it is a terminal.
@@ -74,8 +76,11 @@ int RunDiagnose(const DiagnoseArgs& args) {
     bar.last = -1;
     const Report report = Diagnose(data, opt);
     if (bar.tty) std::fprintf(stderr, "\n");
-    WriteJson(args.json, ToJson(report));
+    auto json = ToJson(report);
+    json["real_bridge_unit"] = data.real_unit;
+    WriteJson(args.json, json);
     if (!args.html.empty()) WriteHtml(args.html, data, report);
+    std::printf("real recording: %s (diagnosed in mV/V)\n", data.real_unit.c_str());
     std::fputs(SummaryText(report).c_str(), stdout);
     return kExitOk;
   } catch (const std::exception& e) {
@@ -131,6 +136,12 @@ int RunScorecard(const ScorecardArgs& args) {
       if (!f) throw std::runtime_error(args.out + ": cannot write");
     }
     std::printf("scorecard: %d/%zu cases meet every criterion\n", passed, results.size());
+    const double fraction = results.empty() ? 0.0 : passed / static_cast<double>(results.size());
+    if (fraction < args.min_pass) {
+      std::fprintf(stderr, "ftdiag scorecard: %d/%zu = %.3f is below --min-pass %.3f\n", passed,
+                   results.size(), fraction, args.min_pass);
+      return kExitBelowThreshold;
+    }
     return kExitOk;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ftdiag scorecard: %s\n", e.what());
@@ -179,6 +190,9 @@ int main(int argc, char** argv) {
                  "seeds (and sizes ×1, ×0.5, ×2 cycling) per effect (default 3)");
   sc->add_option("--duration-s", scorecard.duration_s, "recording length, s (default 120)");
   sc->add_option("--out", scorecard.out, "Markdown file to write (default: print)");
+  sc->add_option("--min-pass", scorecard.min_pass,
+                 "exit 3 when fewer than this fraction of cases meet every criterion")
+      ->check(CLI::Range(0.0, 1.0));
   sc->callback([&] { exit_code = RunScorecard(scorecard); });
 
   try {

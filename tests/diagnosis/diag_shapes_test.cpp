@@ -1,0 +1,232 @@
+// Effects in shapes the textbook models were not written for (issue 12), from a generator written
+// for this test only (not sim/effects.cpp, not the diagnosis's models): a thermometer that the
+// gauges' temperature lags by tens of seconds.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "diagnosis/diagnose.hpp"
+#include "diagnosis/report/html_report.hpp"
+#include "tests/support/chromium.hpp"
+
+namespace ftstack::diag {
+namespace {
+
+/// 6 bridges at 100 Hz for `duration_s`: steps of random loads every 8 s through a fixed
+/// sensitivity; the body's thermometer follows a non-monotone profile, the gauges see it through
+/// a first-order lag `lag_s` (integrated with 20 Euler substeps per sample), and their apparent
+/// strain adds k_c · (T_gauge − 20 °C). Noise σ = 1e-3 mV/V.
+DiagData LaggingThermometer(double lag_s, double duration_s, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const int nc = 6;
+  Eigen::MatrixXd s(nc, 6);
+  for (int c = 0; c < nc; ++c) {
+    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
+  }
+  std::vector<double> k(nc);
+  for (double& v : k) v = 0.004 * (0.5 + 0.5 * std::fabs(u(rng)));  // mV/V per K: ~15 σ over 5 K
+  const double dt = 0.01;
+  const auto n = static_cast<Eigen::Index>(duration_s / dt);
+  DiagData d;
+  d.sim_name = "independent generator";
+  d.real_name = "lagging thermometer";
+  d.sim_mvv.resize(n, nc);
+  d.real_mvv.resize(n, nc);
+  d.wrench.resize(n, 6);
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(6);
+  auto thermometer = [](double t) {
+    return 20.0 + 4.0 * std::sin(2.0 * M_PI * t / 400.0) + 2.0 * std::sin(2.0 * M_PI * t / 130.0);
+  };
+  double gauge = thermometer(0.0);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) * dt;
+    if (i % 800 == 0) {
+      for (int a = 0; a < 6; ++a) w(a) = 40.0 * u(rng);
+    }
+    if (i > 0) {
+      for (int sub = 0; sub < 20; ++sub) {
+        const double ts = t - dt + (sub + 0.5) * dt / 20.0;
+        gauge += (thermometer(ts) - gauge) * (dt / 20.0) / lag_s;
+      }
+    }
+    d.t_s.push_back(t);
+    d.temp_c.push_back(thermometer(t));
+    d.wrench.row(i) = w.transpose();
+    const Eigen::VectorXd b = s * w;
+    for (int c = 0; c < nc; ++c) {
+      d.sim_mvv(i, c) = b(c);
+      d.real_mvv(i, c) = b(c) + k[static_cast<std::size_t>(c)] * (gauge - 20.0) + 1e-3 * g(rng);
+    }
+  }
+  return d;
+}
+
+TEST(DiagShapes, LaggingThermometerIsThermalZeroDriftWithTheLag) {
+  for (const double lag : {25.0, 60.0}) {
+    const DiagData d = LaggingThermometer(lag, 900.0, 7);
+    const Report r = Diagnose(d);
+    ASSERT_FALSE(r.effects.empty()) << "lag " << lag;
+    EXPECT_EQ(r.verdict, "thermal_zero_drift") << "lag " << lag << ToJson(r)["effects"].dump(1);
+    const auto& p = r.effects.front().fit.params;
+    ASSERT_TRUE(p.contains("lag_s")) << p.dump();
+    EXPECT_NEAR(p["lag_s"].get<double>(), lag, 0.3 * lag) << p.dump();
+    // Held-out error falls by at least half its excess over the noise.
+    const double noise2 = 1e-6;
+    const double before = r.hold_rms_before * r.hold_rms_before - noise2;
+    const double after = r.hold_rms_after * r.hold_rms_after - noise2;
+    EXPECT_LT(after, 0.5 * before) << r.hold_rms_before << " -> " << r.hold_rms_after;
+    if (lag == 25.0) {
+      // The HTML gives the fitted parameters as a table with units and uncertainties.
+      const std::string html = std::string(FTSTACK_BIN_DIR) + "/../diag_shapes_lag.html";
+      WriteHtml(html, d, r);
+      std::ifstream in(html);
+      const std::string text((std::istreambuf_iterator<char>(in)), {});
+      EXPECT_NE(text.find("<th>± 1σ</th><th>unit</th>"), std::string::npos);
+      EXPECT_NE(text.find("<tr><td>lag_s</td>"), std::string::npos);
+      EXPECT_NE(text.find("mV/V per K"), std::string::npos);
+      if (test::HaveChromium()) {
+        EXPECT_TRUE(test::RenderWithChromium(
+            html, html + ".png", std::string(FTSTACK_BIN_DIR) + "/../chromium-shapes", 1000, 1400));
+      }
+    }
+    std::printf("lag %.0f s: verdict %s, lag_s %.3g ± %.2g, held-out %.3g -> %.3g mV/V\n", lag,
+                r.verdict.c_str(), p["lag_s"].get<double>(),
+                r.effects.front().fit.sigma.value("lag_s", -1.0), r.hold_rms_before,
+                r.hold_rms_after);
+  }
+}
+
+/// Rate-independent hysteresis of general shape: a Preisach sum of 60 relays per bridge (random
+/// up/down thresholds within the bridge's load range, random weights, all at rest "down" at the
+/// start) on each bridge's load, which ramps between random targets (8 bridges, 150 Hz, ±30 %
+/// jitter). Noise σ = 1e-3 mV/V. With `load_path` the relays sit on the 6 wrench axes instead
+/// (thresholds within each axis's range, weights in N or N·m): the structure's hysteresis, which
+/// every bridge sees through the sensitivity.
+DiagData PreisachHysteresis(unsigned seed, bool load_path = false) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const int nc = 8;
+  Eigen::MatrixXd s(nc, 6);
+  for (int c = 0; c < nc; ++c) {
+    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
+  }
+  struct Relay {
+    double up, down, weight;
+  };
+  // Load history first (ramps between random targets, then holds), so that the relays'
+  // thresholds can lie within each bridge's actual load range.
+  const int rows = 36000;
+  std::vector<Eigen::VectorXd> loads;
+  Eigen::VectorXd from = Eigen::VectorXd::Zero(6);
+  Eigen::VectorXd to = Eigen::VectorXd::Zero(6);
+  for (int i = 0; i < rows; ++i) {
+    if (i % 180 == 0) {
+      from = to;
+      for (int a = 0; a < 6; ++a) to(a) = 40.0 * u(rng);
+    }
+    const double f = std::min(1.0, (i % 180) / 120.0);
+    loads.push_back(from + f * (to - from));
+  }
+  // One relay set per bridge (its load s_c·w) or per wrench axis (w_a).
+  const int inputs = load_path ? 6 : nc;
+  auto input = [&](const Eigen::VectorXd& w, int k) { return load_path ? w(k) : s.row(k).dot(w); };
+  std::vector<std::vector<Relay>> relays(static_cast<std::size_t>(inputs));
+  std::vector<std::vector<int>> state(static_cast<std::size_t>(inputs));
+  for (int c = 0; c < inputs; ++c) {
+    double lo = 1e300;
+    double hi = -1e300;
+    for (const auto& w : loads) {
+      lo = std::min(lo, input(w, c));
+      hi = std::max(hi, input(w, c));
+    }
+    std::uniform_real_distribution<double> level(lo + 0.05 * (hi - lo), hi - 0.05 * (hi - lo));
+    const double unit = load_path ? 0.4e-3 / 0.02 : 0.4e-3;  // N (0.02 mV/V per N) or mV/V
+    for (int j = 0; j < 60; ++j) {
+      double a = level(rng);
+      double b = level(rng);
+      if (a < b) std::swap(a, b);
+      relays[static_cast<std::size_t>(c)].push_back({a, b, unit * std::fabs(u(rng))});
+      state[static_cast<std::size_t>(c)].push_back(-1);  // at rest below every threshold
+    }
+  }
+  DiagData d;
+  d.sim_name = "independent generator";
+  d.real_name = "Preisach hysteresis";
+  std::vector<double> sim;
+  std::vector<double> real;
+  std::vector<double> wr;
+  double t = 0.0;
+  for (int i = 0; i < rows; ++i) {
+    const Eigen::VectorXd& w = loads[static_cast<std::size_t>(i)];
+    t += (1.0 + 0.3 * u(rng)) / 150.0;
+    d.t_s.push_back(t);
+    Eigen::VectorXd h = Eigen::VectorXd::Zero(inputs);
+    for (int c = 0; c < inputs; ++c) {
+      auto& st = state[static_cast<std::size_t>(c)];
+      const auto& rl = relays[static_cast<std::size_t>(c)];
+      const double x = input(w, c);
+      for (std::size_t j = 0; j < rl.size(); ++j) {
+        if (x >= rl[j].up) st[j] = 1;
+        if (x <= rl[j].down) st[j] = -1;
+        h(c) += rl[j].weight * st[j];
+      }
+    }
+    const Eigen::VectorXd b = s * w;
+    const Eigen::VectorXd seen = load_path ? Eigen::VectorXd(s * (w + h)) : Eigen::VectorXd(b + h);
+    for (int c = 0; c < nc; ++c) {
+      sim.push_back(b(c));
+      real.push_back(seen(c) + 1e-3 * g(rng));
+    }
+    for (int a = 0; a < 6; ++a) wr.push_back(w(a));
+  }
+  const auto n = static_cast<Eigen::Index>(rows);
+  d.sim_mvv = Eigen::Map<Eigen::MatrixXd>(sim.data(), nc, n).transpose();
+  d.real_mvv = Eigen::Map<Eigen::MatrixXd>(real.data(), nc, n).transpose();
+  d.wrench = Eigen::Map<Eigen::MatrixXd>(wr.data(), 6, n).transpose();
+  return d;
+}
+
+TEST(DiagShapes, PreisachHysteresisIsNamedHysteresis) {
+  const DiagData d = PreisachHysteresis(11);
+  const Report r = Diagnose(d);
+  EXPECT_EQ(r.verdict, "hysteresis") << ToJson(r)["candidates"].dump();
+  const double noise2 = 1e-6;
+  const double before = r.hold_rms_before * r.hold_rms_before - noise2;
+  const double after = r.hold_rms_after * r.hold_rms_after - noise2;
+  EXPECT_LT(after, 0.5 * before) << r.hold_rms_before << " -> " << r.hold_rms_after;
+  std::printf("Preisach: verdict %s (%s), held-out %.3g -> %.3g mV/V\n", r.verdict.c_str(),
+              r.effects.empty() ? "" : r.effects.front().fit.variant.c_str(), r.hold_rms_before,
+              r.hold_rms_after);
+}
+
+TEST(DiagShapes, HysteresisInTheLoadPathIsNamedHysteresisAlone) {
+  // Relays on the wrench axes, seen by all 8 bridges through the sensitivity: per-bridge
+  // operators cannot represent the mixture, and a 49-knot time spline following the hold-to-hold
+  // offsets used to win (zero_drift claimed for the simulator's hysteresis, seed 2).
+  const DiagData d = PreisachHysteresis(5, true);
+  const Report r = Diagnose(d);
+  EXPECT_EQ(r.verdict, "hysteresis") << ToJson(r)["candidates"].dump();
+  std::string claimed;
+  for (const auto& e : r.effects) claimed += e.fit.name + " (" + e.fit.variant + ") ";
+  ASSERT_EQ(r.effects.size(), 1u) << claimed;  // nothing claimed beside it
+  EXPECT_NE(r.effects.front().fit.variant.find("wrench axis"), std::string::npos)
+      << r.effects.front().fit.variant;
+  const double noise2 = 1e-6;
+  const double before = r.hold_rms_before * r.hold_rms_before - noise2;
+  const double after = r.hold_rms_after * r.hold_rms_after - noise2;
+  EXPECT_LT(after, 0.5 * before) << r.hold_rms_before << " -> " << r.hold_rms_after;
+  std::printf("load-path Preisach: verdict %s (%s), held-out %.3g -> %.3g mV/V\n",
+              r.verdict.c_str(), r.effects.front().fit.variant.c_str(), r.hold_rms_before,
+              r.hold_rms_after);
+}
+
+}  // namespace
+}  // namespace ftstack::diag
