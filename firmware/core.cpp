@@ -209,7 +209,9 @@ void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts,
   if (clamped) *saturated = true;
 }
 
-WrenchCore::Faults WrenchCore::DetectFaults(const hal::AdcSample& in, CoreOutput& out) {
+// The per-sample stages are inlined into Process: the split is for reading, not a call each.
+[[gnu::always_inline]] inline WrenchCore::Faults WrenchCore::DetectFaults(const hal::AdcSample& in,
+                                                                          CoreOutput& out) {
   const std::size_t n = in.channel_count;
   Faults f;
   bool all_same = n > 0;
@@ -249,7 +251,8 @@ WrenchCore::Faults WrenchCore::DetectFaults(const hal::AdcSample& in, CoreOutput
   return f;
 }
 
-void WrenchCore::AccumulateTare(const hal::AdcSample& in, std::int32_t dt_mdegc) {
+[[gnu::always_inline]] inline void WrenchCore::AccumulateTare(const hal::AdcSample& in,
+                                                              std::int32_t dt_mdegc) {
   const std::size_t n = in.channel_count;
   for (std::size_t c = 0; c < n; ++c) tare_sum_[c] += in.counts[c];
   tare_temp_sum_ += dt_mdegc;
@@ -268,7 +271,7 @@ void WrenchCore::AccumulateTare(const hal::AdcSample& in, std::int32_t dt_mdegc)
   }
 }
 
-void WrenchCore::Filter(const WrenchLsb& y, CoreOutput& out) {
+[[gnu::always_inline]] inline void WrenchCore::Filter(const WrenchLsb& y, CoreOutput& out) {
   auto& slot = filter_ring_[filter_pos_];
   for (std::size_t r = 0; r < kAxes; ++r) {
     if (filter_fill_ == filter_length_) filter_sum_[r] -= slot[r];

@@ -198,8 +198,9 @@ void SetZeroAndTemperature(const FloatCalibration& cal, const hal::AdcInfo& adc,
   }
   fixed->extra_count = static_cast<std::uint8_t>(count - n);
   lay->count = count;
-  for (std::size_t k = 0; k < count; ++k)
+  for (std::size_t k = 0; k < count; ++k) {
     lay->fmax_int[k] = static_cast<std::uint64_t>(lay->fbound[k]);
+  }
   return LoadStatus::kOk;
 }
 
