@@ -234,35 +234,175 @@ Eigen::Matrix<double, 6, 6> AtiWrenchTransform(const Eigen::Vector3d& d, double 
   return t;
 }
 
-AtiImport ParseAtiCal(const std::string& text, const std::string& path) {
-  Scanner scan(text, path);
-  const std::vector<Element> els = scan.Elements();
+namespace {
+
+/// The elements of an ATI .cal file the import reads, found in one pass.
+struct AtiElements {
   const Element* sensor = nullptr;
   const Element* calib = nullptr;
   const Element* basic = nullptr;
   std::vector<const Element*> axes;
   std::vector<const Element*> user_axes;
   std::vector<std::string> ignored;
+};
+
+AtiElements FindElements(const std::vector<Element>& els) {
+  AtiElements found;
   for (const Element& e : els) {
-    if (e.name == "FTSensor" && sensor == nullptr) {
-      sensor = &e;
+    if (e.name == "FTSensor" && found.sensor == nullptr) {
+      found.sensor = &e;
     } else if (e.name == "Calibration") {
-      if (calib != nullptr) {
-        ignored.push_back("only the first <Calibration> is imported");
+      if (found.calib != nullptr) {
+        found.ignored.push_back("only the first <Calibration> is imported");
         break;
       }
-      calib = &e;
+      found.calib = &e;
     } else if (e.name == "Axis") {
-      axes.push_back(&e);
+      found.axes.push_back(&e);
     } else if (e.name == "UserAxis") {
-      user_axes.push_back(&e);
+      found.user_axes.push_back(&e);
     } else if (e.name == "BasicTransform") {
-      basic = &e;
+      found.basic = &e;
     } else if (e.name == "BiasSlope" || e.name == "GainSlope" || e.name == "Thermistor") {
-      ignored.push_back("ATI software temperature compensation (" + e.name +
-                        ") is not imported: it works on a thermistor voltage, not °C");
+      found.ignored.push_back("ATI software temperature compensation (" + e.name +
+                              ") is not imported: it works on a thermistor voltage, not °C");
     }
   }
+  return found;
+}
+
+/// What reading a block of axis rows needs: the file, its <Calibration>, the gauge count and the
+/// SI factors of the force and torque units.
+struct RowContext {
+  const std::string& path;
+  const Element& calib;
+  int n = 0;
+  double f_si = 0;
+  double t_si = 0;
+};
+
+/// Reads six named rows (values ÷ scale if `scaled`, the scales into `axis_scale`), SI units; rated
+/// max per axis.
+void ReadRows(const RowContext& ctx, const std::vector<const Element*>& rows, bool scaled,
+              Eigen::MatrixXd* m, std::array<double, 6>* rated, std::array<double, 6>* axis_scale) {
+  const std::string& path = ctx.path;
+  const int n = ctx.n;
+  m->setZero(6, n);
+  std::array<bool, 6> seen{};
+  for (const Element* e : rows) {
+    const int a = AxisIndex(Attr(path, *e, "Name"));
+    if (a < 0) {
+      throw CalFileError(Where(path, *e) + ": axis name '" + e->attrs.at("Name") +
+                         "' is not Fx, Fy, Fz, Tx, Ty or Tz");
+    }
+    if (seen[static_cast<std::size_t>(a)]) {
+      throw CalFileError(Where(path, *e) + ": axis " + e->attrs.at("Name") + " given twice");
+    }
+    seen[static_cast<std::size_t>(a)] = true;
+    const std::vector<double> vals = Numbers(path, *e, "value", Attr(path, *e, "values"));
+    if (static_cast<int>(vals.size()) != n) {
+      throw CalFileError(Where(path, *e) + ": " + std::to_string(vals.size()) +
+                         " values, NumGages says " + std::to_string(n));
+    }
+    double scale = 1.0;
+    if (scaled && e->attrs.count("scale") != 0) {
+      scale = Number(path, *e, "scale", e->attrs.at("scale"));
+      if (scale == 0) throw CalFileError(Where(path, *e) + ": scale is zero");
+    }
+    if (scaled) (*axis_scale)[static_cast<std::size_t>(a)] = scale;
+    const double unit = a < 3 ? ctx.f_si : ctx.t_si;
+    for (int c = 0; c < n; ++c) (*m)(a, c) = vals[static_cast<std::size_t>(c)] / scale * unit;
+    if (e->attrs.count("max") != 0) {
+      (*rated)[static_cast<std::size_t>(a)] =
+          std::fabs(Number(path, *e, "max", e->attrs.at("max"))) * unit;
+    }
+  }
+  for (int a = 0; a < 6; ++a) {
+    if (!seen[static_cast<std::size_t>(a)]) {
+      throw CalFileError(Where(path, ctx.calib) + ": axis " + std::string(a < 3 ? "F" : "T") +
+                         "xyz"[a % 3] + " is missing");
+    }
+  }
+}
+
+/// The <BasicTransform> as a wrench transform (identity when the file has none).
+Eigen::Matrix<double, 6, 6> ReadBasicTransform(const std::string& path, const Element& calib,
+                                               const Element* basic) {
+  Eigen::Vector3d d = Eigen::Vector3d::Zero();
+  double r[3] = {0, 0, 0};
+  if (basic != nullptr) {
+    const std::string du = Attr(path, calib, "DistUnits");
+    const double d_si = AtiDistanceToM(du);
+    if (d_si == 0) throw CalFileError(Where(path, calib) + ": unknown DistUnits '" + du + "'");
+    const auto au = calib.attrs.find("AngleUnits");
+    const double a_deg = AtiAngleToDeg(au != calib.attrs.end() ? au->second : "degrees");
+    if (a_deg == 0) throw CalFileError(Where(path, calib) + ": unknown AngleUnits");
+    const char* dn[3] = {"Dx", "Dy", "Dz"};
+    const char* rn[3] = {"Rx", "Ry", "Rz"};
+    for (int i = 0; i < 3; ++i) {
+      if (basic->attrs.count(dn[i]) != 0) {
+        d(i) = Number(path, *basic, dn[i], basic->attrs.at(dn[i])) * d_si;
+      }
+      if (basic->attrs.count(rn[i]) != 0) {
+        r[i] = Number(path, *basic, rn[i], basic->attrs.at(rn[i])) * a_deg;
+      }
+    }
+  }
+  return AtiWrenchTransform(d, r[0], r[1], r[2]);
+}
+
+/// Warns for each row where the Axis and UserAxis matrices disagree beyond their print rounding.
+void CompareAxisWithUserAxis(const RowContext& ctx, const std::array<double, 6>& axis_scale,
+                             const Eigen::Matrix<double, 6, 6>& transform, AtiImport* imp) {
+  // Both kinds of rows are printed with 5 decimals in file units: the Axis values' rounding
+  // (÷ scale, through the transform) plus the UserAxis rounding bound the honest difference.
+  static const char* const kNames[6] = {"Fx", "Fy", "Fz", "Tx", "Ty", "Tz"};
+  Eigen::Matrix<double, 6, 1> axis_round;
+  for (int a = 0; a < 6; ++a) {
+    axis_round(a) =
+        0.5e-5 / std::fabs(axis_scale[static_cast<std::size_t>(a)]) * (a < 3 ? ctx.f_si : ctx.t_si);
+  }
+  const Eigen::Matrix<double, 6, 1> propagated = transform.cwiseAbs() * axis_round;
+  for (int a = 0; a < 6; ++a) {
+    const double unit = a < 3 ? ctx.f_si : ctx.t_si;
+    const double tol = (0.5e-5 * unit + propagated(a)) * 1.01 +
+                       1e-9 * imp->from_user_axis.row(a).cwiseAbs().maxCoeff();
+    const double diff = (imp->from_axis.row(a) - imp->from_user_axis.row(a)).cwiseAbs().maxCoeff();
+    if (diff > tol) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "%s row: Axis/scale with BasicTransform and UserAxis disagree by %.3g %s/V "
+                    "(rounding allows %.3g); using UserAxis",
+                    kNames[a], diff, a < 3 ? "N" : "N*m", tol);
+      imp->warnings.push_back(buf);
+    }
+  }
+}
+
+/// The DAQ's input range: OutputRange volts span, bipolar by default; 16-bit converter.
+void FillAdcRange(const std::string& path, const Element& calib, int n, CalFile* f) {
+  double range_v = 20.0;
+  const auto orange = calib.attrs.find("OutputRange");
+  if (orange != calib.attrs.end()) range_v = Number(path, calib, "OutputRange", orange->second);
+  const auto bip = calib.attrs.find("OutputBipolar");
+  const bool bipolar = bip == calib.attrs.end() || bip->second != "False";
+  const double full_scale_v = bipolar ? range_v / 2.0 : range_v;
+  if (!(full_scale_v > 0))
+    throw CalFileError(Where(path, calib) + ": OutputRange must be positive");
+  f->adc.channel_count = static_cast<std::uint8_t>(n);
+  f->adc.max_counts = 32767;
+  f->adc.min_counts = -32768;
+  f->adc.full_scale_nvv = std::llround(full_scale_v * 1e6);  // input unit × 1e-6 (µV)
+}
+
+}  // namespace
+
+AtiImport ParseAtiCal(const std::string& text, const std::string& path) {
+  Scanner scan(text, path);
+  const std::vector<Element> els = scan.Elements();
+  const AtiElements found = FindElements(els);
+  const Element* sensor = found.sensor;
+  const Element* calib = found.calib;
   if (sensor == nullptr)
     throw CalFileError(path + ":1:1: no <FTSensor> element: not an ATI .cal file");
   if (calib == nullptr) throw CalFileError(Where(path, *sensor) + ": no <Calibration> element");
@@ -276,119 +416,35 @@ AtiImport ParseAtiCal(const std::string& text, const std::string& path) {
   imp.version = v != sensor->attrs.end() ? v->second : "1.0";
   const std::string& fu = Attr(path, *calib, "ForceUnits");
   const std::string& tu = Attr(path, *calib, "TorqueUnits");
-  const double f_si = AtiForceToN(fu);
-  const double t_si = AtiTorqueToNm(tu);
-  if (f_si == 0) throw CalFileError(Where(path, *calib) + ": unknown ForceUnits '" + fu + "'");
-  if (t_si == 0) throw CalFileError(Where(path, *calib) + ": unknown TorqueUnits '" + tu + "'");
+  const RowContext ctx{path, *calib, n, AtiForceToN(fu), AtiTorqueToNm(tu)};
+  if (ctx.f_si == 0) throw CalFileError(Where(path, *calib) + ": unknown ForceUnits '" + fu + "'");
+  if (ctx.t_si == 0) throw CalFileError(Where(path, *calib) + ": unknown TorqueUnits '" + tu + "'");
 
-  // Reads six named rows (values ÷ scale if `scaled`), SI units; rated max per axis.
   std::array<double, 6> axis_scale{};
-  auto read_rows = [&](const std::vector<const Element*>& rows, bool scaled, Eigen::MatrixXd* m,
-                       std::array<double, 6>* rated) {
-    m->setZero(6, n);
-    std::array<bool, 6> seen{};
-    for (const Element* e : rows) {
-      const int a = AxisIndex(Attr(path, *e, "Name"));
-      if (a < 0) {
-        throw CalFileError(Where(path, *e) + ": axis name '" + e->attrs.at("Name") +
-                           "' is not Fx, Fy, Fz, Tx, Ty or Tz");
-      }
-      if (seen[static_cast<std::size_t>(a)]) {
-        throw CalFileError(Where(path, *e) + ": axis " + e->attrs.at("Name") + " given twice");
-      }
-      seen[static_cast<std::size_t>(a)] = true;
-      const std::vector<double> vals = Numbers(path, *e, "value", Attr(path, *e, "values"));
-      if (static_cast<int>(vals.size()) != n) {
-        throw CalFileError(Where(path, *e) + ": " + std::to_string(vals.size()) +
-                           " values, NumGages says " + std::to_string(n));
-      }
-      double scale = 1.0;
-      if (scaled && e->attrs.count("scale") != 0) {
-        scale = Number(path, *e, "scale", e->attrs.at("scale"));
-        if (scale == 0) throw CalFileError(Where(path, *e) + ": scale is zero");
-      }
-      if (scaled) axis_scale[static_cast<std::size_t>(a)] = scale;
-      const double unit = a < 3 ? f_si : t_si;
-      for (int c = 0; c < n; ++c) (*m)(a, c) = vals[static_cast<std::size_t>(c)] / scale * unit;
-      if (e->attrs.count("max") != 0) {
-        (*rated)[static_cast<std::size_t>(a)] =
-            std::fabs(Number(path, *e, "max", e->attrs.at("max"))) * unit;
-      }
-    }
-    for (int a = 0; a < 6; ++a) {
-      if (!seen[static_cast<std::size_t>(a)]) {
-        throw CalFileError(Where(path, *calib) + ": axis " + std::string(a < 3 ? "F" : "T") +
-                           "xyz"[a % 3] + " is missing");
-      }
-    }
-  };
-
   std::array<double, 6> rated{};
   Eigen::Matrix<double, 6, 6> transform = Eigen::Matrix<double, 6, 6>::Identity();
-  if (!axes.empty()) {
+  if (!found.axes.empty()) {
     Eigen::MatrixXd basic_m;
-    read_rows(axes, true, &basic_m, &rated);
-    Eigen::Vector3d d = Eigen::Vector3d::Zero();
-    double r[3] = {0, 0, 0};
-    if (basic != nullptr) {
-      const std::string du = Attr(path, *calib, "DistUnits");
-      const double d_si = AtiDistanceToM(du);
-      if (d_si == 0) throw CalFileError(Where(path, *calib) + ": unknown DistUnits '" + du + "'");
-      const auto au = calib->attrs.find("AngleUnits");
-      const double a_deg = AtiAngleToDeg(au != calib->attrs.end() ? au->second : "degrees");
-      if (a_deg == 0) throw CalFileError(Where(path, *calib) + ": unknown AngleUnits");
-      const char* dn[3] = {"Dx", "Dy", "Dz"};
-      const char* rn[3] = {"Rx", "Ry", "Rz"};
-      for (int i = 0; i < 3; ++i) {
-        if (basic->attrs.count(dn[i]) != 0) {
-          d(i) = Number(path, *basic, dn[i], basic->attrs.at(dn[i])) * d_si;
-        }
-        if (basic->attrs.count(rn[i]) != 0) {
-          r[i] = Number(path, *basic, rn[i], basic->attrs.at(rn[i])) * a_deg;
-        }
-      }
-    }
-    transform = AtiWrenchTransform(d, r[0], r[1], r[2]);
+    ReadRows(ctx, found.axes, true, &basic_m, &rated, &axis_scale);
+    transform = ReadBasicTransform(path, *calib, found.basic);
     imp.from_axis = transform * basic_m;
   }
-  if (!user_axes.empty()) {
+  if (!found.user_axes.empty()) {
     std::array<double, 6> user_rated{};
-    read_rows(user_axes, false, &imp.from_user_axis, &user_rated);
+    ReadRows(ctx, found.user_axes, false, &imp.from_user_axis, &user_rated, &axis_scale);
     for (std::size_t a = 0; a < 6; ++a) {
       if (user_rated[a] > 0) rated[a] = user_rated[a];
     }
   }
-  if (axes.empty() && user_axes.empty()) {
+  if (found.axes.empty() && found.user_axes.empty()) {
     throw CalFileError(Where(path, *calib) + ": no <Axis> or <UserAxis> rows");
   }
-  imp.used_user_axis = !user_axes.empty();
+  imp.used_user_axis = !found.user_axes.empty();
   const Eigen::MatrixXd& m = imp.used_user_axis ? imp.from_user_axis : imp.from_axis;
-  if (!axes.empty() && !user_axes.empty()) {
-    // Both kinds of rows are printed with 5 decimals in file units: the Axis values' rounding
-    // (÷ scale, through the transform) plus the UserAxis rounding bound the honest difference.
-    static const char* const kNames[6] = {"Fx", "Fy", "Fz", "Tx", "Ty", "Tz"};
-    Eigen::Matrix<double, 6, 1> axis_round;
-    for (int a = 0; a < 6; ++a) {
-      axis_round(a) =
-          0.5e-5 / std::fabs(axis_scale[static_cast<std::size_t>(a)]) * (a < 3 ? f_si : t_si);
-    }
-    const Eigen::Matrix<double, 6, 1> propagated = transform.cwiseAbs() * axis_round;
-    for (int a = 0; a < 6; ++a) {
-      const double unit = a < 3 ? f_si : t_si;
-      const double tol = (0.5e-5 * unit + propagated(a)) * 1.01 +
-                         1e-9 * imp.from_user_axis.row(a).cwiseAbs().maxCoeff();
-      const double diff = (imp.from_axis.row(a) - imp.from_user_axis.row(a)).cwiseAbs().maxCoeff();
-      if (diff > tol) {
-        char buf[200];
-        std::snprintf(buf, sizeof buf,
-                      "%s row: Axis/scale with BasicTransform and UserAxis disagree by %.3g %s/V "
-                      "(rounding allows %.3g); using UserAxis",
-                      kNames[a], diff, a < 3 ? "N" : "N*m", tol);
-        imp.warnings.push_back(buf);
-      }
-    }
+  if (!found.axes.empty() && !found.user_axes.empty()) {
+    CompareAxisWithUserAxis(ctx, axis_scale, transform, &imp);
   }
-  for (const std::string& s : ignored) imp.warnings.push_back(s);
+  for (const std::string& s : found.ignored) imp.warnings.push_back(s);
 
   CalFile& f = imp.file;
   f.source = "ati";
@@ -404,19 +460,7 @@ AtiImport ParseAtiCal(const std::string& text, const std::string& path) {
     }
   }
   f.rated = rated;
-  // The DAQ's input range: OutputRange volts span, bipolar by default; 16-bit converter.
-  double range_v = 20.0;
-  const auto orange = calib->attrs.find("OutputRange");
-  if (orange != calib->attrs.end()) range_v = Number(path, *calib, "OutputRange", orange->second);
-  const auto bip = calib->attrs.find("OutputBipolar");
-  const bool bipolar = bip == calib->attrs.end() || bip->second != "False";
-  const double full_scale_v = bipolar ? range_v / 2.0 : range_v;
-  if (!(full_scale_v > 0))
-    throw CalFileError(Where(path, *calib) + ": OutputRange must be positive");
-  f.adc.channel_count = static_cast<std::uint8_t>(n);
-  f.adc.max_counts = 32767;
-  f.adc.min_counts = -32768;
-  f.adc.full_scale_nvv = std::llround(full_scale_v * 1e6);  // input unit × 1e-6 (µV)
+  FillAdcRange(path, *calib, n, &f);
   f.extra["ati"] = {
       {"version", imp.version},
       {"matrix_from", imp.used_user_axis ? "UserAxis" : "Axis/scale + BasicTransform"},

@@ -195,6 +195,95 @@ nlohmann::json ToJson(const CalFile& f) {
   return j;
 }
 
+namespace {
+
+/// The invalid_axes list (schema 3 only) into the calibration's bit mask.
+void ReadInvalidAxes(const nlohmann::json& j, const std::string& path, fw::FloatCalibration* cal) {
+  // Only with schema 3, so that no reader that ignores the field ever sees it.
+  if (j["schema"] != kCalSchemaV3 || !j.contains("invalid_axes")) {
+    throw CalFileError(path + ": invalid_axes and schema '" + kCalSchemaV3 + "' go together");
+  }
+  const auto& a = j["invalid_axes"];
+  if (!a.is_array() || a.empty()) {
+    throw CalFileError(path + ": invalid_axes must list axis names (Fx … Mz)");
+  }
+  for (const auto& name : a) {
+    std::size_t axis = 6;
+    for (std::size_t i = 0; i < 6; ++i) {
+      if (name.is_string() && name.get<std::string>() == kAxisNames[i]) axis = i;
+    }
+    if (axis == 6 || (cal->invalid_axes & (1u << axis)) != 0) {
+      throw CalFileError(path + ": invalid_axes: " + name.dump() +
+                         " is not an axis name (Fx … Mz) or is listed twice");
+    }
+    cal->invalid_axes = static_cast<std::uint8_t>(cal->invalid_axes | (1u << axis));
+  }
+}
+
+/// The second-order model: product pairs and their 6 × K matrix.
+void ReadProducts(const nlohmann::json& model, const std::string& path, int n,
+                  fw::FloatCalibration* cal) {
+  const auto& terms = model.at("products");
+  const auto& pm = model.at("product_matrix");
+  if (!terms.is_array() || terms.size() > fw::kMaxProducts) {
+    throw CalFileError(path + ": model.products must list at most " +
+                       std::to_string(fw::kMaxProducts) + " pairs");
+  }
+  const std::size_t k_count = terms.size();
+  cal->product_count = static_cast<std::uint8_t>(k_count);
+  for (std::size_t k = 0; k < k_count; ++k) {
+    const auto& t = terms[k];
+    if (!t.is_array() || t.size() != 2 || !t[0].is_number_integer() || !t[1].is_number_integer()) {
+      throw CalFileError(path + ": model.products[" + std::to_string(k) + "] must be [a, b]");
+    }
+    const int a = t[0].get<int>();
+    const int b = t[1].get<int>();
+    if (a < 0 || b < a || b >= n) {
+      throw CalFileError(path + ": model.products[" + std::to_string(k) +
+                         "] names a channel outside 0.." + std::to_string(n - 1));
+    }
+    cal->products[k] = fw::ProductTerm{static_cast<std::uint8_t>(a), static_cast<std::uint8_t>(b)};
+  }
+  if (!pm.is_array() || pm.size() != 6) {
+    throw CalFileError(path + ": model.product_matrix must have 6 rows");
+  }
+  for (std::size_t r = 0; r < 6; ++r) {
+    if (!pm[r].is_array() || pm[r].size() != k_count) {
+      throw CalFileError(path + ": model.product_matrix row " + std::to_string(r) + " must have " +
+                         std::to_string(k_count) + " entries");
+    }
+    for (std::size_t k = 0; k < k_count; ++k) {
+      cal->product_matrix[r][k] =
+          Finite(pm[r][k], path,
+                 "model.product_matrix[" + std::to_string(r) + "][" + std::to_string(k) + "]");
+    }
+  }
+}
+
+/// The temperature compensation: reference, range and per-channel slopes.
+void ReadTemperature(const nlohmann::json& t, const std::string& path, int n,
+                     fw::FloatCalibration* cal) {
+  cal->temperature_compensated = true;
+  cal->temp_ref_c = Finite(t.at("ref_C"), path, "temperature.ref_C");
+  cal->temp_min_c = Finite(t.at("min_C"), path, "temperature.min_C");
+  cal->temp_max_c = Finite(t.at("max_C"), path, "temperature.max_C");
+  auto slopes = [&](const char* key, double* out) {
+    const auto& a = t.at(key);
+    if (!a.is_array() || a.size() != static_cast<std::size_t>(n)) {
+      throw CalFileError(path + ": temperature." + key + " must have " + std::to_string(n) +
+                         " entries");
+    }
+    for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) {
+      out[i] =
+          Finite(a[i], path, std::string("temperature.") + key + "[" + std::to_string(i) + "]");
+    }
+  };
+  slopes("bias_slope_mvv_per_C", cal->bias_slope_mvv_per_c.data());
+  slopes("gain_slope_per_C", cal->gain_slope_per_c.data());
+}
+
+}  // namespace
+
 CalFile FromJson(const nlohmann::json& j, const std::string& path) {
   if (!j.is_object()) throw CalFileError(path + ": not a JSON object");
   if (!j.contains("schema") ||
@@ -255,87 +344,9 @@ CalFile FromJson(const nlohmann::json& j, const std::string& path) {
   vec("bias", 6, f.cal.bias.data(), true);
   vec("rated", 6, f.rated.data(), true);
   vec("uncertainty", 6, f.uncertainty.data(), false);
-  if (j.contains("invalid_axes") || j["schema"] == kCalSchemaV3) {
-    // Only with schema 3, so that no reader that ignores the field ever sees it.
-    if (j["schema"] != kCalSchemaV3 || !j.contains("invalid_axes")) {
-      throw CalFileError(path + ": invalid_axes and schema '" + kCalSchemaV3 + "' go together");
-    }
-    const auto& a = j["invalid_axes"];
-    if (!a.is_array() || a.empty()) {
-      throw CalFileError(path + ": invalid_axes must list axis names (Fx … Mz)");
-    }
-    for (const auto& name : a) {
-      std::size_t axis = 6;
-      for (std::size_t i = 0; i < 6; ++i) {
-        if (name.is_string() && name.get<std::string>() == kAxisNames[i]) axis = i;
-      }
-      if (axis == 6 || (f.cal.invalid_axes & (1u << axis)) != 0) {
-        throw CalFileError(path + ": invalid_axes: " + name.dump() +
-                           " is not an axis name (Fx … Mz) or is listed twice");
-      }
-      f.cal.invalid_axes = static_cast<std::uint8_t>(f.cal.invalid_axes | (1u << axis));
-    }
-  }
-  if (j.contains("model")) {
-    const auto& model = j["model"];
-    const auto& terms = model.at("products");
-    const auto& pm = model.at("product_matrix");
-    if (!terms.is_array() || terms.size() > fw::kMaxProducts) {
-      throw CalFileError(path + ": model.products must list at most " +
-                         std::to_string(fw::kMaxProducts) + " pairs");
-    }
-    const std::size_t k_count = terms.size();
-    f.cal.product_count = static_cast<std::uint8_t>(k_count);
-    for (std::size_t k = 0; k < k_count; ++k) {
-      const auto& t = terms[k];
-      if (!t.is_array() || t.size() != 2 || !t[0].is_number_integer() ||
-          !t[1].is_number_integer()) {
-        throw CalFileError(path + ": model.products[" + std::to_string(k) + "] must be [a, b]");
-      }
-      const int a = t[0].get<int>();
-      const int b = t[1].get<int>();
-      if (a < 0 || b < a || b >= n) {
-        throw CalFileError(path + ": model.products[" + std::to_string(k) +
-                           "] names a channel outside 0.." + std::to_string(n - 1));
-      }
-      f.cal.products[k] =
-          fw::ProductTerm{static_cast<std::uint8_t>(a), static_cast<std::uint8_t>(b)};
-    }
-    if (!pm.is_array() || pm.size() != 6) {
-      throw CalFileError(path + ": model.product_matrix must have 6 rows");
-    }
-    for (std::size_t r = 0; r < 6; ++r) {
-      if (!pm[r].is_array() || pm[r].size() != k_count) {
-        throw CalFileError(path + ": model.product_matrix row " + std::to_string(r) +
-                           " must have " + std::to_string(k_count) + " entries");
-      }
-      for (std::size_t k = 0; k < k_count; ++k) {
-        f.cal.product_matrix[r][k] =
-            Finite(pm[r][k], path,
-                   "model.product_matrix[" + std::to_string(r) + "][" + std::to_string(k) + "]");
-      }
-    }
-  }
-  if (j.contains("temperature")) {
-    const auto& t = j["temperature"];
-    f.cal.temperature_compensated = true;
-    f.cal.temp_ref_c = Finite(t.at("ref_C"), path, "temperature.ref_C");
-    f.cal.temp_min_c = Finite(t.at("min_C"), path, "temperature.min_C");
-    f.cal.temp_max_c = Finite(t.at("max_C"), path, "temperature.max_C");
-    auto slopes = [&](const char* key, double* out) {
-      const auto& a = t.at(key);
-      if (!a.is_array() || a.size() != static_cast<std::size_t>(n)) {
-        throw CalFileError(path + ": temperature." + key + " must have " + std::to_string(n) +
-                           " entries");
-      }
-      for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) {
-        out[i] =
-            Finite(a[i], path, std::string("temperature.") + key + "[" + std::to_string(i) + "]");
-      }
-    };
-    slopes("bias_slope_mvv_per_C", f.cal.bias_slope_mvv_per_c.data());
-    slopes("gain_slope_per_C", f.cal.gain_slope_per_c.data());
-  }
+  if (j.contains("invalid_axes") || j["schema"] == kCalSchemaV3) ReadInvalidAxes(j, path, &f.cal);
+  if (j.contains("model")) ReadProducts(j["model"], path, n, &f.cal);
+  if (j.contains("temperature")) ReadTemperature(j["temperature"], path, n, &f.cal);
   const auto& adc = j.at("adc");
   f.adc.channel_count = static_cast<std::uint8_t>(n);
   f.adc.min_counts = adc.at("min_counts").get<std::int32_t>();

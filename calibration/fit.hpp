@@ -117,6 +117,9 @@ struct FitResult {
 /// (fewer than 2 blocks, fewer rows than coefficients, NaN).
 [[nodiscard]] FitResult FitCalibration(const RigData& data, const FitOptions& options);
 
+/// sqrt(λmax/λmin) of a symmetric Gram matrix (infinity when it is singular).
+[[nodiscard]] double GramCondition(const Eigen::MatrixXd& gram);
+
 /// Condition number (σmax/σmin) of [1, wrench ./ rated] — how well a load set excites all axes.
 [[nodiscard]] double LoadSetCondition(const Eigen::MatrixXd& wrench,
                                       const std::array<double, 6>& rated);

@@ -14,8 +14,11 @@
 #   ftstack_diagnosis    sim-vs-real diagnosis engine                 -> meas
 #   ftstack_diagnosis_report  its HTML/JSON reports                   -> meas, diag
 #   ftstack_diagnosis_eval    scorecard, demo, model prediction       -> diag, sim (and below)
-#   ftstack_tool_*       logic behind the command-line tools          -> anything above
-# Executables (tools, tests, benchmarks, fuzzers) may link anything; nothing links a test.
+# Every ftstack_* library has one of these layers (a library without one fails configuration).
+# The programs of tools/ are argument parsing only: each is declared with ftstack_program and
+# may link the layers it names, nothing else (ftd: the daemon, and its simulator on a host; ftcal:
+# calibration and the rig simulation; ftsim: the simulator; ftdiag: the diagnosis).
+# Tests, benchmarks and fuzzers may link any library; nothing links a test.
 
 add_library(ftstack_warnings INTERFACE)
 target_compile_options(ftstack_warnings INTERFACE -Wall -Wextra -Wshadow -Wnon-virtual-dtor)
@@ -80,6 +83,13 @@ function(ftstack_library name)
   set_property(GLOBAL APPEND PROPERTY FTSTACK_LIBRARIES ${name})
 endfunction()
 
+# ftstack_program(NAME LAYERS layer...): a program of tools/ and the layers it may link directly.
+function(ftstack_program name)
+  cmake_parse_arguments(ARG "" "" "LAYERS" ${ARGN})
+  set_property(TARGET ${name} PROPERTY FTSTACK_LAYERS "${ARG_LAYERS}")
+  set_property(GLOBAL APPEND PROPERTY FTSTACK_PROGRAMS ${name})
+endfunction()
+
 function(_ftstack_layer_of target out)
   if(target STREQUAL "ftstack_hal")
     set(${out} "hal_if" PARENT_SCOPE)
@@ -105,8 +115,6 @@ function(_ftstack_layer_of target out)
     set(${out} "diag_report" PARENT_SCOPE)
   elseif(target STREQUAL "ftstack_diagnosis_eval")
     set(${out} "diag_eval" PARENT_SCOPE)
-  elseif(target MATCHES "^ftstack_tool_")
-    set(${out} "tool" PARENT_SCOPE)
   elseif(target MATCHES "^ftstack_test|^test_")
     set(${out} "test" PARENT_SCOPE)
   else()
@@ -127,10 +135,19 @@ function(ftstack_check_layers)
   set(allowed_diag "meas")
   set(allowed_diag_report "meas;diag")
   set(allowed_diag_eval "hal_if;hal;meas;calfile;sim;diag")
-  set(allowed_tool "hal_if;hal;fw;meas;calfile;calfit;sim;daemon;daemon_sim;diag;diag_report;diag_eval;tool")
   get_property(libs GLOBAL PROPERTY FTSTACK_LIBRARIES)
-  foreach(lib IN LISTS libs)
-    _ftstack_layer_of(${lib} layer)
+  get_property(programs GLOBAL PROPERTY FTSTACK_PROGRAMS)
+  foreach(lib IN LISTS libs programs)
+    if(lib IN_LIST programs)
+      set(layer "program")
+      get_target_property(allowed_program ${lib} FTSTACK_LAYERS)
+    else()
+      _ftstack_layer_of(${lib} layer)
+      if(layer STREQUAL "external" OR layer STREQUAL "test")
+        message(FATAL_ERROR "Architecture violation: library ${lib} has no layer (name it for one "
+                            "in cmake/FtstackTargets.cmake). See docs/architecture.md.")
+      endif()
+    endif()
     get_target_property(type ${lib} TYPE)
     if(type STREQUAL "INTERFACE_LIBRARY")
       get_target_property(deps ${lib} INTERFACE_LINK_LIBRARIES)

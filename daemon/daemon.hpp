@@ -1,4 +1,4 @@
-// The ftd daemon: sampling thread, Modbus TCP/RTU threads and the recording logger, as a library.
+// The ftd daemon: composes backend, device, servers and logger; runs the sampling thread.
 #pragma once
 
 #include <array>
@@ -13,67 +13,19 @@
 #include <vector>
 
 #include "daemon/backend.hpp"
-#include "daemon/rdt_server.hpp"
+#include "daemon/calibration_set.hpp"
+#include "daemon/options.hpp"
+#include "daemon/sample_log.hpp"
+#include "daemon/servers.hpp"
 #include "firmware/device.hpp"
 #include "firmware/modbus_server.hpp"
 #include "firmware/register_map.hpp"
 
-namespace ftstack {
-class RecordingWriter;
-}  // namespace ftstack
-
 namespace ftstack::daemon {
-
-/// A start-up failure of the daemon; what() is the one-line reason.
-class FtdError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-/// Everything `ftd` is told on its command line (shared spec cli.md).
-struct FtdOptions {
-  std::string adc = "sim";                          ///< sim, hx711, spi
-  std::optional<std::array<double, 6>> sim_wrench;  ///< constant applied wrench, N and N·m
-  std::string replay;                               ///< recording whose wrench columns are played
-  unsigned rate_hz = 1000;
-  std::string cal;    ///< calibration file for slot 0 ("" = built-in)
-  std::string cal_b;  ///< calibration file for slot 1 ("" = none)
-  /// A slot directory of `ftcal install` (cal_A.json, cal_B.json, active): slots 0/1 from its
-  /// files, starting on the one CalSlots::LoadActive resolves ("" = use cal / cal_b).
-  std::string cal_dir;
-  std::string payload;  ///< payload file for gravity compensation ("" = none)
-  std::string rdt;      ///< HOST:PORT of the RDT server ("" = none)
-  double rdt_counts_per_n = 1e6;
-  double rdt_counts_per_nm = 1e6;
-  unsigned rdt_buffer = 4;                 ///< records per packet in buffered RDT modes
-  std::uint32_t rdt_status_mask = 0xFFFF;  ///< status bits copied into RDT records
-  std::string modbus_tcp;                  ///< HOST:PORT ("" = no TCP server)
-  std::string modbus_rtu;                  ///< serial device ("" = no RTU server)
-  unsigned baud = 19200;
-  char parity = 'N';
-  unsigned unit_id = 1;
-  std::string log;  ///< recording to write ("" = none)
-  std::string gpiochip;
-  std::string spidev;
-  std::uint64_t seed = 1;
-  bool paced = true;  ///< simulated ADC follows the wall clock (false: as fast as possible)
-  /// Simulated ADC: hold the sampling thread sim_stall_ms on every sim_stall_every-th sample
-  /// (0: never) — a deterministic stand-in for a preempted sampler (--sim-stall EVERY:MS).
-  unsigned sim_stall_every = 0;
-  double sim_stall_ms = 0;
-};
 
 /// Longest pause of the sampling loop after a backend call that failed at once (the back-off
 /// doubles from one sample period up to this).
 inline constexpr std::uint32_t kMaxBackoffUs = 100000;
-
-/// Parses "HOST:PORT"; throws FtdError naming the bad part.
-void ParseHostPort(const std::string& text, std::string* host, std::uint16_t* port);
-
-/// CRC-32 of the fixed-point form of a calibration (little-endian: channel count, then per row
-/// the N coefficients and the bias as int64 and the shift as uint8, then the rails as int32).
-/// Reported in input registers 72–73 for the built-in calibration, which has no file.
-[[nodiscard]] std::uint32_t FixedFormCrc(const fw::FixedCalibration& cal);
 
 /// Live figures of a running daemon.
 struct FtdStats {
@@ -109,17 +61,16 @@ class Ftd {
   [[nodiscard]] fw::RegisterMap& register_map() { return *map_; }
   [[nodiscard]] const fw::ServerCounters* tcp_counters() const;
   /// The RDT server (nullptr without --rdt).
-  [[nodiscard]] const RdtServer* rdt() const { return rdt_.get(); }
+  [[nodiscard]] const RdtServer* rdt() const { return servers_.rdt(); }
   /// One status line (no newline): sequence, wrench, status bits, sample rate, clients.
   [[nodiscard]] std::string StatusLine() const;
 
  private:
-  /// --cal-dir: points cal/cal_b at the directory's slot files and returns the active slot
-  /// ('A', 'B') as CalSlots::LoadActive resolves it (0 when none is valid), logging why.
-  char ResolveSlotDirectory();
+  /// The backend --adc names (the simulator's, or a hardware converter). Throws FtdError.
+  void MakeBackend();
+  /// Starts the sampling thread (real-time where granted) and one thread per server.
+  void StartThreads();
   void SamplingLoop();
-  void StartRdt();
-  void PrepareLog();  ///< checks that --log can be written, sizes the log ring
   void BackOff(std::uint32_t pause_us);
 
   FtdOptions opt_;
@@ -128,21 +79,8 @@ class Ftd {
   std::unique_ptr<fw::WrenchCore> core_;
   std::unique_ptr<fw::Device> device_;
   std::unique_ptr<fw::RegisterMap> map_;
-  std::unique_ptr<fw::ModbusTcpServer> tcp_;
-  std::unique_ptr<fw::ModbusRtuServer> rtu_;
-  std::unique_ptr<RdtServer> rdt_;
-  std::unique_ptr<RecordingWriter> writer_;
-
-  // Single-producer (sampling thread) single-consumer (DrainLog) ring of published samples.
-  std::vector<fw::DeviceSample> ring_;
-  std::atomic<std::uint64_t> ring_head_{0};
-  std::atomic<std::uint64_t> ring_tail_{0};
-  std::atomic<std::uint64_t> log_dropped_{0};
-  std::uint64_t logged_rows_ = 0;
-  std::uint32_t last_logged_sequence_ = 0;
-  std::uint64_t log_time_base_us_ = 0;
-  std::uint32_t last_log_timestamp_us_ = 0;
-  bool log_started_ = false;
+  Servers servers_;
+  SampleLog log_;
 
   std::atomic<bool> stop_{false};
   std::atomic<bool> ended_{false};

@@ -197,34 +197,53 @@ void ApplyHardwareEnvironment(HardwareAdcOptions& options) {
   }
 }
 
-std::unique_ptr<hal::Adc> MakeHardwareAdc(const HardwareAdcOptions& given, std::string* error) {
+std::unique_ptr<hal::Adc> MakeHardwareAdc(const HardwareAdcOptions& given) {
   HardwareAdcOptions options = given;
   try {
     ApplyHardwareEnvironment(options);
   } catch (const std::exception& e) {
-    *error = e.what();
-    return nullptr;
+    throw FtdError(e.what());
   }
+  std::string error;
   if (options.kind == "hx711") {
-    if (options.gpiochip.empty()) {
-      *error = "--adc hx711 needs --gpiochip /dev/gpiochipN";
-      return nullptr;
-    }
+    if (options.gpiochip.empty()) throw FtdError("--adc hx711 needs --gpiochip /dev/gpiochipN");
     auto board = std::make_unique<Hx711Board>(options);
-    if (!board->Open(error)) return nullptr;
+    if (!board->Open(&error)) throw FtdError(error);
     return board;
   }
   if (options.kind == "spi") {
     if (options.spidev.empty() || options.gpiochip.empty()) {
-      *error = "--adc spi needs --spidev /dev/spidevB.C and --gpiochip /dev/gpiochipN (/DRDY)";
-      return nullptr;
+      throw FtdError(
+          "--adc spi needs --spidev /dev/spidevB.C and --gpiochip /dev/gpiochipN (/DRDY)");
     }
     auto board = std::make_unique<SpiBoard>(options);
-    if (!board->Open(error)) return nullptr;
+    if (!board->Open(&error)) throw FtdError(error);
     return board;
   }
-  *error = "--adc " + options.kind + ": unknown hardware ADC (hx711, spi)";
-  return nullptr;
+  throw FtdError("--adc " + options.kind + ": unknown hardware ADC (hx711, spi)");
+}
+
+namespace {
+
+/// A hardware converter (HX711 over GPIO, ADS131M over SPI); needs a calibration file.
+class HardwareBackend final : public AdcBackend {
+ public:
+  HardwareBackend(std::unique_ptr<hal::Adc> adc, std::uint8_t channels)
+      : adc_(std::move(adc)), channels_(channels) {}
+  hal::Adc& adc() override { return *adc_; }
+  [[nodiscard]] std::uint8_t channel_count() const override { return channels_; }
+
+ private:
+  std::unique_ptr<hal::Adc> adc_;
+  std::uint8_t channels_;
+};
+
+}  // namespace
+
+std::unique_ptr<AdcBackend> MakeHardwareBackend(const FtdOptions& opt) {
+  constexpr std::uint8_t kChannels = 6;
+  const HardwareAdcOptions hw{opt.adc, opt.gpiochip, opt.spidev, kChannels};
+  return std::make_unique<HardwareBackend>(MakeHardwareAdc(hw), kChannels);
 }
 
 }  // namespace ftstack::daemon

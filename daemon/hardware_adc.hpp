@@ -7,6 +7,8 @@
 #include <utility>
 #include <vector>
 
+#include "daemon/backend.hpp"
+#include "daemon/options.hpp"
 #include "hal/adc.hpp"
 
 namespace ftstack::daemon {
@@ -38,8 +40,11 @@ std::vector<std::pair<unsigned, unsigned>> ParseHx711Lines(const std::string& te
 /// FTD_ADS131M, FTD_EXCITATION_UV, FTD_RT_PRIORITY when set. Throws std::invalid_argument.
 void ApplyHardwareEnvironment(HardwareAdcOptions& options);
 
-/// Opens the backend; nullptr with a one-line reason in *error when it cannot (no chip, no
+/// Opens the converter; throws FtdError with a one-line reason when it cannot (no chip, no
 /// permission, missing --gpiochip/--spidev, bad environment value).
-std::unique_ptr<hal::Adc> MakeHardwareAdc(const HardwareAdcOptions& options, std::string* error);
+[[nodiscard]] std::unique_ptr<hal::Adc> MakeHardwareAdc(const HardwareAdcOptions& options);
+
+/// ftd's backend of --adc hx711|spi (six bridges); throws FtdError as MakeHardwareAdc.
+[[nodiscard]] std::unique_ptr<AdcBackend> MakeHardwareBackend(const FtdOptions& opt);
 
 }  // namespace ftstack::daemon

@@ -1,5 +1,7 @@
 #include "daemon/rdt_server.hpp"
 
+#include "daemon/options.hpp"
+
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <netinet/in.h>
@@ -44,28 +46,22 @@ RdtServer::~RdtServer() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-bool RdtServer::Open(std::string* error) {
+void RdtServer::Open() {
   fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-  if (fd_ < 0) {
-    *error = std::string("socket: ") + std::strerror(errno);
-    return false;
-  }
+  if (fd_ < 0) throw FtdError(std::string("socket: ") + std::strerror(errno));
   sockaddr_in a{};
   a.sin_family = AF_INET;
   a.sin_port = htons(opt_.port);
   if (::inet_pton(AF_INET, opt_.host.c_str(), &a.sin_addr) != 1) {
-    *error = "'" + opt_.host + "' is not an IPv4 address";
-    return false;
+    throw FtdError("'" + opt_.host + "' is not an IPv4 address");
   }
   if (::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
-    *error = std::string("bind: ") + std::strerror(errno);
-    return false;
+    throw FtdError(std::string("bind: ") + std::strerror(errno));
   }
   socklen_t len = sizeof a;
   if (::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len) == 0) port_ = ntohs(a.sin_port);
   const int sndbuf = 1 << 20;
   (void)::setsockopt(fd_, SOL_SOCKET, SO_SNDBUF, &sndbuf, sizeof sndbuf);
-  return true;
 }
 
 void RdtServer::Publish(const fw::DeviceSample& d) {

@@ -65,8 +65,8 @@ class RdtServer {
   RdtServer(const RdtServer&) = delete;
   RdtServer& operator=(const RdtServer&) = delete;
 
-  /// Binds the UDP socket; false with *error set on failure.
-  [[nodiscard]] bool Open(std::string* error);
+  /// Binds the UDP socket; throws FtdError with the reason on failure.
+  void Open();
   [[nodiscard]] std::uint16_t port() const { return port_; }
 
   /// Queues one published sample (sampling thread only).

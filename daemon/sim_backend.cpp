@@ -27,23 +27,16 @@ class SimulatedBackend final : public AdcBackend {
       }
       source_ = std::make_unique<sim::ConstantWrench>(w);
     }
-    sensor_ = std::make_unique<sim::SimulatedSensor>(*desc_.model, *source_);
     // The built-in sensor's converter at the requested rate (its datasheet noise); a rate the
     // converter cannot run keeps the nominal operating point's noise.
-    hal::sim::SimAdcParams params;
-    try {
-      params = sim::AdcParamsAt(desc_, opt.rate_hz);
-    } catch (const std::invalid_argument&) {
-      params = desc_.adc;
-      params.required_rate_hz = 0;
-    }
+    hal::sim::SimAdcParams params = sim::AdcParamsOrNominal(desc_, opt.rate_hz);
     params.seed = opt.seed;
     params.realtime = opt.paced;
     params.stall_every = opt.sim_stall_every;
     params.stall_us = static_cast<std::uint32_t>(opt.sim_stall_ms * 1000.0);
-    adc_ = std::make_unique<hal::sim::SimAdc>(*sensor_, params);
+    simulated_ = std::make_unique<sim::SimulatedAdc>(desc_, *source_, params);
   }
-  hal::Adc& adc() override { return *adc_; }
+  hal::Adc& adc() override { return simulated_->adc(); }
   [[nodiscard]] std::uint8_t channel_count() const override {
     return static_cast<std::uint8_t>(desc_.model->channel_count());
   }
@@ -56,8 +49,7 @@ class SimulatedBackend final : public AdcBackend {
  private:
   sim::SensorDescription desc_;
   std::unique_ptr<sim::WrenchSource> source_;
-  std::unique_ptr<sim::SimulatedSensor> sensor_;
-  std::unique_ptr<hal::sim::SimAdc> adc_;
+  std::unique_ptr<sim::SimulatedAdc> simulated_;
 };
 
 }  // namespace

@@ -209,18 +209,12 @@ void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts,
   if (clamped) *saturated = true;
 }
 
-void WrenchCore::Process(const hal::AdcSample& in, bool simulated, CoreOutput& out) {
-  out.status = simulated ? kStatusSimulated : 0;
-  out.arithmetic_saturated = false;
-  out.updated = false;
+// The per-sample stages are inlined into Process: the split is for reading, not a call each.
+[[gnu::always_inline]] inline WrenchCore::Faults WrenchCore::DetectFaults(const hal::AdcSample& in,
+                                                                          CoreOutput& out) {
   const std::size_t n = in.channel_count;
-
-  // Fault detection on the raw counts.
-  bool any_saturated = false;
-  bool any_error = false;
-  bool bridge_fault = false;
+  Faults f;
   bool all_same = n > 0;
-  bool jumped = false;  // a channel reached saturation by a jump: a broken gauge, not a load
   for (std::size_t c = 0; c < n && c < kMaxChannels; ++c) {
     const std::int32_t v = in.counts[c];
     const bool at_rail = cal_.valid && (v >= cal_.max_counts || v <= cal_.min_counts);
@@ -234,87 +228,50 @@ void WrenchCore::Process(const hal::AdcSample& in, bool simulated, CoreOutput& o
       rail_jump_[c] = prev - mid < quarter && mid - prev < quarter;
     }
     was_saturated_[c] = sat;
-    if (flagged) any_saturated = true;  // the backend's saturation flag (within 1 % of a rail)
-    if (sat && rail_jump_[c]) jumped = true;
-    if ((in.flags[c] & (hal::kChannelReadError | hal::kChannelTimeout)) != 0) any_error = true;
+    if (flagged) f.any_saturated = true;  // the backend's saturation flag (within 1 % of a rail)
+    if (sat && rail_jump_[c]) f.jumped = true;
+    if ((in.flags[c] & (hal::kChannelReadError | hal::kChannelTimeout)) != 0) f.any_error = true;
     if (v != last_counts_[c]) all_same = false;
     rail_run_[c] = at_rail ? static_cast<std::uint16_t>(rail_run_[c] < 0xFFFF ? rail_run_[c] + 1
                                                                               : rail_run_[c])
                            : 0;
     if (limits_.rail_samples > 0 && rail_run_[c] >= limits_.rail_samples && rail_jump_[c]) {
-      bridge_fault = true;
+      f.bridge_fault = true;
     }
     last_counts_[c] = v;
   }
   same_count_run_ = all_same ? static_cast<std::uint16_t>(
                                    same_count_run_ < 0xFFFF ? same_count_run_ + 1 : same_count_run_)
                              : 0;
-  if (any_saturated) out.status |= kStatusSaturated;
-  if (bridge_fault) out.status |= kStatusBridgeFault;
-  if (any_error || (limits_.stuck_samples > 0 && same_count_run_ >= limits_.stuck_samples)) {
+  if (f.any_saturated) out.status |= kStatusSaturated;
+  if (f.bridge_fault) out.status |= kStatusBridgeFault;
+  if (f.any_error || (limits_.stuck_samples > 0 && same_count_run_ >= limits_.stuck_samples)) {
     out.status |= kStatusAdcFault;
   }
+  return f;
+}
 
-  if (!cal_.valid || n != cal_.channel_count) {
-    out.status |= kStatusCalInvalid;
-    out.wrench = {};
-    out.unfiltered = {};
-    out.structural = {};
-    out.structural_valid = false;
-    out.saturated_by_load = false;
-    return;
-  }
-
-  if (cal_.invalid_axes != 0) out.status |= kStatusAxisInvalid;
-  const bool usable = !any_saturated && !any_error && !bridge_fault;
-  bool temp_range = false;
-  const std::int32_t dt_mdegc = DeltaT(in.temperature_mdegc, in.has_temperature, &temp_range);
-  if (temp_range) out.status |= kStatusTempRange;
-  // Tare accumulates only on usable samples.
-  if (usable && tare_remaining_ > 0) {
-    for (std::size_t c = 0; c < n; ++c) tare_sum_[c] += in.counts[c];
-    tare_temp_sum_ += dt_mdegc;
-    if (--tare_remaining_ == 0) {
-      for (std::size_t c = 0; c < n; ++c) {
-        tare_counts_[c] = static_cast<std::int32_t>(RoundDiv(tare_sum_[c], tare_total_));
-      }
-      if (cal_.extra_count > 0) {
-        ExtraFeatures(tare_counts_,
-                      static_cast<std::int32_t>(RoundDiv(tare_temp_sum_, tare_total_)),
-                      tare_extra_);
-      }
-      tare_active_ = true;
-      BuildTareFeatures();
-      ComputeTareOffset();
-      ResetFilter();
+[[gnu::always_inline]] inline void WrenchCore::AccumulateTare(const hal::AdcSample& in,
+                                                              std::int32_t dt_mdegc) {
+  const std::size_t n = in.channel_count;
+  for (std::size_t c = 0; c < n; ++c) tare_sum_[c] += in.counts[c];
+  tare_temp_sum_ += dt_mdegc;
+  if (--tare_remaining_ == 0) {
+    for (std::size_t c = 0; c < n; ++c) {
+      tare_counts_[c] = static_cast<std::int32_t>(RoundDiv(tare_sum_[c], tare_total_));
     }
-  }
-  if (tare_active_) out.status |= kStatusTareActive;
-
-  // The load on the body (untared, unfiltered). While a bridge is saturated its counts are
-  // clamped at the rails by Apply, so this is a lower bound of the load — still the evidence the
-  // overload rule needs. Not on read errors or a broken bridge: those counts mean nothing.
-  WrenchLsb y{};
-  out.structural_valid = !any_error && !bridge_fault && !jumped;
-  out.saturated_by_load = any_saturated && !jumped;
-  if (out.structural_valid) {
-    bool clipped = false;
-    Apply(in.counts, in.temperature_mdegc, in.has_temperature, y, &clipped, &temp_range);
-    for (std::size_t r = 0; r < kAxes; ++r) {
-      out.structural[r] = SatToI32(std::int64_t{y[r]} + tare_offset_[r], &clipped);
+    if (cal_.extra_count > 0) {
+      ExtraFeatures(tare_counts_, static_cast<std::int32_t>(RoundDiv(tare_temp_sum_, tare_total_)),
+                    tare_extra_);
     }
-    if (usable) out.arithmetic_saturated = out.arithmetic_saturated || clipped;
-  } else {
-    out.structural = {};
+    tare_active_ = true;
+    BuildTareFeatures();
+    ComputeTareOffset();
+    ResetFilter();
   }
+}
 
-  if (!usable) {  // hold the last valid wrench (the publication marks it invalid)
-    out.wrench = last_valid_;
-    return;
-  }
-  out.unfiltered = y;
-
-  // Moving average over the last filter_length_ samples (shorter while filling).
+[[gnu::always_inline]] inline void WrenchCore::Filter(const WrenchLsb& y, CoreOutput& out) {
   auto& slot = filter_ring_[filter_pos_];
   for (std::size_t r = 0; r < kAxes; ++r) {
     if (filter_fill_ == filter_length_) filter_sum_[r] -= slot[r];
@@ -333,6 +290,57 @@ void WrenchCore::Process(const hal::AdcSample& in, bool simulated, CoreOutput& o
                                &out.arithmetic_saturated);
     }
   }
+}
+
+void WrenchCore::Process(const hal::AdcSample& in, bool simulated, CoreOutput& out) {
+  out.status = simulated ? kStatusSimulated : 0;
+  out.arithmetic_saturated = false;
+  out.updated = false;
+  const std::size_t n = in.channel_count;
+  const Faults faults = DetectFaults(in, out);
+
+  if (!cal_.valid || n != cal_.channel_count) {
+    out.status |= kStatusCalInvalid;
+    out.wrench = {};
+    out.unfiltered = {};
+    out.structural = {};
+    out.structural_valid = false;
+    out.saturated_by_load = false;
+    return;
+  }
+
+  if (cal_.invalid_axes != 0) out.status |= kStatusAxisInvalid;
+  const bool usable = !faults.any_saturated && !faults.any_error && !faults.bridge_fault;
+  bool temp_range = false;
+  const std::int32_t dt_mdegc = DeltaT(in.temperature_mdegc, in.has_temperature, &temp_range);
+  if (temp_range) out.status |= kStatusTempRange;
+  // Tare accumulates only on usable samples.
+  if (usable && tare_remaining_ > 0) AccumulateTare(in, dt_mdegc);
+  if (tare_active_) out.status |= kStatusTareActive;
+
+  // The load on the body (untared, unfiltered). While a bridge is saturated its counts are
+  // clamped at the rails by Apply, so this is a lower bound of the load — still the evidence the
+  // overload rule needs. Not on read errors or a broken bridge: those counts mean nothing.
+  WrenchLsb y{};
+  out.structural_valid = !faults.any_error && !faults.bridge_fault && !faults.jumped;
+  out.saturated_by_load = faults.any_saturated && !faults.jumped;
+  if (out.structural_valid) {
+    bool clipped = false;
+    Apply(in.counts, in.temperature_mdegc, in.has_temperature, y, &clipped, &temp_range);
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      out.structural[r] = SatToI32(std::int64_t{y[r]} + tare_offset_[r], &clipped);
+    }
+    if (usable) out.arithmetic_saturated = out.arithmetic_saturated || clipped;
+  } else {
+    out.structural = {};
+  }
+
+  if (!usable) {  // hold the last valid wrench (the publication marks it invalid)
+    out.wrench = last_valid_;
+    return;
+  }
+  out.unfiltered = y;
+  Filter(y, out);
   last_valid_ = out.wrench;
   out.updated = true;
 }

@@ -81,6 +81,19 @@ class WrenchCore {
              bool has_temperature, WrenchLsb& y, bool* saturated, bool* temp_range) const;
 
  private:
+  /// What the fault detection found on one sample's raw counts.
+  struct Faults {
+    bool any_saturated = false;  ///< the backend flagged a channel within 1 % of a rail
+    bool any_error = false;      ///< a read error or time-out
+    bool bridge_fault = false;   ///< a channel held at a rail it jumped to
+    bool jumped = false;         ///< a channel reached saturation by a jump (a broken gauge)
+  };
+  /// Fault detection on the raw counts; sets the fault status bits in out.
+  [[nodiscard]] Faults DetectFaults(const hal::AdcSample& in, CoreOutput& out);
+  /// Tare accumulation of one usable sample; activates the tare when complete.
+  void AccumulateTare(const hal::AdcSample& in, std::int32_t dt_mdegc);
+  /// Moving average of y over the last filter_length_ samples into out.wrench.
+  void Filter(const WrenchLsb& y, CoreOutput& out);
   void ResetFilter();
   /// Rearranges the installed calibration for the per-sample path (see Plan).
   void BuildPlan();

@@ -70,6 +70,243 @@ bool RawProductFits(std::uint64_t amax, std::uint64_t bmax, std::uint8_t shift) 
   return p <= static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
 }
 
+/// Stage 1: refuses a calibration the fixed-point form cannot represent (counts, NaN, terms).
+[[nodiscard]] LoadStatus CheckInputs(const FloatCalibration& cal, const hal::AdcInfo& adc) {
+  const std::size_t n = cal.channel_count;
+  if (n < 1 || n > kMaxChannels || (adc.channel_count != 0 && adc.channel_count != n)) {
+    return LoadStatus::kBadChannelCount;
+  }
+  const double counts_per_mvv = CountsPerMvv(adc);
+  if (!(counts_per_mvv > 0) || !std::isfinite(counts_per_mvv)) return LoadStatus::kBadAdcScaling;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    if (!std::isfinite(cal.bias[r])) return LoadStatus::kNotFinite;
+    for (std::size_t c = 0; c < n; ++c) {
+      if (!std::isfinite(cal.matrix[r][c]) || !std::isfinite(cal.offset_mvv[c])) {
+        return LoadStatus::kNotFinite;
+      }
+    }
+  }
+  if (cal.product_count > kMaxProducts) return LoadStatus::kBadTerms;
+  for (std::size_t k = 0; k < cal.product_count; ++k) {
+    const ProductTerm& t = cal.products[k];
+    if (t.a > t.b || t.b >= n) return LoadStatus::kBadTerms;
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      if (!std::isfinite(cal.product_matrix[r][k])) return LoadStatus::kNotFinite;
+    }
+  }
+  if (cal.temperature_compensated) {
+    if (!std::isfinite(cal.temp_ref_c) || !std::isfinite(cal.temp_min_c) ||
+        !std::isfinite(cal.temp_max_c)) {
+      return LoadStatus::kNotFinite;
+    }
+    if (!(cal.temp_min_c <= cal.temp_ref_c && cal.temp_ref_c <= cal.temp_max_c) ||
+        cal.temp_min_c < -1000.0 || cal.temp_max_c > 1000.0) {
+      return LoadStatus::kBadTerms;
+    }
+    for (std::size_t c = 0; c < n; ++c) {
+      if (!std::isfinite(cal.bias_slope_mvv_per_c[c]) || !std::isfinite(cal.gain_slope_per_c[c])) {
+        return LoadStatus::kNotFinite;
+      }
+    }
+  }
+  return LoadStatus::kOk;
+}
+
+/// The feature layout of a calibration and the bounds the overflow proof uses.
+struct FeatureLayout {
+  double counts_per_mvv = 0;
+  std::array<double, kMaxChannels> offset_counts{};
+  std::array<double, kMaxChannels> e{};                // zero_c − offset_c, counts
+  std::array<double, kMaxChannels> xmax{};             // bound on |counts − zero|
+  std::array<std::uint64_t, kMaxChannels> xmax_int{};  // the same, exact
+  double dt_max = 0.0;                                 // bound on |ΔT|, m°C
+  double dt_ref_err = 0.0;                             // integer reference − true reference, m°C
+  std::size_t count = 0;                               // features in use
+  std::array<double, kMaxFeatures> fbound{};
+  std::array<std::uint64_t, kMaxFeatures> fmax_int{};
+  std::size_t temp_index = 0;
+  std::array<std::size_t, kMaxProducts> product_index{};
+  std::array<std::size_t, kMaxChannels> temp_product_index{};
+};
+
+/// Stage 2a: integer zero of the product features and its rounding, the temperature in m°C.
+void SetZeroAndTemperature(const FloatCalibration& cal, const hal::AdcInfo& adc,
+                           FixedCalibration* fixed, FeatureLayout* lay) {
+  const std::size_t n = cal.channel_count;
+  const double min_c = adc.min_counts;
+  const double max_c = adc.max_counts;
+  for (std::size_t c = 0; c < n; ++c) {
+    lay->offset_counts[c] = cal.offset_mvv[c] * lay->counts_per_mvv;
+    double z = std::nearbyint(lay->offset_counts[c]);
+    if (z > max_c) z = max_c;
+    if (z < min_c) z = min_c;
+    fixed->zero[c] = static_cast<std::int32_t>(z);
+    lay->e[c] = z - lay->offset_counts[c];
+    lay->xmax[c] = std::fmax(max_c - z, z - min_c);
+    const std::int64_t zi = fixed->zero[c];
+    lay->xmax_int[c] = static_cast<std::uint64_t>(
+        std::max(std::int64_t{adc.max_counts} - zi, zi - std::int64_t{adc.min_counts}));
+  }
+  if (cal.temperature_compensated) {
+    fixed->temperature = true;
+    fixed->temp_ref_mdegc = static_cast<std::int32_t>(std::lround(cal.temp_ref_c * 1000.0));
+    fixed->temp_min_mdegc = static_cast<std::int32_t>(std::lround(cal.temp_min_c * 1000.0));
+    fixed->temp_max_mdegc = static_cast<std::int32_t>(std::lround(cal.temp_max_c * 1000.0));
+    lay->dt_max = std::fmax(static_cast<double>(fixed->temp_max_mdegc) - fixed->temp_ref_mdegc,
+                            static_cast<double>(fixed->temp_ref_mdegc) - fixed->temp_min_mdegc);
+    lay->dt_ref_err = fixed->temp_ref_mdegc - cal.temp_ref_c * 1000.0;
+  }
+}
+
+/// Stage 2b: feature layout and bounds (f_max with a tare: twice the one-sided bound for derived
+/// features).
+[[nodiscard]] LoadStatus LayOutFeatures(const FloatCalibration& cal, const hal::AdcInfo& adc,
+                                        FixedCalibration* fixed, FeatureLayout* lay) {
+  const std::size_t n = cal.channel_count;
+  const bool temp = cal.temperature_compensated;
+  // Largest |x| = |counts − zero| with counts and zero (a tare or the offset) between the rails.
+  const double x_span = static_cast<double>(adc.max_counts) - adc.min_counts;
+  std::size_t count = n;
+  for (std::size_t c = 0; c < n; ++c) lay->fbound[c] = x_span;
+  if (temp) {
+    lay->temp_index = count;
+    fixed->extra[count - n] = FixedFeature{FeatureKind::kTemperature, 0, 0, 0};
+    lay->fbound[count++] = 2.0 * lay->dt_max;
+  }
+  for (std::size_t k = 0; k < cal.product_count; ++k) {
+    const ProductTerm& t = cal.products[k];
+    const double bound = lay->xmax[t.a] * lay->xmax[t.b];
+    const std::uint8_t sh = ProductShift(bound);
+    if (!RawProductFits(lay->xmax_int[t.a], lay->xmax_int[t.b], sh)) {
+      return LoadStatus::kFeatureOverflow;
+    }
+    lay->product_index[k] = count;
+    fixed->extra[count - n] = FixedFeature{FeatureKind::kProduct, t.a, t.b, sh};
+    lay->fbound[count++] = 2.0 * (std::ceil(std::ldexp(bound, -sh)) + 1.0);
+  }
+  if (temp) {
+    for (std::size_t c = 0; c < n; ++c) {
+      if (cal.gain_slope_per_c[c] == 0.0) continue;
+      const double bound = lay->xmax[c] * lay->dt_max;
+      const std::uint8_t sh = ProductShift(bound);
+      if (!RawProductFits(lay->xmax_int[c], static_cast<std::uint64_t>(lay->dt_max), sh)) {
+        return LoadStatus::kFeatureOverflow;
+      }
+      lay->temp_product_index[c] = count;
+      fixed->extra[count - n] =
+          FixedFeature{FeatureKind::kTempProduct, static_cast<std::uint8_t>(c), 0, sh};
+      lay->fbound[count++] = 2.0 * (std::ceil(std::ldexp(bound, -sh)) + 1.0);
+    }
+  }
+  fixed->extra_count = static_cast<std::uint8_t>(count - n);
+  lay->count = count;
+  for (std::size_t k = 0; k < count; ++k) {
+    lay->fmax_int[k] = static_cast<std::uint64_t>(lay->fbound[k]);
+  }
+  return LoadStatus::kOk;
+}
+
+/// One output row in real numbers: coefficients per feature unit and the bias, LSB.
+struct RealRow {
+  std::array<double, kMaxFeatures> m{};
+  double bias_lsb = 0.0;
+  double rounding_error = 0.0;  // from rounding the derived features, LSB
+};
+
+/// Stage 3: the real coefficients of row r against the integer features.
+RealRow MakeRealRow(const FloatCalibration& cal, const FixedCalibration& fixed,
+                    const FeatureLayout& lay, std::size_t r) {
+  const std::size_t n = cal.channel_count;
+  const double lsb = AxisLsb(r);
+  const double cpm = lay.counts_per_mvv;
+  const auto& e = lay.e;
+  RealRow row;
+  auto& m = row.m;
+  row.bias_lsb = cal.bias[r] / lsb;
+  for (std::size_t c = 0; c < n; ++c) {
+    m[c] = cal.matrix[r][c] / lsb / cpm;
+    row.bias_lsb -= m[c] * lay.offset_counts[c];
+  }
+  // Products: q·(x̃_a + e_a)(x̃_b + e_b) with x̃ = counts − zero, expanded exactly.
+  for (std::size_t k = 0; k < cal.product_count; ++k) {
+    const ProductTerm& t = cal.products[k];
+    const double q = cal.product_matrix[r][k] / lsb / (cpm * cpm);
+    const FixedFeature& f = fixed.extra[lay.product_index[k] - n];
+    m[lay.product_index[k]] = q * std::ldexp(1.0, f.shift);
+    m[t.a] += q * e[t.b];
+    m[t.b] += q * e[t.a];
+    row.bias_lsb += q * (e[t.a] * e[t.b] - e[t.b] * fixed.zero[t.a] - e[t.a] * fixed.zero[t.b]);
+    if (f.shift > 0) row.rounding_error += 2.0 * 0.5 * std::fabs(m[lay.product_index[k]]);
+  }
+  // Temperature: −ΔT·(M·α)_r − ΔT·Σ_c M_rc γ_c (x̃_c + e_c), ΔT in m°C against the integer
+  // reference (the reference's rounding folds into the constant and linear terms).
+  if (cal.temperature_compensated) {
+    const double dt_ref_err = lay.dt_ref_err;
+    double a_r = 0.0;  // LSB per m°C
+    for (std::size_t c = 0; c < n; ++c) {
+      a_r -= cal.matrix[r][c] / lsb * cal.bias_slope_mvv_per_c[c] / 1000.0;
+    }
+    for (std::size_t c = 0; c < n; ++c) {
+      if (cal.gain_slope_per_c[c] == 0.0) continue;
+      const double g = -(cal.matrix[r][c] / lsb / cpm) * cal.gain_slope_per_c[c] / 1000.0;
+      const FixedFeature& f = fixed.extra[lay.temp_product_index[c] - n];
+      m[lay.temp_product_index[c]] = g * std::ldexp(1.0, f.shift);
+      a_r += g * e[c];
+      // ΔT_true = ΔT_int + dt_ref_err: the product's share is linear in x̃_c.
+      m[c] += g * dt_ref_err;
+      row.bias_lsb -= g * dt_ref_err * fixed.zero[c];
+      if (f.shift > 0) row.rounding_error += 2.0 * 0.5 * std::fabs(m[lay.temp_product_index[c]]);
+    }
+    m[lay.temp_index] = a_r;
+    row.bias_lsb += a_r * dt_ref_err;
+  }
+  return row;
+}
+
+/// Stage 4: row r in integers with the largest binary point that provably cannot overflow.
+[[nodiscard]] LoadStatus QuantiseRow(const RealRow& row, const FeatureLayout& lay, std::size_t r,
+                                     FixedCalibration* fixed, LoadReport* rep) {
+  const double lsb = AxisLsb(r);
+  // Bound on |output| for every input between the rails, with or without a tare (every
+  // feature then relative to its value at the tare): Σ |m_k|·f_max,k + |bias|.
+  double real_bound = std::fabs(row.bias_lsb);
+  double fsum = 1.0;
+  for (std::size_t k = 0; k < lay.count; ++k) {
+    real_bound += std::fabs(row.m[k]) * lay.fbound[k];
+    fsum += lay.fbound[k];
+  }
+  rep->worst_case_output_lsb[r] = real_bound;
+  if (!std::isfinite(real_bound) || real_bound + row.rounding_error + 1.0 > kInt32Max) {
+    rep->failing_axis = static_cast<std::uint8_t>(r);
+    return LoadStatus::kOutputOverflow;
+  }
+  // Largest binary point with real_bound·2^s + rounding of the coefficients ≤ 2^61: every
+  // partial sum then stays inside ±2^62 and adding the rounding half cannot overflow. Proven
+  // again below with exact integer arithmetic.
+  const double room = std::ldexp(1.0, 61) - 0.5 * fsum - 1.0;
+  int s = real_bound > 0 ? static_cast<int>(std::floor(std::log2(room / real_bound))) : 62;
+  if (s > 62) s = 62;
+  if (s < 0) s = 0;
+  for (;; --s) {
+    const double scale = std::ldexp(1.0, s);
+    for (std::size_t k = 0; k < lay.count; ++k) fixed->coef[r][k] = std::llround(row.m[k] * scale);
+    fixed->bias[r] = std::llround(row.bias_lsb * scale);
+    if (AccumulatorFits(fixed->coef[r], fixed->bias[r], lay.fmax_int, lay.count)) break;
+    if (s == 0) {
+      rep->failing_axis = static_cast<std::uint8_t>(r);
+      return LoadStatus::kOutputOverflow;
+    }
+  }
+  fixed->shift[r] = static_cast<std::uint8_t>(s);
+  const double scale = std::ldexp(1.0, s);
+  // Each coefficient and the bias are off by at most half a unit of 2^-s; derived features
+  // are rounded to ±1/2 (twice with a tare); the final rounding adds half an LSB.
+  const double err = 0.5 / scale * fsum + row.rounding_error + 0.5;
+  rep->worst_case_error_lsb[r] = err;
+  rep->worst_case_error_si[r] = err * lsb;
+  return LoadStatus::kOk;
+}
+
 }  // namespace
 
 LoadStatus LoadCalibration(const FloatCalibration& cal, const hal::AdcInfo& adc,
@@ -80,205 +317,20 @@ LoadStatus LoadCalibration(const FloatCalibration& cal, const hal::AdcInfo& adc,
     if (report != nullptr) *report = rep;
     return s;
   };
-  const std::size_t n = cal.channel_count;
-  if (n < 1 || n > kMaxChannels || (adc.channel_count != 0 && adc.channel_count != n)) {
-    return finish(LoadStatus::kBadChannelCount);
-  }
-  const double counts_per_mvv = CountsPerMvv(adc);
-  if (!(counts_per_mvv > 0) || !std::isfinite(counts_per_mvv)) {
-    return finish(LoadStatus::kBadAdcScaling);
-  }
-  for (std::size_t r = 0; r < kAxes; ++r) {
-    if (!std::isfinite(cal.bias[r])) return finish(LoadStatus::kNotFinite);
-    for (std::size_t c = 0; c < n; ++c) {
-      if (!std::isfinite(cal.matrix[r][c]) || !std::isfinite(cal.offset_mvv[c])) {
-        return finish(LoadStatus::kNotFinite);
-      }
-    }
-  }
-  if (cal.product_count > kMaxProducts) return finish(LoadStatus::kBadTerms);
-  for (std::size_t k = 0; k < cal.product_count; ++k) {
-    const ProductTerm& t = cal.products[k];
-    if (t.a > t.b || t.b >= n) return finish(LoadStatus::kBadTerms);
-    for (std::size_t r = 0; r < kAxes; ++r) {
-      if (!std::isfinite(cal.product_matrix[r][k])) return finish(LoadStatus::kNotFinite);
-    }
-  }
-  const bool temp = cal.temperature_compensated;
-  if (temp) {
-    if (!std::isfinite(cal.temp_ref_c) || !std::isfinite(cal.temp_min_c) ||
-        !std::isfinite(cal.temp_max_c)) {
-      return finish(LoadStatus::kNotFinite);
-    }
-    if (!(cal.temp_min_c <= cal.temp_ref_c && cal.temp_ref_c <= cal.temp_max_c) ||
-        cal.temp_min_c < -1000.0 || cal.temp_max_c > 1000.0) {
-      return finish(LoadStatus::kBadTerms);
-    }
-    for (std::size_t c = 0; c < n; ++c) {
-      if (!std::isfinite(cal.bias_slope_mvv_per_c[c]) || !std::isfinite(cal.gain_slope_per_c[c])) {
-        return finish(LoadStatus::kNotFinite);
-      }
-    }
-  }
-  const double min_c = adc.min_counts;
-  const double max_c = adc.max_counts;
-  // Largest |x| = |counts − zero| with counts and zero (a tare or the offset) between the rails.
-  const double x_span = max_c - min_c;
+  const LoadStatus checked = CheckInputs(cal, adc);
+  if (checked != LoadStatus::kOk) return finish(checked);
   FixedCalibration fixed{};
-  fixed.channel_count = static_cast<std::uint8_t>(n);
+  fixed.channel_count = cal.channel_count;
   fixed.min_counts = adc.min_counts;
   fixed.max_counts = adc.max_counts;
-
-  // Integer zero of the product features and its rounding e_c = zero_c − offset_c (counts).
-  std::array<double, kMaxChannels> offset_counts{};
-  std::array<double, kMaxChannels> e{};
-  std::array<double, kMaxChannels> xmax{};             // bound on |counts − zero|
-  std::array<std::uint64_t, kMaxChannels> xmax_int{};  // the same, exact
-  for (std::size_t c = 0; c < n; ++c) {
-    offset_counts[c] = cal.offset_mvv[c] * counts_per_mvv;
-    double z = std::nearbyint(offset_counts[c]);
-    if (z > max_c) z = max_c;
-    if (z < min_c) z = min_c;
-    fixed.zero[c] = static_cast<std::int32_t>(z);
-    e[c] = z - offset_counts[c];
-    xmax[c] = std::fmax(max_c - z, z - min_c);
-    const std::int64_t zi = fixed.zero[c];
-    xmax_int[c] = static_cast<std::uint64_t>(
-        std::max(std::int64_t{adc.max_counts} - zi, zi - std::int64_t{adc.min_counts}));
-  }
-  // Temperature in m°C.
-  double dt_max = 0.0;  // bound on |ΔT|, m°C
-  if (temp) {
-    fixed.temperature = true;
-    fixed.temp_ref_mdegc = static_cast<std::int32_t>(std::lround(cal.temp_ref_c * 1000.0));
-    fixed.temp_min_mdegc = static_cast<std::int32_t>(std::lround(cal.temp_min_c * 1000.0));
-    fixed.temp_max_mdegc = static_cast<std::int32_t>(std::lround(cal.temp_max_c * 1000.0));
-    dt_max = std::fmax(static_cast<double>(fixed.temp_max_mdegc) - fixed.temp_ref_mdegc,
-                       static_cast<double>(fixed.temp_ref_mdegc) - fixed.temp_min_mdegc);
-  }
-  const double dt_ref_err = temp ? fixed.temp_ref_mdegc - cal.temp_ref_c * 1000.0 : 0.0;
-
-  // Feature layout and bounds (f_max with a tare: twice the one-sided bound for derived features).
-  std::size_t count = n;
-  std::array<double, kMaxFeatures> fbound{};
-  std::array<std::uint64_t, kMaxFeatures> fmax_int{};
-  for (std::size_t c = 0; c < n; ++c) fbound[c] = x_span;
-  std::size_t temp_index = 0;
-  if (temp) {
-    temp_index = count;
-    fixed.extra[count - n] = FixedFeature{FeatureKind::kTemperature, 0, 0, 0};
-    fbound[count++] = 2.0 * dt_max;
-  }
-  std::array<std::size_t, kMaxProducts> product_index{};
-  for (std::size_t k = 0; k < cal.product_count; ++k) {
-    const ProductTerm& t = cal.products[k];
-    const double bound = xmax[t.a] * xmax[t.b];
-    const std::uint8_t sh = ProductShift(bound);
-    if (!RawProductFits(xmax_int[t.a], xmax_int[t.b], sh)) {
-      return finish(LoadStatus::kFeatureOverflow);
-    }
-    product_index[k] = count;
-    fixed.extra[count - n] = FixedFeature{FeatureKind::kProduct, t.a, t.b, sh};
-    fbound[count++] = 2.0 * (std::ceil(std::ldexp(bound, -sh)) + 1.0);
-  }
-  std::array<std::size_t, kMaxChannels> temp_product_index{};
-  if (temp) {
-    for (std::size_t c = 0; c < n; ++c) {
-      if (cal.gain_slope_per_c[c] == 0.0) continue;
-      const double bound = xmax[c] * dt_max;
-      const std::uint8_t sh = ProductShift(bound);
-      if (!RawProductFits(xmax_int[c], static_cast<std::uint64_t>(dt_max), sh)) {
-        return finish(LoadStatus::kFeatureOverflow);
-      }
-      temp_product_index[c] = count;
-      fixed.extra[count - n] =
-          FixedFeature{FeatureKind::kTempProduct, static_cast<std::uint8_t>(c), 0, sh};
-      fbound[count++] = 2.0 * (std::ceil(std::ldexp(bound, -sh)) + 1.0);
-    }
-  }
-  fixed.extra_count = static_cast<std::uint8_t>(count - n);
-  for (std::size_t k = 0; k < count; ++k) fmax_int[k] = static_cast<std::uint64_t>(fbound[k]);
-
+  FeatureLayout lay;
+  lay.counts_per_mvv = CountsPerMvv(adc);
+  SetZeroAndTemperature(cal, adc, &fixed, &lay);
+  const LoadStatus laid = LayOutFeatures(cal, adc, &fixed, &lay);
+  if (laid != LoadStatus::kOk) return finish(laid);
   for (std::size_t r = 0; r < kAxes; ++r) {
-    const double lsb = AxisLsb(r);
-    // Real coefficients per feature unit, LSB, and the real bias, LSB.
-    std::array<double, kMaxFeatures> m{};
-    double bias_lsb = cal.bias[r] / lsb;
-    for (std::size_t c = 0; c < n; ++c) {
-      m[c] = cal.matrix[r][c] / lsb / counts_per_mvv;
-      bias_lsb -= m[c] * offset_counts[c];
-    }
-    // Products: q·(x̃_a + e_a)(x̃_b + e_b) with x̃ = counts − zero, expanded exactly.
-    double rounding_error = 0.0;  // from rounding the derived features, LSB
-    for (std::size_t k = 0; k < cal.product_count; ++k) {
-      const ProductTerm& t = cal.products[k];
-      const double q = cal.product_matrix[r][k] / lsb / (counts_per_mvv * counts_per_mvv);
-      const FixedFeature& f = fixed.extra[product_index[k] - n];
-      m[product_index[k]] = q * std::ldexp(1.0, f.shift);
-      m[t.a] += q * e[t.b];
-      m[t.b] += q * e[t.a];
-      bias_lsb += q * (e[t.a] * e[t.b] - e[t.b] * fixed.zero[t.a] - e[t.a] * fixed.zero[t.b]);
-      if (f.shift > 0) rounding_error += 2.0 * 0.5 * std::fabs(m[product_index[k]]);
-    }
-    // Temperature: −ΔT·(M·α)_r − ΔT·Σ_c M_rc γ_c (x̃_c + e_c), ΔT in m°C against the integer
-    // reference (the reference's rounding folds into the constant and linear terms).
-    if (temp) {
-      double a_r = 0.0;  // LSB per m°C
-      for (std::size_t c = 0; c < n; ++c) {
-        a_r -= cal.matrix[r][c] / lsb * cal.bias_slope_mvv_per_c[c] / 1000.0;
-      }
-      for (std::size_t c = 0; c < n; ++c) {
-        if (cal.gain_slope_per_c[c] == 0.0) continue;
-        const double g =
-            -(cal.matrix[r][c] / lsb / counts_per_mvv) * cal.gain_slope_per_c[c] / 1000.0;
-        const FixedFeature& f = fixed.extra[temp_product_index[c] - n];
-        m[temp_product_index[c]] = g * std::ldexp(1.0, f.shift);
-        a_r += g * e[c];
-        // ΔT_true = ΔT_int + dt_ref_err: the product's share is linear in x̃_c.
-        m[c] += g * dt_ref_err;
-        bias_lsb -= g * dt_ref_err * fixed.zero[c];
-        if (f.shift > 0) rounding_error += 2.0 * 0.5 * std::fabs(m[temp_product_index[c]]);
-      }
-      m[temp_index] = a_r;
-      bias_lsb += a_r * dt_ref_err;
-    }
-    // Bound on |output| for every input between the rails, with or without a tare (every
-    // feature then relative to its value at the tare): Σ |m_k|·f_max,k + |bias|.
-    double real_bound = std::fabs(bias_lsb);
-    double fsum = 1.0;
-    for (std::size_t k = 0; k < count; ++k) {
-      real_bound += std::fabs(m[k]) * fbound[k];
-      fsum += fbound[k];
-    }
-    rep.worst_case_output_lsb[r] = real_bound;
-    if (!std::isfinite(real_bound) || real_bound + rounding_error + 1.0 > kInt32Max) {
-      rep.failing_axis = static_cast<std::uint8_t>(r);
-      return finish(LoadStatus::kOutputOverflow);
-    }
-    // Largest binary point with real_bound·2^s + rounding of the coefficients ≤ 2^61: every
-    // partial sum then stays inside ±2^62 and adding the rounding half cannot overflow. Proven
-    // again below with exact integer arithmetic.
-    const double room = std::ldexp(1.0, 61) - 0.5 * fsum - 1.0;
-    int s = real_bound > 0 ? static_cast<int>(std::floor(std::log2(room / real_bound))) : 62;
-    if (s > 62) s = 62;
-    if (s < 0) s = 0;
-    for (;; --s) {
-      const double scale = std::ldexp(1.0, s);
-      for (std::size_t k = 0; k < count; ++k) fixed.coef[r][k] = std::llround(m[k] * scale);
-      fixed.bias[r] = std::llround(bias_lsb * scale);
-      if (AccumulatorFits(fixed.coef[r], fixed.bias[r], fmax_int, count)) break;
-      if (s == 0) {
-        rep.failing_axis = static_cast<std::uint8_t>(r);
-        return finish(LoadStatus::kOutputOverflow);
-      }
-    }
-    fixed.shift[r] = static_cast<std::uint8_t>(s);
-    const double scale = std::ldexp(1.0, s);
-    // Each coefficient and the bias are off by at most half a unit of 2^-s; derived features
-    // are rounded to ±1/2 (twice with a tare); the final rounding adds half an LSB.
-    const double err = 0.5 / scale * fsum + rounding_error + 0.5;
-    rep.worst_case_error_lsb[r] = err;
-    rep.worst_case_error_si[r] = err * lsb;
+    const LoadStatus row = QuantiseRow(MakeRealRow(cal, fixed, lay, r), lay, r, &fixed, &rep);
+    if (row != LoadStatus::kOk) return finish(row);
   }
   fixed.invalid_axes = static_cast<std::uint8_t>(cal.invalid_axes & ((1u << kAxes) - 1));
   fixed.valid = true;

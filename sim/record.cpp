@@ -103,11 +103,10 @@ std::vector<EffectSpec> ParseEffects(const std::vector<std::string>& texts) {
   return out;
 }
 
-RecordResult MakeRecording(const RecordRequest& req) {
-  if (!req.sensor.model) throw std::invalid_argument("record: no sensor model");
-  const SensorModel& model = *req.sensor.model;
-  const int n = model.channel_count();
-  const Wrench rated = model.rated();
+namespace {
+
+/// Checks the request's numbers; returns the ADC noise to use, mV/V RMS.
+double CheckedNoise(const RecordRequest& req) {
   if (!std::isfinite(req.duration_s) || req.duration_s < 0 || req.duration_s > 1e6) {
     throw std::invalid_argument("--duration-s must be a finite number in [0, 1e6] s");
   }
@@ -118,6 +117,154 @@ RecordResult MakeRecording(const RecordRequest& req) {
   if (!std::isfinite(noise) || noise < 0) {
     throw std::invalid_argument("--noise-mvv must be a finite number >= 0");
   }
+  return noise;
+}
+
+/// Saturation effects without a limit get 0.9 × the 99.5th percentile of |output| of their
+/// channels in the effect-free prediction, so the largest loads clip.
+void DefaultSaturationLimits(const Eigen::MatrixXd& sim, std::vector<Effect>* effects) {
+  for (auto& e : *effects) {
+    if (e.kind != EffectKind::kSaturation || !std::isnan(e.num["limit"])) continue;
+    std::vector<double> mags;
+    for (Eigen::Index i = 0; i < sim.cols(); ++i) {
+      double m = 0.0;
+      for (const int ch : e.channels) m = std::max(m, std::abs(sim(ch, i)));
+      mags.push_back(m);
+    }
+    const auto q =
+        mags.begin() + static_cast<std::ptrdiff_t>(0.995 * static_cast<double>(mags.size() - 1));
+    std::nth_element(mags.begin(), q, mags.end());
+    e.num["limit"] = 0.9 * *q;
+    if (!(*q > 0)) throw std::invalid_argument("saturation: the recording has no load to clip");
+  }
+}
+
+/// The real recording's bridges after the simulated ADC, back in mV/V, and its temperature.
+struct AdcOutput {
+  std::vector<std::vector<double>> bridges_mvv;  // per channel
+  std::vector<double> temp_c;
+  double counts_per_mvv = 0.0;
+};
+
+/// Through the simulated ADC: noise, quantisation to counts, rails; back to mV/V.
+AdcOutput ThroughAdc(const RecordRequest& req, const Eigen::MatrixXd& clean_real,
+                     const std::vector<double>& temp_c, double rate, double noise) {
+  const auto n = static_cast<int>(clean_real.rows());
+  const auto rows = static_cast<std::size_t>(clean_real.cols());
+  hal::sim::SimAdcParams adc_params = req.sensor.adc;
+  adc_params.noise_rms_mvv = noise;
+  adc_params.seed = req.seed * 0x9E3779B97F4A7C15ULL + 0xADC;
+  adc_params.realtime = false;
+  MatrixSource source(clean_real, temp_c);
+  hal::sim::SimAdc adc(source, adc_params);
+  hal::AdcConfig cfg;
+  cfg.channel_count = static_cast<std::uint8_t>(n);
+  cfg.gain = req.sensor.adc_gain;
+  cfg.rate_hz = static_cast<std::uint32_t>(std::max(1.0, std::round(rate)));
+  if (adc.Configure(cfg) != hal::Status::kOk) {
+    throw std::invalid_argument("record: the sensor's ADC parameters are not usable");
+  }
+  AdcOutput out;
+  out.counts_per_mvv = adc.counts_per_mvv();
+  out.bridges_mvv.assign(static_cast<std::size_t>(n), std::vector<double>(rows));
+  out.temp_c.resize(rows);
+  for (std::size_t i = 0; i < rows; ++i) {
+    hal::AdcSample s;
+    if (adc.WaitDataReady(1000) != hal::Status::kOk || adc.Read(s) != hal::Status::kOk) {
+      throw std::runtime_error("record: simulated ADC failed at row " + std::to_string(i));
+    }
+    for (int c = 0; c < n; ++c) {
+      out.bridges_mvv[static_cast<std::size_t>(c)][i] =
+          s.counts[static_cast<std::size_t>(c)] / out.counts_per_mvv;
+    }
+    out.temp_c[i] = s.has_temperature ? s.temperature_mdegc / 1000.0 : temp_c[i];
+  }
+  return out;
+}
+
+/// The two recordings: they share t, the reference wrench and temp_C.
+void FillRecordings(const RecordRequest& req, const ComposeInput& in, const Eigen::MatrixXd& sim,
+                    const AdcOutput& adc, double rate, RecordResult* res) {
+  const auto n = static_cast<int>(sim.rows());
+  const std::size_t rows = in.t_s.size();
+  std::vector<std::vector<double>> wrench(6, std::vector<double>(rows));
+  for (std::size_t i = 0; i < rows; ++i) {
+    const Wrench w = res->profile.LoadAt(in.t_s[i]);
+    for (int k = 0; k < 6; ++k) wrench[static_cast<std::size_t>(k)][i] = w(k);
+  }
+  const auto bnames = BridgeColumns(static_cast<std::size_t>(n));
+  for (Recording* r : {&res->real, &res->sim}) {
+    r->SetColumn("t", in.t_s);
+    for (int k = 0; k < 6; ++k)
+      r->SetColumn(WrenchColumns()[static_cast<std::size_t>(k)],
+                   wrench[static_cast<std::size_t>(k)]);
+  }
+  for (int c = 0; c < n; ++c) {
+    res->real.SetColumn(bnames[static_cast<std::size_t>(c)],
+                        adc.bridges_mvv[static_cast<std::size_t>(c)]);
+    std::vector<double> v(rows);
+    for (std::size_t i = 0; i < rows; ++i) v[i] = sim(c, static_cast<Eigen::Index>(i));
+    res->sim.SetColumn(bnames[static_cast<std::size_t>(c)], std::move(v));
+  }
+  if (req.temperature) {
+    res->real.SetColumn("temp_C", adc.temp_c);
+    res->sim.SetColumn("temp_C", adc.temp_c);
+  }
+  const std::vector<std::string> common = {
+      "sensor: " + req.sensor.name, "profile: " + res->profile.name(),
+      "seed: " + std::to_string(req.seed), "rate_hz: " + Fmt(rate)};
+  res->real.metadata = common;
+  res->real.metadata.insert(res->real.metadata.begin(),
+                            "source: ftsim record (simulated measurement)");
+  res->sim.metadata = common;
+  res->sim.metadata.insert(res->sim.metadata.begin(),
+                           "source: ftsim record (model prediction, " + in.model->name() + ")");
+}
+
+/// Truth: every effect with its exact parameters and where its own contribution shows.
+nlohmann::json MakeTruth(const RecordRequest& req, const ComposeInput& in,
+                         const Eigen::MatrixXd& sim, const RecordResult& res, double rate,
+                         double noise, double counts_per_mvv) {
+  nlohmann::json truth;
+  truth["schema"] = "ftsim-truth/1";
+  truth["sensor"] = req.sensor.name;
+  truth["model"] = in.model->name();
+  truth["profile"] = res.profile.name();
+  truth["seed"] = req.seed;
+  truth["rate_hz"] = rate;
+  truth["rows"] = in.t_s.size();
+  truth["duration_s"] = in.t_s.back();
+  truth["noise_rms_mvv"] = noise;
+  truth["lsb_mvv"] = 1.0 / counts_per_mvv;
+  truth["effects"] = nlohmann::json::array();
+  std::string strongest = "none";
+  double strongest_rms = 0.0;
+  for (const auto& e : res.effects) {
+    if (e.kind == EffectKind::kNone) continue;
+    const Eigen::MatrixXd c = Compose({e}, in) - sim;
+    nlohmann::json j;
+    j["name"] = e.name;
+    j["params"] = ParamsJson(e);
+    j["footprint"] = Footprint(c, in.t_s, noise);
+    truth["effects"].push_back(j);
+    const double r = std::sqrt(c.squaredNorm() / static_cast<double>(c.size()));
+    if (r > strongest_rms) {
+      strongest_rms = r;
+      strongest = e.name;
+    }
+  }
+  truth["strongest"] = strongest;
+  return truth;
+}
+
+}  // namespace
+
+RecordResult MakeRecording(const RecordRequest& req) {
+  if (!req.sensor.model) throw std::invalid_argument("record: no sensor model");
+  const SensorModel& model = *req.sensor.model;
+  const int n = model.channel_count();
+  const Wrench rated = model.rated();
+  const double noise = CheckedNoise(req);
 
   RecordResult res;
   res.profile = MakeProfile(req.profile, rated, req.seed, req.duration_s);
@@ -155,115 +302,11 @@ RecordResult MakeRecording(const RecordRequest& req) {
   for (std::size_t i = 0; i < rows; ++i) in.temp_c[i] = profile.TemperatureAt(in.t_s[i]);
 
   const Eigen::MatrixXd sim = Compose({}, in);
-  for (auto& e : res.effects) {
-    if (e.kind == EffectKind::kSaturation && std::isnan(e.num["limit"])) {
-      // Default: 0.9 × the 99.5th percentile of |output|, so the largest loads clip.
-      std::vector<double> mags;
-      for (Eigen::Index i = 0; i < sim.cols(); ++i) {
-        double m = 0.0;
-        for (const int ch : e.channels) m = std::max(m, std::abs(sim(ch, i)));
-        mags.push_back(m);
-      }
-      const auto q =
-          mags.begin() + static_cast<std::ptrdiff_t>(0.995 * static_cast<double>(mags.size() - 1));
-      std::nth_element(mags.begin(), q, mags.end());
-      e.num["limit"] = 0.9 * *q;
-      if (!(*q > 0)) throw std::invalid_argument("saturation: the recording has no load to clip");
-    }
-  }
+  DefaultSaturationLimits(sim, &res.effects);
   res.clean_real = Compose(res.effects, in);
-
-  // Through the simulated ADC: noise, quantisation to counts, rails; back to mV/V.
-  hal::sim::SimAdcParams adc_params = req.sensor.adc;
-  adc_params.noise_rms_mvv = noise;
-  adc_params.seed = req.seed * 0x9E3779B97F4A7C15ULL + 0xADC;
-  adc_params.realtime = false;
-  MatrixSource source(res.clean_real, in.temp_c);
-  hal::sim::SimAdc adc(source, adc_params);
-  hal::AdcConfig cfg;
-  cfg.channel_count = static_cast<std::uint8_t>(n);
-  cfg.gain = req.sensor.adc_gain;
-  cfg.rate_hz = static_cast<std::uint32_t>(std::max(1.0, std::round(rate)));
-  if (adc.Configure(cfg) != hal::Status::kOk) {
-    throw std::invalid_argument("record: the sensor's ADC parameters are not usable");
-  }
-  const double cpm = adc.counts_per_mvv();
-  std::vector<std::vector<double>> real_b(static_cast<std::size_t>(n), std::vector<double>(rows));
-  std::vector<double> temp(rows);
-  for (std::size_t i = 0; i < rows; ++i) {
-    hal::AdcSample s;
-    if (adc.WaitDataReady(1000) != hal::Status::kOk || adc.Read(s) != hal::Status::kOk) {
-      throw std::runtime_error("record: simulated ADC failed at row " + std::to_string(i));
-    }
-    for (int c = 0; c < n; ++c)
-      real_b[static_cast<std::size_t>(c)][i] = s.counts[static_cast<std::size_t>(c)] / cpm;
-    temp[i] = s.has_temperature ? s.temperature_mdegc / 1000.0 : in.temp_c[i];
-  }
-
-  // The two recordings share t, the reference wrench and temp_C.
-  std::vector<std::vector<double>> wrench(6, std::vector<double>(rows));
-  for (std::size_t i = 0; i < rows; ++i) {
-    const Wrench w = profile.LoadAt(in.t_s[i]);
-    for (int k = 0; k < 6; ++k) wrench[static_cast<std::size_t>(k)][i] = w(k);
-  }
-  const auto bnames = BridgeColumns(static_cast<std::size_t>(n));
-  for (Recording* r : {&res.real, &res.sim}) {
-    r->SetColumn("t", in.t_s);
-    for (int k = 0; k < 6; ++k)
-      r->SetColumn(WrenchColumns()[static_cast<std::size_t>(k)],
-                   wrench[static_cast<std::size_t>(k)]);
-  }
-  for (int c = 0; c < n; ++c) {
-    res.real.SetColumn(bnames[static_cast<std::size_t>(c)], real_b[static_cast<std::size_t>(c)]);
-    std::vector<double> v(rows);
-    for (std::size_t i = 0; i < rows; ++i) v[i] = sim(c, static_cast<Eigen::Index>(i));
-    res.sim.SetColumn(bnames[static_cast<std::size_t>(c)], std::move(v));
-  }
-  if (req.temperature) {
-    res.real.SetColumn("temp_C", temp);
-    res.sim.SetColumn("temp_C", temp);
-  }
-  const std::vector<std::string> common = {
-      "sensor: " + req.sensor.name, "profile: " + profile.name(),
-      "seed: " + std::to_string(req.seed), "rate_hz: " + Fmt(rate)};
-  res.real.metadata = common;
-  res.real.metadata.insert(res.real.metadata.begin(),
-                           "source: ftsim record (simulated measurement)");
-  res.sim.metadata = common;
-  res.sim.metadata.insert(res.sim.metadata.begin(),
-                          "source: ftsim record (model prediction, " + model.name() + ")");
-
-  // Truth: every effect with its exact parameters and where its own contribution shows.
-  nlohmann::json truth;
-  truth["schema"] = "ftsim-truth/1";
-  truth["sensor"] = req.sensor.name;
-  truth["model"] = model.name();
-  truth["profile"] = profile.name();
-  truth["seed"] = req.seed;
-  truth["rate_hz"] = rate;
-  truth["rows"] = rows;
-  truth["duration_s"] = in.t_s.back();
-  truth["noise_rms_mvv"] = noise;
-  truth["lsb_mvv"] = 1.0 / cpm;
-  truth["effects"] = nlohmann::json::array();
-  std::string strongest = "none";
-  double strongest_rms = 0.0;
-  for (const auto& e : res.effects) {
-    if (e.kind == EffectKind::kNone) continue;
-    const Eigen::MatrixXd c = Compose({e}, in) - sim;
-    nlohmann::json j;
-    j["name"] = e.name;
-    j["params"] = ParamsJson(e);
-    j["footprint"] = Footprint(c, in.t_s, noise);
-    truth["effects"].push_back(j);
-    const double r = std::sqrt(c.squaredNorm() / static_cast<double>(c.size()));
-    if (r > strongest_rms) {
-      strongest_rms = r;
-      strongest = e.name;
-    }
-  }
-  truth["strongest"] = strongest;
-  res.truth = std::move(truth);
+  const AdcOutput adc = ThroughAdc(req, res.clean_real, in.temp_c, rate, noise);
+  FillRecordings(req, in, sim, adc, rate, &res);
+  res.truth = MakeTruth(req, in, sim, res, rate, noise, adc.counts_per_mvv);
   return res;
 }
 

@@ -109,15 +109,13 @@ Recording SimulateRig(const sim::SensorDescription& sensor,
                       std::uint64_t seed, bool with_pose) {
   if (keys.empty()) throw std::invalid_argument("empty rig sequence");
   const sim::ProfileWrench profile(keys, true);
-  sim::SimulatedSensor source(*sensor.model, profile);
   hal::sim::SimAdcParams params = sensor.adc;
   params.seed = seed;
   params.realtime = false;
-  hal::sim::SimAdc adc(source, params);
-  hal::AdcConfig cfg;
-  cfg.channel_count = source.channel_count();
-  cfg.gain = sensor.adc_gain;
-  cfg.rate_hz = static_cast<std::uint32_t>(std::lround(rate_hz));
+  sim::SimulatedAdc simulated(sensor, profile, params);
+  const sim::SimulatedSensor& source = simulated.sensor();
+  hal::sim::SimAdc& adc = simulated.adc();
+  const hal::AdcConfig cfg = simulated.Config(static_cast<std::uint32_t>(std::lround(rate_hz)));
   if (adc.Configure(cfg) != hal::Status::kOk) {
     throw std::invalid_argument("simulated ADC refused the configuration");
   }

@@ -156,6 +156,85 @@ BridgeWiring Wiring(const Reader& rd, const std::string& s, const std::string& p
   rd.Fail(ptr, "wiring must be two_wire, three_wire, four_wire or six_wire");
 }
 
+/// One gauge of a bridge arm: its beam, position along it, face, offset and angle.
+GaugeSite ReadArm(const Reader& rd, const json& arm, const std::string& pa,
+                  const FlexureGeometry& body) {
+  GaugeSite site;
+  site.beam = static_cast<int>(rd.Integer(arm, pa, "beam", 0, body.beam_count - 1, nullptr));
+  site.position_m = rd.Required(arm, pa, "position_m");
+  const double length = body.rim_radius_m - body.hub_radius_m;
+  if (site.position_m < 0 || site.position_m > length) {
+    rd.Fail(pa + "/position_m",
+            "position_m must lie on the beam (0 … " + std::to_string(length) + " m)");
+  }
+  site.face = Face(rd, arm, pa);
+  site.offset_m = rd.Optional(arm, pa, "offset_m", 0.0);
+  const bool top_bottom = site.face == BeamFace::kTop || site.face == BeamFace::kBottom;
+  const double half = 0.5 * (top_bottom ? body.beam_width_m : body.beam_height_m);
+  if (std::abs(site.offset_m) > half) rd.Fail(pa + "/offset_m", "offset_m lies off the face");
+  site.angle_deg = rd.Optional(arm, pa, "angle_deg", 0.0);
+  return site;
+}
+
+/// The electrical defaults and the bridges with their arms (gauge sites).
+void ReadBridges(const Reader& rd, const json& m, const std::string& p, FlexureSensorSpec* s) {
+  BridgeCircuit defaults;
+  const std::string pe = p + "/electrical";
+  if (m.contains("electrical")) {
+    const json& e = rd.Object(m, p, "electrical");
+    rd.OnlyKeys(e, pe, {"excitation_v", "wiring", "lead_ohm"});
+    defaults.excitation_v = rd.Positive(e, pe, "excitation_v");
+    defaults.wiring = Wiring(rd, rd.String(e, pe, "wiring", "six_wire"), pe + "/wiring");
+    defaults.lead_ohm = rd.Optional(e, pe, "lead_ohm", 0.0);
+  }
+
+  const std::string pbr = p + "/bridges";
+  if (!m.contains("bridges") || !m["bridges"].is_array() || m["bridges"].empty() ||
+      m["bridges"].size() > 8) {
+    rd.Fail(m.contains("bridges") ? pbr : p, "'bridges' needs 1 … 8 bridges");
+  }
+  for (std::size_t b = 0; b < m["bridges"].size(); ++b) {
+    const json& br = m["bridges"][b];
+    const std::string pi = pbr + "/" + std::to_string(b);
+    if (!br.is_object()) rd.Fail(pi, "a bridge must be an object");
+    rd.OnlyKeys(br, pi, {"kind", "wiring", "lead_ohm", "completion_ohm", "arms"});
+    BridgeSpec spec;
+    spec.circuit = defaults;
+    spec.circuit.kind = Kind(rd, rd.String(br, pi, "kind", "full"), pi + "/kind");
+    if (br.contains("wiring"))
+      spec.circuit.wiring = Wiring(rd, rd.String(br, pi, "wiring", ""), pi + "/wiring");
+    spec.circuit.lead_ohm = rd.Optional(br, pi, "lead_ohm", defaults.lead_ohm);
+    spec.circuit.completion_ohm = rd.Optional(br, pi, "completion_ohm", 0.0);
+    try {
+      BridgeCircuit check = spec.circuit;
+      if (check.completion_ohm == 0) check.completion_ohm = s->gauge.resistance_ohm;
+      ValidateBridge(check);
+    } catch (const std::invalid_argument& e) {
+      rd.Fail(pi, e.what());
+    }
+    const int active = spec.circuit.kind == BridgeKind::kQuarter ? 1
+                       : spec.circuit.kind == BridgeKind::kHalf  ? 2
+                                                                 : 4;
+    if (!br.contains("arms") || !br["arms"].is_array() ||
+        br["arms"].size() != static_cast<std::size_t>(active)) {
+      rd.Fail(br.contains("arms") ? pi + "/arms" : pi,
+              "'arms' needs " + std::to_string(active) + " gauge(s) (R1 … R" +
+                  std::to_string(active) + ") for a " + rd.String(br, pi, "kind", "full") +
+                  " bridge");
+    }
+    for (int a = 0; a < active; ++a) {
+      const json& arm = br["arms"][static_cast<std::size_t>(a)];
+      const std::string pa = pi + "/arms/" + std::to_string(a);
+      if (!arm.is_object()) rd.Fail(pa, "an arm must be an object");
+      rd.OnlyKeys(arm, pa, {"beam", "position_m", "face", "offset_m", "angle_deg"});
+      const GaugeSite site = ReadArm(rd, arm, pa, s->body);
+      spec.arm_gauge[static_cast<std::size_t>(a)] = static_cast<int>(s->gauges.size());
+      s->gauges.push_back(site);
+    }
+    s->bridges.push_back(spec);
+  }
+}
+
 FlexureSensorSpec ReadFlexure(const Reader& rd, const json& m, const std::string& p,
                               const std::string& name) {
   rd.OnlyKeys(m, p,
@@ -220,74 +299,7 @@ FlexureSensorSpec ReadFlexure(const Reader& rd, const json& m, const std::string
     rd.Fail(pg, "gauge: resistance and gauge factor must be > 0, |Kt| < 0.5, self heating >= 0");
   }
 
-  BridgeCircuit defaults;
-  const std::string pe = p + "/electrical";
-  if (m.contains("electrical")) {
-    const json& e = rd.Object(m, p, "electrical");
-    rd.OnlyKeys(e, pe, {"excitation_v", "wiring", "lead_ohm"});
-    defaults.excitation_v = rd.Positive(e, pe, "excitation_v");
-    defaults.wiring = Wiring(rd, rd.String(e, pe, "wiring", "six_wire"), pe + "/wiring");
-    defaults.lead_ohm = rd.Optional(e, pe, "lead_ohm", 0.0);
-  }
-
-  const std::string pbr = p + "/bridges";
-  if (!m.contains("bridges") || !m["bridges"].is_array() || m["bridges"].empty() ||
-      m["bridges"].size() > 8) {
-    rd.Fail(m.contains("bridges") ? pbr : p, "'bridges' needs 1 … 8 bridges");
-  }
-  for (std::size_t b = 0; b < m["bridges"].size(); ++b) {
-    const json& br = m["bridges"][b];
-    const std::string pi = pbr + "/" + std::to_string(b);
-    if (!br.is_object()) rd.Fail(pi, "a bridge must be an object");
-    rd.OnlyKeys(br, pi, {"kind", "wiring", "lead_ohm", "completion_ohm", "arms"});
-    BridgeSpec spec;
-    spec.circuit = defaults;
-    spec.circuit.kind = Kind(rd, rd.String(br, pi, "kind", "full"), pi + "/kind");
-    if (br.contains("wiring"))
-      spec.circuit.wiring = Wiring(rd, rd.String(br, pi, "wiring", ""), pi + "/wiring");
-    spec.circuit.lead_ohm = rd.Optional(br, pi, "lead_ohm", defaults.lead_ohm);
-    spec.circuit.completion_ohm = rd.Optional(br, pi, "completion_ohm", 0.0);
-    try {
-      BridgeCircuit check = spec.circuit;
-      if (check.completion_ohm == 0) check.completion_ohm = s.gauge.resistance_ohm;
-      ValidateBridge(check);
-    } catch (const std::invalid_argument& e) {
-      rd.Fail(pi, e.what());
-    }
-    const int active = spec.circuit.kind == BridgeKind::kQuarter ? 1
-                       : spec.circuit.kind == BridgeKind::kHalf  ? 2
-                                                                 : 4;
-    if (!br.contains("arms") || !br["arms"].is_array() ||
-        br["arms"].size() != static_cast<std::size_t>(active)) {
-      rd.Fail(br.contains("arms") ? pi + "/arms" : pi,
-              "'arms' needs " + std::to_string(active) + " gauge(s) (R1 … R" +
-                  std::to_string(active) + ") for a " + rd.String(br, pi, "kind", "full") +
-                  " bridge");
-    }
-    for (int a = 0; a < active; ++a) {
-      const json& arm = br["arms"][static_cast<std::size_t>(a)];
-      const std::string pa = pi + "/arms/" + std::to_string(a);
-      if (!arm.is_object()) rd.Fail(pa, "an arm must be an object");
-      rd.OnlyKeys(arm, pa, {"beam", "position_m", "face", "offset_m", "angle_deg"});
-      GaugeSite site;
-      site.beam = static_cast<int>(rd.Integer(arm, pa, "beam", 0, s.body.beam_count - 1, nullptr));
-      site.position_m = rd.Required(arm, pa, "position_m");
-      const double length = s.body.rim_radius_m - s.body.hub_radius_m;
-      if (site.position_m < 0 || site.position_m > length) {
-        rd.Fail(pa + "/position_m",
-                "position_m must lie on the beam (0 … " + std::to_string(length) + " m)");
-      }
-      site.face = Face(rd, arm, pa);
-      site.offset_m = rd.Optional(arm, pa, "offset_m", 0.0);
-      const bool top_bottom = site.face == BeamFace::kTop || site.face == BeamFace::kBottom;
-      const double half = 0.5 * (top_bottom ? s.body.beam_width_m : s.body.beam_height_m);
-      if (std::abs(site.offset_m) > half) rd.Fail(pa + "/offset_m", "offset_m lies off the face");
-      site.angle_deg = rd.Optional(arm, pa, "angle_deg", 0.0);
-      spec.arm_gauge[static_cast<std::size_t>(a)] = static_cast<int>(s.gauges.size());
-      s.gauges.push_back(site);
-    }
-    s.bridges.push_back(spec);
-  }
+  ReadBridges(rd, m, p, &s);
   return s;
 }
 

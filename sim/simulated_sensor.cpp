@@ -1,5 +1,7 @@
 #include "sim/simulated_sensor.hpp"
 
+#include <stdexcept>
+
 namespace ftstack::sim {
 
 bool SimulatedSensor::Sample(double t_s, double* bridge_mvv, double* temperature_c) {
@@ -10,6 +12,24 @@ bool SimulatedSensor::Sample(double t_s, double* bridge_mvv, double* temperature
   model_.BridgeOutputsInto(w, temp, bridge_mvv);  // no allocation: runs in the sampling thread
   *temperature_c = temp;
   return true;
+}
+
+hal::AdcConfig SimulatedAdc::Config(std::uint32_t rate_hz) const {
+  hal::AdcConfig cfg;
+  cfg.channel_count = static_cast<std::uint8_t>(desc_.model->channel_count());
+  cfg.gain = desc_.adc_gain;
+  cfg.rate_hz = rate_hz;
+  return cfg;
+}
+
+hal::sim::SimAdcParams AdcParamsOrNominal(const SensorDescription& desc, std::uint32_t rate_hz) {
+  try {
+    return AdcParamsAt(desc, rate_hz);
+  } catch (const std::invalid_argument&) {
+    hal::sim::SimAdcParams params = desc.adc;
+    params.required_rate_hz = 0;
+    return params;
+  }
 }
 
 }  // namespace ftstack::sim

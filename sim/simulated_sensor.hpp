@@ -1,7 +1,10 @@
-// The simulated sensor seen by the simulated ADC: a wrench source driving a sensor model.
+// The simulated sensor and its converter: wrench source → sensor model → hal::sim::SimAdc.
 #pragma once
 
+#include <cstdint>
+
 #include "hal/sim/sim_adc.hpp"
+#include "sim/sensor_description.hpp"
 #include "sim/sensor_model.hpp"
 #include "sim/wrench_source.hpp"
 
@@ -25,5 +28,32 @@ class SimulatedSensor final : public hal::sim::BridgeSignalSource {
   const WrenchSource& source_;
   Wrench last_wrench_ = Wrench::Zero();
 };
+
+/// A sensor description read by its simulated converter: the one set-up of description →
+/// simulated sensor → SimAdc that ftd's simulator, the rig simulation and the tests share. The
+/// description and the source must outlive it.
+class SimulatedAdc {
+ public:
+  SimulatedAdc(const SensorDescription& desc, const WrenchSource& source,
+               const hal::sim::SimAdcParams& params)
+      : desc_(desc), sensor_(*desc.model, source), adc_(sensor_, params) {}
+  SimulatedAdc(const SimulatedAdc&) = delete;
+  SimulatedAdc& operator=(const SimulatedAdc&) = delete;
+
+  [[nodiscard]] hal::sim::SimAdc& adc() { return adc_; }
+  [[nodiscard]] const SimulatedSensor& sensor() const { return sensor_; }
+  /// The configuration that runs the description's converter (its channels, PGA gain) at rate_hz.
+  [[nodiscard]] hal::AdcConfig Config(std::uint32_t rate_hz) const;
+
+ private:
+  const SensorDescription& desc_;
+  SimulatedSensor sensor_;
+  hal::sim::SimAdc adc_;
+};
+
+/// The converter parameters of `desc` at rate_hz as ftd runs them: AdcParamsAt, or, when the
+/// converter cannot run that rate, the nominal operating point's noise with the rate left free.
+[[nodiscard]] hal::sim::SimAdcParams AdcParamsOrNominal(const SensorDescription& desc,
+                                                        std::uint32_t rate_hz);
 
 }  // namespace ftstack::sim

@@ -21,7 +21,12 @@ std::unique_ptr<hal::Adc> Make(const std::string& kind, const std::string& chip,
   o.kind = kind;
   o.gpiochip = chip;
   o.spidev = spi;
-  return MakeHardwareAdc(o, error);
+  try {
+    return MakeHardwareAdc(o);
+  } catch (const FtdError& e) {  // the one error convention of the daemon's start-up
+    *error = e.what();
+    return nullptr;
+  }
 }
 
 TEST(HardwareAdc, Hx711NeedsAGpioChip) {

@@ -19,21 +19,13 @@ struct BuiltinAdc {
 
 inline BuiltinAdc BuiltinSimAdc(std::uint32_t rate_hz = 1000) {
   const sim::SensorDescription desc = sim::DefaultSensorDescription();
-  hal::sim::SimAdcParams params;
-  try {
-    params = sim::AdcParamsAt(desc, rate_hz);
-  } catch (const std::invalid_argument&) {
-    params = desc.adc;
-    params.required_rate_hz = 0;
-  }
+  const hal::sim::SimAdcParams params = sim::AdcParamsOrNominal(desc, rate_hz);
   sim::ConstantWrench zero(Wrench::Zero());
-  sim::SimulatedSensor sensor(*desc.model, zero);
-  hal::sim::SimAdc adc(sensor, params);
-  hal::AdcConfig cfg;
-  cfg.channel_count = static_cast<std::uint8_t>(desc.model->channel_count());
-  cfg.gain = desc.adc_gain;
-  cfg.rate_hz = rate_hz;
-  if (adc.Configure(cfg) != hal::Status::kOk) throw std::runtime_error("built-in ADC refused");
+  sim::SimulatedAdc simulated(desc, zero, params);
+  hal::sim::SimAdc& adc = simulated.adc();
+  if (adc.Configure(simulated.Config(rate_hz)) != hal::Status::kOk) {
+    throw std::runtime_error("built-in ADC refused");
+  }
   return BuiltinAdc{adc.Info(), params.noise_rms_mvv};
 }
 

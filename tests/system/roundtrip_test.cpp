@@ -23,18 +23,13 @@ struct RoundTrip {
 RoundTrip RunChain(const sim::SensorDescription& desc, const Wrench& applied, int samples,
                    std::uint64_t seed) {
   sim::ConstantWrench source(applied, 20.0);
-  sim::SimulatedSensor sensor(*desc.model, source);
   hal::sim::SimAdcParams params = desc.adc;
   params.seed = seed;
   params.realtime = false;
-  hal::sim::SimAdc adc(sensor, params);
+  sim::SimulatedAdc simulated(desc, source, params);
   fw::WrenchCore core;
-  fw::Sampler sampler(adc, core);
-  hal::AdcConfig cfg;
-  cfg.channel_count = static_cast<std::uint8_t>(desc.model->channel_count());
-  cfg.gain = desc.adc_gain;
-  cfg.rate_hz = 1000;
-  EXPECT_EQ(sampler.Start(cfg), hal::Status::kOk);
+  fw::Sampler sampler(simulated.adc(), core);
+  EXPECT_EQ(sampler.Start(simulated.Config(1000)), hal::Status::kOk);
   const cal::CalFile cal = sim::IdealCalibration(*desc.model, sampler.info());
   fw::LoadReport rep{};
   core.SetCalibration(cal::ToFixed(cal, sampler.info(), &rep));

@@ -60,10 +60,10 @@ TEST(SamplingPath, SimulatedBackendStepsWithoutAllocating) {
   Wrench w;
   w << 10.0, -5.0, -50.0, 0.2, 0.1, -0.05;
   sim::ConstantWrench source(w);
-  sim::SimulatedSensor sensor(*desc.model, source);
   hal::sim::SimAdcParams params = sim::AdcParamsAt(desc, 1000);
   params.realtime = false;  // as fast as it can: the test measures allocations, not time
-  hal::sim::SimAdc adc(sensor, params);
+  sim::SimulatedAdc simulated(desc, source, params);
+  hal::sim::SimAdc& adc = simulated.adc();
   fw::WrenchCore core;
   fw::Device device(adc, core);
   fw::DeviceConfig cfg;

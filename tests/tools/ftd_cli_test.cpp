@@ -17,7 +17,7 @@ struct BadCase {
 
 TEST(FtdCli, BadInputGivesExit2AndOneLineNamingIt) {
   // (An unusable calibration file is not among them: a field device comes up without it and
-  // says why — tests/system/test_ftd_modbus.cpp, FtdModbus.UnusableCalibrationFiles….)
+  // says why — tests/system/ftd_modbus_test.cpp, FtdModbus.UnusableCalibrationFiles….)
   const std::vector<BadCase> cases = {
       {{"--modbus-tcp", "127.0.0.1:99999"}, "99999"},
       {{"--modbus-tcp", "127.0.0.1"}, "HOST:PORT"},

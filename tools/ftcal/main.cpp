@@ -21,6 +21,14 @@
 
 namespace {
 
+/// ftcal's exit codes (docs/spec: command lines).
+enum ExitCode : int {
+  kExitOk = 0,          ///< done
+  kExitError = 1,       ///< bad input or a refused operation: one line on stderr names it
+  kExitIncomplete = 3,  ///< verify: the file is intact but flags an axis invalid
+  kExitFlagged = 3,     ///< apply: rows carry status bits (no valid wrench) and no --allow-flagged
+};
+
 std::string Today() {
   const std::time_t now = std::time(nullptr);
   std::tm tm{};
@@ -174,6 +182,141 @@ void RunFit(const FitArgs& args) {
   std::printf("wrote %s\n", args.out_path.c_str());
 }
 
+/// ftcal import-ati: converts, prints the matrix and the fixed-point error, writes.
+void RunImportAti(const std::string& ati_path, const std::string& out_path) {
+  using namespace ftstack;
+  const cal::AtiImport imp = cal::ImportAtiCal(ati_path);
+  for (const std::string& w : imp.warnings) std::fprintf(stderr, "ftcal: warning: %s\n", w.c_str());
+  cal::SaveCalFile(out_path, imp.file);
+  std::printf("%s: ATI calibration version %s, serial %s, %d gauges, matrix from %s\n",
+              ati_path.c_str(), imp.version.c_str(), imp.file.serial.c_str(),
+              imp.file.cal.channel_count,
+              imp.used_user_axis ? "UserAxis rows" : "Axis rows / scale + BasicTransform");
+  for (std::size_t a = 0; a < 6; ++a) {
+    std::printf("  %s (%s/V):", cal::kAxisNames[a], a < 3 ? "N" : "N*m");
+    for (std::size_t c = 0; c < imp.file.cal.channel_count; ++c) {
+      std::printf(" %10.5f", imp.file.cal.matrix[a][c]);
+    }
+    std::printf("   rated %g\n", imp.file.rated[a]);
+  }
+  fw::LoadReport rep{};
+  (void)cal::ToFixed(imp.file, imp.file.adc, &rep);
+  PrintWorstCase(rep);
+  std::printf("wrote %s (input unit V)\n", out_path.c_str());
+}
+
+/// ftcal active: prints the active slot's calibration.
+void RunActive(const std::string& slots_dir) {
+  using namespace ftstack;
+  cal::CalSlots slots(slots_dir);
+  char slot = 0;
+  std::string note;
+  const cal::CalFile f = slots.LoadActive(&slot, &note);
+  if (!note.empty()) std::fprintf(stderr, "ftcal: warning: %s\n", note.c_str());
+  std::printf("slot %c: serial %s, date %s, source %s\n", slot, f.serial.c_str(), f.date.c_str(),
+              f.source.c_str());
+}
+
+/// ftcal apply: the firmware's fixed-point core over a recording, in the calibration's input unit;
+/// kExitFlagged when rows carry status bits (their wrench is not a valid reading) unless allowed.
+ExitCode RunApply(const std::string& cal_path, const std::string& in_path,
+                  const std::string& out_path, const ftstack::UnitOverrides& units,
+                  bool allow_flagged) {
+  using namespace ftstack;
+  const cal::CalFile cal = cal::LoadCalFile(cal_path);
+  if (cal.cal.invalid_axes != 0) {
+    std::fprintf(stderr,
+                 "ftcal: warning: %s flags axis %s invalid (not calibrated): its column holds "
+                 "0, not a measurement\n",
+                 cal_path.c_str(), cal::AxisList(cal.cal.invalid_axes).c_str());
+  }
+  ReadOptions opt;
+  opt.require_bridges = true;
+  Recording in = ReadRecording(in_path, opt);
+  const std::string used = cal::PrepareApplyInput(&in, units, cal);
+  std::fprintf(stderr, "ftcal: %s\n", used.c_str());
+  const Recording out = cal::ApplyCalibration(cal, in);
+  WriteRecording(out_path, out);
+  std::fprintf(stderr, "ftcal: wrote %zu rows to %s\n", in.rows(), out_path.c_str());
+  const std::size_t flagged = tools::ReportStatusBits(out.Column("status"), stderr);
+  if (flagged > 0 && !allow_flagged) {
+    std::fprintf(stderr,
+                 "ftcal: %zu of %zu rows carry status bits (their wrench is not a valid "
+                 "reading); exit 3 (--allow-flagged to accept)\n",
+                 flagged, out.rows());
+    return kExitFlagged;
+  }
+  return kExitOk;
+}
+
+/// ftcal verify: integrity and the fixed-point form; kExitIncomplete for a file with invalid axes.
+ExitCode RunVerify(const std::string& cal_path) {
+  using namespace ftstack;
+  const cal::CalFile cal = cal::LoadCalFile(cal_path);
+  fw::LoadReport rep{};
+  (void)cal::ToFixed(cal, cal.adc, &rep);
+  if (cal.cal.invalid_axes != 0) {
+    // Intact, but not a calibration of every axis: never "OK" alone (exit 3).
+    std::printf(
+        "%s: INCOMPLETE: axis %s flagged invalid (not excited on the rig): ftd serves "
+        "no value for it (NaN / 0, status bit 10); the file itself is intact (CRC "
+        "valid)\n",
+        cal_path.c_str(), cal::AxisList(cal.cal.invalid_axes).c_str());
+    PrintWorstCase(rep);
+    return kExitIncomplete;
+  }
+  std::printf(
+      "%s: OK (schema %s, %d channels, %d second-order terms, temperature %s, "
+      "serial %s, CRC valid, fixed-point form matches)\n",
+      cal_path.c_str(), cal::kCalSchema, cal.cal.channel_count, cal.cal.product_count,
+      cal.cal.temperature_compensated ? "compensated" : "not compensated", cal.serial.c_str());
+  PrintWorstCase(rep);
+  return kExitOk;
+}
+
+/// What `ftcal design` is told.
+struct DesignArgs {
+  std::string sensor = "builtin";
+  std::string profile_out;
+  std::string simulate_out;
+  double rate_hz = 1000.0;
+  std::vector<double> temps;
+};
+
+/// ftcal design: the load sequence, optionally its keyframe profile and a simulated rig run.
+void RunDesign(const DesignArgs& args) {
+  using namespace ftstack;
+  const sim::SensorDescription s = sim::LoadSensorDescription(args.sensor);
+  sim::RigDesignOptions ro;
+  ro.temperatures_c = args.temps;
+  const auto steps = sim::DesignRig(s.model->rated(), ro);
+  const auto keys = sim::RigKeys(steps, ro);
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    std::printf("%4zu  %-28s  %8.2f %8.2f %8.2f %7.3f %7.3f %7.3f  %5.1f C\n", i,
+                steps[i].label.c_str(), steps[i].wrench(0), steps[i].wrench(1), steps[i].wrench(2),
+                steps[i].wrench(3), steps[i].wrench(4), steps[i].wrench(5), steps[i].temperature_c);
+  }
+  std::printf("%zu loads, %.1f s; condition number of the load set: %.3g\n", steps.size(),
+              keys.back().t_s, cal::LoadSetCondition(sim::RigLoads(steps), s.model->rated()));
+  if (!args.profile_out.empty()) {
+    Recording prof;
+    prof.names = {"t", "Fx", "Fy", "Fz", "Mx", "My", "Mz", "temp_C"};
+    prof.columns.resize(8);
+    for (const auto& k : keys) {
+      prof.columns[0].push_back(k.t_s);
+      for (int a = 0; a < 6; ++a) prof.columns[static_cast<std::size_t>(1 + a)].push_back(k.w(a));
+      prof.columns[7].push_back(k.temperature_c);
+    }
+    prof.metadata.push_back("source: ftcal design");
+    WriteRecording(args.profile_out, prof);
+    std::printf("wrote %s\n", args.profile_out.c_str());
+  }
+  if (!args.simulate_out.empty()) {
+    WriteRecording(args.simulate_out, sim::SimulateRig(s, keys, args.rate_hz, 1));
+    std::printf("wrote %s\n", args.simulate_out.c_str());
+  }
+}
+
 int main(int argc, char** argv) {
   using namespace ftstack;
   CLI::App app{"ftcal — fit, apply, import and verify force/torque calibrations"};
@@ -236,19 +379,15 @@ int main(int argc, char** argv) {
   auto* verify = app.add_subcommand("verify", "check a calibration file's integrity");
   verify->add_option("cal", cal_path, "calibration file")->required();
 
-  std::string profile_out;
-  std::string simulate_out;
-  double rate_hz = 1000.0;
-  std::vector<double> temps;
-  std::string design_sensor;
+  DesignArgs da;
   auto* design = app.add_subcommand("design", "propose a calibration rig load sequence");
-  design->add_option("--sensor", design_sensor, "sensor description or builtin")
+  design->add_option("--sensor", da.sensor, "sensor description or builtin")
       ->default_val("builtin");
-  design->add_option("--out", profile_out, "keyframe profile CSV (t, Fx…Mz, temp_C)");
-  design->add_option("--simulate", simulate_out, "also simulate the rig into this recording");
-  design->add_option("--rate-hz", rate_hz, "sample rate of the simulation")
+  design->add_option("--out", da.profile_out, "keyframe profile CSV (t, Fx…Mz, temp_C)");
+  design->add_option("--simulate", da.simulate_out, "also simulate the rig into this recording");
+  design->add_option("--rate-hz", da.rate_hz, "sample rate of the simulation")
       ->check(CLI::Range(1.0, 100000.0));
-  design->add_option("--temperatures", temps, "repeat at these body temperatures, °C")
+  design->add_option("--temperatures", da.temps, "repeat at these body temperatures, °C")
       ->delimiter(',');
 
   double max_condition = 30.0;
@@ -270,117 +409,23 @@ int main(int argc, char** argv) {
     } else if (*payload) {
       RunPayload(in_path, out_path, max_condition);
     } else if (*import_ati) {
-      const cal::AtiImport imp = cal::ImportAtiCal(ati_path);
-      for (const std::string& w : imp.warnings)
-        std::fprintf(stderr, "ftcal: warning: %s\n", w.c_str());
-      cal::SaveCalFile(out_path, imp.file);
-      std::printf("%s: ATI calibration version %s, serial %s, %d gauges, matrix from %s\n",
-                  ati_path.c_str(), imp.version.c_str(), imp.file.serial.c_str(),
-                  imp.file.cal.channel_count,
-                  imp.used_user_axis ? "UserAxis rows" : "Axis rows / scale + BasicTransform");
-      for (std::size_t a = 0; a < 6; ++a) {
-        std::printf("  %s (%s/V):", cal::kAxisNames[a], a < 3 ? "N" : "N*m");
-        for (std::size_t c = 0; c < imp.file.cal.channel_count; ++c) {
-          std::printf(" %10.5f", imp.file.cal.matrix[a][c]);
-        }
-        std::printf("   rated %g\n", imp.file.rated[a]);
-      }
-      fw::LoadReport rep{};
-      (void)cal::ToFixed(imp.file, imp.file.adc, &rep);
-      PrintWorstCase(rep);
-      std::printf("wrote %s (input unit V)\n", out_path.c_str());
+      RunImportAti(ati_path, out_path);
     } else if (*install) {
       cal::CalSlots slots(slots_dir);
       const char slot = slots.InstallFromPath(cal_path);
       std::printf("%s: installed into slot %c (now active)\n", cal_path.c_str(), slot);
     } else if (*active) {
-      cal::CalSlots slots(slots_dir);
-      char slot = 0;
-      std::string note;
-      const cal::CalFile f = slots.LoadActive(&slot, &note);
-      if (!note.empty()) std::fprintf(stderr, "ftcal: warning: %s\n", note.c_str());
-      std::printf("slot %c: serial %s, date %s, source %s\n", slot, f.serial.c_str(),
-                  f.date.c_str(), f.source.c_str());
+      RunActive(slots_dir);
     } else if (*apply) {
-      const cal::CalFile cal = cal::LoadCalFile(cal_path);
-      if (cal.cal.invalid_axes != 0) {
-        std::fprintf(stderr,
-                     "ftcal: warning: %s flags axis %s invalid (not calibrated): its column holds "
-                     "0, not a measurement\n",
-                     cal_path.c_str(), cal::AxisList(cal.cal.invalid_axes).c_str());
-      }
-      ReadOptions opt;
-      opt.require_bridges = true;
-      Recording in = ReadRecording(in_path, opt);
-      const std::string used = cal::PrepareApplyInput(&in, apply_units, cal);
-      std::fprintf(stderr, "ftcal: %s\n", used.c_str());
-      const Recording out = cal::ApplyCalibration(cal, in);
-      WriteRecording(out_path, out);
-      std::fprintf(stderr, "ftcal: wrote %zu rows to %s\n", in.rows(), out_path.c_str());
-      const std::size_t flagged = tools::ReportStatusBits(out.Column("status"), stderr);
-      if (flagged > 0 && !allow_flagged) {
-        std::fprintf(stderr,
-                     "ftcal: %zu of %zu rows carry status bits (their wrench is not a valid "
-                     "reading); exit 3 (--allow-flagged to accept)\n",
-                     flagged, out.rows());
-        return 3;
-      }
+      return RunApply(cal_path, in_path, out_path, apply_units, allow_flagged);
     } else if (*verify) {
-      const cal::CalFile cal = cal::LoadCalFile(cal_path);
-      fw::LoadReport rep{};
-      (void)cal::ToFixed(cal, cal.adc, &rep);
-      if (cal.cal.invalid_axes != 0) {
-        // Intact, but not a calibration of every axis: never "OK" alone (exit 3).
-        std::printf(
-            "%s: INCOMPLETE: axis %s flagged invalid (not excited on the rig): ftd serves "
-            "no value for it (NaN / 0, status bit 10); the file itself is intact (CRC "
-            "valid)\n",
-            cal_path.c_str(), cal::AxisList(cal.cal.invalid_axes).c_str());
-        PrintWorstCase(rep);
-        return 3;
-      }
-      std::printf(
-          "%s: OK (schema %s, %d channels, %d second-order terms, temperature %s, "
-          "serial %s, CRC valid, fixed-point form matches)\n",
-          cal_path.c_str(), cal::kCalSchema, cal.cal.channel_count, cal.cal.product_count,
-          cal.cal.temperature_compensated ? "compensated" : "not compensated", cal.serial.c_str());
-      PrintWorstCase(rep);
+      return RunVerify(cal_path);
     } else if (*design) {
-      const sim::SensorDescription s = sim::LoadSensorDescription(design_sensor);
-      sim::RigDesignOptions ro;
-      ro.temperatures_c = temps;
-      const auto steps = sim::DesignRig(s.model->rated(), ro);
-      const auto keys = sim::RigKeys(steps, ro);
-      for (std::size_t i = 0; i < steps.size(); ++i) {
-        std::printf("%4zu  %-28s  %8.2f %8.2f %8.2f %7.3f %7.3f %7.3f  %5.1f C\n", i,
-                    steps[i].label.c_str(), steps[i].wrench(0), steps[i].wrench(1),
-                    steps[i].wrench(2), steps[i].wrench(3), steps[i].wrench(4), steps[i].wrench(5),
-                    steps[i].temperature_c);
-      }
-      std::printf("%zu loads, %.1f s; condition number of the load set: %.3g\n", steps.size(),
-                  keys.back().t_s, cal::LoadSetCondition(sim::RigLoads(steps), s.model->rated()));
-      if (!profile_out.empty()) {
-        Recording prof;
-        prof.names = {"t", "Fx", "Fy", "Fz", "Mx", "My", "Mz", "temp_C"};
-        prof.columns.resize(8);
-        for (const auto& k : keys) {
-          prof.columns[0].push_back(k.t_s);
-          for (int a = 0; a < 6; ++a)
-            prof.columns[static_cast<std::size_t>(1 + a)].push_back(k.w(a));
-          prof.columns[7].push_back(k.temperature_c);
-        }
-        prof.metadata.push_back("source: ftcal design");
-        WriteRecording(profile_out, prof);
-        std::printf("wrote %s\n", profile_out.c_str());
-      }
-      if (!simulate_out.empty()) {
-        WriteRecording(simulate_out, sim::SimulateRig(s, keys, rate_hz, 1));
-        std::printf("wrote %s\n", simulate_out.c_str());
-      }
+      RunDesign(da);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ftcal: %s\n", e.what());
-    return 1;
+    return kExitError;
   }
-  return 0;
+  return kExitOk;
 }

@@ -37,18 +37,30 @@ void AddRdtOptions(CLI::App& app, ftstack::daemon::FtdOptions& opt) {
       ->check(CLI::Range(0u, 0xFFFFu));
 }
 
-int Run(int argc, char** argv) {
-  using namespace ftstack;
-  CLI::App app{"ftd — force/torque sensor daemon (firmware main loop on a board or host)"};
-  daemon::FtdOptions opt;
+/// ftd's exit codes (docs/spec: command lines).
+enum ExitCode : int {
+  kExitOk = 0,        ///< stopped by a signal, --duration-s or the end of a replay
+  kExitRuntime = 1,   ///< failed while running (e.g. the log could not be written)
+  kExitBadStart = 2,  ///< bad options, or the daemon could not start: one line on stderr
+};
+
+/// ftd's command line: the daemon's options and what the program itself does with them.
+struct Args {
+  ftstack::daemon::FtdOptions opt;
   std::string sim_wrench;
+  std::string sim_stall;
   std::string parity = "N";
   double duration_s = 0;
   double print_hz = -1;
   bool unpaced = false;
+};
+
+void AddOptions(CLI::App& app, Args& a) {
+  ftstack::daemon::FtdOptions& opt = a.opt;
   app.add_option("--adc", opt.adc, "ADC backend: sim, hx711, spi")
       ->check(CLI::IsMember({"sim", "hx711", "spi"}));
-  app.add_option("--sim-wrench", sim_wrench, "constant applied wrench FX,FY,FZ,MX,MY,MZ (N, N·m)");
+  app.add_option("--sim-wrench", a.sim_wrench,
+                 "constant applied wrench FX,FY,FZ,MX,MY,MZ (N, N·m)");
   app.add_option("--replay", opt.replay, "play the wrench columns of a recording")
       ->check(CLI::ExistingFile);
   app.add_option("--rate-hz", opt.rate_hz, "sample rate, Hz")->check(CLI::Range(1u, 100000u));
@@ -68,62 +80,50 @@ int Run(int argc, char** argv) {
   app.add_option("--modbus-rtu", opt.modbus_rtu, "serve Modbus RTU on a serial DEVICE");
   AddRdtOptions(app, opt);
   app.add_option("--baud", opt.baud, "RTU baud rate")->check(CLI::Range(300u, 4000000u));
-  app.add_option("--parity", parity, "RTU parity N|E|O")->check(CLI::IsMember({"N", "E", "O"}));
+  app.add_option("--parity", a.parity, "RTU parity N|E|O")->check(CLI::IsMember({"N", "E", "O"}));
   app.add_option("--unit-id", opt.unit_id, "Modbus unit id")->check(CLI::Range(1u, 247u));
   app.add_option("--log", opt.log, "write published samples to a recording (CSV)");
   app.add_option("--gpiochip", opt.gpiochip, "GPIO chip for --adc hx711");
   app.add_option("--spidev", opt.spidev, "SPI device for --adc spi");
-  app.add_option("--duration-s", duration_s,
+  app.add_option("--duration-s", a.duration_s,
                  "stop after this many seconds (0: run until signalled)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--seed", opt.seed, "noise seed of the simulated ADC");
-  app.add_option("--print-hz", print_hz,
+  app.add_option("--print-hz", a.print_hz,
                  "rate of reading lines on stdout (default: 5, or 0 when stderr is a terminal and "
                  "shows the status line)");
-  std::string sim_stall;
-  app.add_option("--sim-stall", sim_stall,
+  app.add_option("--sim-stall", a.sim_stall,
                  "simulated ADC: hold the sampling thread MS ms on every EVERY-th sample, "
                  "EVERY:MS (tests the late-sample counter)");
-  app.add_flag("--unpaced", unpaced, "run the simulated ADC as fast as possible (benchmarks)");
+  app.add_flag("--unpaced", a.unpaced, "run the simulated ADC as fast as possible (benchmarks)");
   app.get_option("--sim-wrench")->excludes(app.get_option("--replay"));
-  CLI11_PARSE(app, argc, argv);
-  opt.parity = parity[0];
-  opt.paced = !unpaced;
+}
+
+/// Turns the program's own option texts into daemon options; throws std::invalid_argument.
+void ResolveArgs(Args& a) {
+  a.opt.parity = a.parity[0];
+  a.opt.paced = !a.unpaced;
   try {
-    if (!sim_wrench.empty()) opt.sim_wrench = tools::ParseWrench(sim_wrench);
+    if (!a.sim_wrench.empty()) a.opt.sim_wrench = ftstack::tools::ParseWrench(a.sim_wrench);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "ftd: --sim-wrench: %s\n", e.what());
-    return 2;
+    throw std::invalid_argument(std::string("--sim-wrench: ") + e.what());
   }
-  if (!sim_stall.empty()) {
+  if (!a.sim_stall.empty()) {
     unsigned every = 0;
     double ms = 0;
     char tail = 0;
-    if (std::sscanf(sim_stall.c_str(), "%u:%lf%c", &every, &ms, &tail) != 2 || every < 1 ||
+    if (std::sscanf(a.sim_stall.c_str(), "%u:%lf%c", &every, &ms, &tail) != 2 || every < 1 ||
         !(ms > 0 && ms <= 10000)) {
-      std::fprintf(stderr,
-                   "ftd: --sim-stall '%s': expected EVERY:MS (EVERY >= 1, 0 < MS <= 10000)\n",
-                   sim_stall.c_str());
-      return 2;
+      throw std::invalid_argument("--sim-stall '" + a.sim_stall +
+                                  "': expected EVERY:MS (EVERY >= 1, 0 < MS <= 10000)");
     }
-    opt.sim_stall_every = every;
-    opt.sim_stall_ms = ms;
+    a.opt.sim_stall_every = every;
+    a.opt.sim_stall_ms = ms;
   }
+}
 
-  std::signal(SIGINT, OnSignal);
-  std::signal(SIGTERM, OnSignal);
-  std::signal(SIGPIPE, SIG_IGN);
-#if FTSTACK_FTD_SIMULATOR
-  daemon::Ftd ftd(opt, &daemon::MakeSimulatedBackend);
-#else
-  daemon::Ftd ftd(opt);  // a board build: --adc sim is refused with a clear message
-#endif
-  try {
-    ftd.Start();
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "ftd: %s\n", e.what());
-    return 2;
-  }
+/// Announces the servers on stderr.
+void PrintServers(const ftstack::daemon::Ftd& ftd, const ftstack::daemon::FtdOptions& opt) {
   if (!opt.modbus_tcp.empty()) {
     const std::string host = opt.modbus_tcp.substr(0, opt.modbus_tcp.rfind(':'));
     std::fprintf(stderr, "ftd: serving Modbus TCP on %s:%u (unit %u and 255)\n", host.c_str(),
@@ -134,22 +134,18 @@ int Run(int argc, char** argv) {
                  opt.modbus_rtu.c_str(), opt.baud, opt.parity, opt.unit_id);
   }
   std::fflush(stderr);
+}
 
-  const bool status_line = isatty(STDERR_FILENO) != 0;
-  if (print_hz < 0) print_hz = status_line ? 0 : 5;
+/// Runs until a signal, --duration-s or the end of sampling: drains the log and prints the
+/// status. Throws what DrainLog throws.
+void Serve(ftstack::daemon::Ftd& ftd, double duration_s, double print_hz, bool status_line) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   auto next_status = t0;
   auto next_print = t0;
   while (!g_stop) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    try {
-      ftd.DrainLog();
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "\nftd: %s\n", e.what());
-      ftd.Stop();
-      return 1;
-    }
+    ftd.DrainLog();
     const auto now = Clock::now();
     if (status_line && now >= next_status) {
       std::fprintf(stderr, "\r%s\x1b[K", ftd.StatusLine().c_str());
@@ -164,9 +160,10 @@ int Run(int argc, char** argv) {
     if (ftd.stats().sampling_ended) break;
     if (duration_s > 0 && std::chrono::duration<double>(now - t0).count() >= duration_s) break;
   }
-  ftd.Stop();
-  const daemon::FtdStats st = ftd.stats();
-  if (status_line) std::fprintf(stderr, "\n");
+}
+
+/// The closing summary on stderr.
+void PrintSummary(const ftstack::daemon::FtdStats& st) {
   std::fprintf(stderr, "ftd: %llu samples in %.2f s (%.0f Hz)%s\n",
                static_cast<unsigned long long>(st.samples), st.elapsed_s,
                st.elapsed_s > 0 ? static_cast<double>(st.samples) / st.elapsed_s : 0.0,
@@ -176,7 +173,51 @@ int Run(int argc, char** argv) {
                  static_cast<unsigned long long>(st.adc_errors),
                  static_cast<unsigned long long>(st.backoffs));
   }
-  return 0;
+}
+
+int Run(int argc, char** argv) {
+  using namespace ftstack;
+  CLI::App app{"ftd — force/torque sensor daemon (firmware main loop on a board or host)"};
+  Args args;
+  AddOptions(app, args);
+  CLI11_PARSE(app, argc, argv);
+  const daemon::FtdOptions& opt = args.opt;
+  try {
+    ResolveArgs(args);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ftd: %s\n", e.what());
+    return kExitBadStart;
+  }
+
+  std::signal(SIGINT, OnSignal);
+  std::signal(SIGTERM, OnSignal);
+  std::signal(SIGPIPE, SIG_IGN);
+#if FTSTACK_FTD_SIMULATOR
+  daemon::Ftd ftd(opt, &daemon::MakeSimulatedBackend);
+#else
+  daemon::Ftd ftd(opt);  // a board build: --adc sim is refused with a clear message
+#endif
+  try {
+    ftd.Start();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ftd: %s\n", e.what());
+    return kExitBadStart;
+  }
+  PrintServers(ftd, opt);
+
+  const bool status_line = isatty(STDERR_FILENO) != 0;
+  const double print_hz = args.print_hz < 0 ? (status_line ? 0 : 5) : args.print_hz;
+  try {
+    Serve(ftd, args.duration_s, print_hz, status_line);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "\nftd: %s\n", e.what());
+    ftd.Stop();
+    return kExitRuntime;
+  }
+  ftd.Stop();
+  if (status_line) std::fprintf(stderr, "\n");
+  PrintSummary(ftd.stats());
+  return kExitOk;
 }
 }  // namespace
 
@@ -185,6 +226,6 @@ int main(int argc, char** argv) {
     return Run(argc, argv);
   } catch (const std::exception& e) {  // nothing is expected here; never die with a trace
     std::fprintf(stderr, "ftd: %s\n", e.what());
-    return 1;
+    return kExitRuntime;
   }
 }

@@ -37,7 +37,7 @@ int RunSensor(const DesignArgs& a, const sim::design::DesignOptions& o,
   if (phys == nullptr) {
     std::cerr << "ftsim design: " << a.sensor
               << " is not a flexure (physical) sensor description\n";
-    return 2;
+    return kExitBadInput;
   }
   sim::design::Material mat =
       phys->spec().body.e_pa < 100e9 ? sim::design::Aluminium7075() : sim::design::Steel174Ph();
@@ -58,9 +58,10 @@ int RunSensor(const DesignArgs& a, const sim::design::DesignOptions& o,
   sim::design::PrintDesign(std::cout, c, o);
   if (req != nullptr) {
     c.check = sim::design::Check(c.model, *req);
-    return sim::design::PrintRequirementVerdict(std::cout, {c}, *req, a.list) > 0 ? 0 : 1;
+    return sim::design::PrintRequirementVerdict(std::cout, {c}, *req, a.list) > 0 ? kExitOk
+                                                                                  : kExitNotMet;
   }
-  return 0;
+  return kExitOk;
 }
 
 int Run(const DesignArgs& a) {
@@ -108,18 +109,18 @@ int Run(const DesignArgs& a) {
     sim::design::WriteDesignReport(out, cs, cat, req.get(), so.design);
     if (!out) {
       std::cerr << "ftsim design: cannot write " << a.report << "\n";
-      return 2;
+      return kExitBadInput;
     }
     std::cout << "Report written to " << a.report << "\n";
   }
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::cout << "Evaluated " << cs.size() << " designs in " << s << " s\n";
-  return met > 0 ? 0 : 1;
+  return met > 0 ? kExitOk : kExitNotMet;
 }
 
 }  // namespace
 
-void AddDesignCommand(CLI::App& app) {
+void AddDesignCommand(CLI::App& app, int* exit_code) {
   auto a = std::make_shared<DesignArgs>();
   auto* cmd = app.add_subcommand(
       "design", "sensor-body design explorer: capacities, resolution, stiffness, modes, sweeps");
@@ -138,16 +139,7 @@ void AddDesignCommand(CLI::App& app) {
   cmd->add_option("--max-radius-m", a->max_radius_m,
                   "sweep: body envelope radius limit, m (default: none)");
   cmd->add_option("--refine", a->refine_starts, "guided designs refined after the sweep (6)");
-  cmd->callback([a] {
-    int rc = 2;
-    try {
-      rc = Run(*a);
-    } catch (const std::exception& e) {
-      std::cerr << "ftsim design: " << e.what() << "\n";
-    }
-    std::cout.flush();
-    std::exit(rc);
-  });
+  cmd->callback([a, exit_code] { *exit_code = Run(*a); });
 }
 
 }  // namespace ftstack::tools

@@ -1,5 +1,4 @@
 // `ftsim pivot` — the crossed-strip flexure pivot solver (logic in sim/pivot/pivot_report).
-#include <cstdlib>
 #include <iostream>
 #include <memory>
 
@@ -8,7 +7,7 @@
 
 namespace ftstack::tools {
 
-void AddPivotCommand(CLI::App& app) {
+void AddPivotCommand(CLI::App& app, int* exit_code) {
   auto args = std::make_shared<sim::pivot::PivotCommandArgs>();
   auto* cmd = app.add_subcommand(
       "pivot",
@@ -32,11 +31,8 @@ void AddPivotCommand(CLI::App& app) {
                   "measured edge points x,y (pixels, any frame) of one strip: register them onto "
                   "the model's deformed strip and report the shape residual");
   cmd->add_option("--strip", args->strip, "strip the --shape-csv points belong to (1 or 2)");
-  cmd->callback([args] {
-    const int rc = sim::pivot::RunPivotCommand(*args, std::cout, std::cerr);
-    std::cout.flush();
-    std::exit(rc);
-  });
+  cmd->callback(
+      [args, exit_code] { *exit_code = sim::pivot::RunPivotCommand(*args, std::cout, std::cerr); });
 }
 
 }  // namespace ftstack::tools

@@ -45,7 +45,7 @@ void Run(const RecordOptions& o, bool noise_given) {
 
 }  // namespace
 
-void AddRecordCommand(CLI::App& app) {
+void AddRecordCommand(CLI::App& app, int* exit_code) {
   auto opt = std::make_shared<RecordOptions>();
   auto* cmd = app.add_subcommand(
       "record", "simulated recording of a load profile, with injected effects (docs/effects.md)");
@@ -64,13 +64,9 @@ void AddRecordCommand(CLI::App& app) {
   auto* noise =
       cmd->add_option("--noise-mvv", opt->noise_mvv, "ADC noise, mV/V RMS (default: the sensor's)");
   cmd->add_flag("--no-temp", opt->no_temp, "omit the temp_C column");
-  cmd->callback([opt, noise] {
-    try {
-      Run(*opt, noise->count() > 0);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "ftsim record: %s\n", e.what());
-      std::exit(2);
-    }
+  cmd->callback([opt, noise, exit_code] {
+    Run(*opt, noise->count() > 0);
+    *exit_code = kExitOk;
   });
 }
 

@@ -1,0 +1,54 @@
+// ftd's options (its command line as a struct) and the daemon's start-up error type.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+namespace ftstack::daemon {
+
+/// A start-up failure of the daemon; what() is the one-line reason.
+class FtdError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Everything `ftd` is told on its command line (shared spec cli.md).
+struct FtdOptions {
+  std::string adc = "sim";                          ///< sim, hx711, spi
+  std::optional<std::array<double, 6>> sim_wrench;  ///< constant applied wrench, N and N·m
+  std::string replay;                               ///< recording whose wrench columns are played
+  unsigned rate_hz = 1000;
+  std::string cal;    ///< calibration file for slot 0 ("" = built-in)
+  std::string cal_b;  ///< calibration file for slot 1 ("" = none)
+  /// A slot directory of `ftcal install` (cal_A.json, cal_B.json, active): slots 0/1 from its
+  /// files, starting on the one CalSlots::LoadActive resolves ("" = use cal / cal_b).
+  std::string cal_dir;
+  std::string payload;  ///< payload file for gravity compensation ("" = none)
+  std::string rdt;      ///< HOST:PORT of the RDT server ("" = none)
+  double rdt_counts_per_n = 1e6;
+  double rdt_counts_per_nm = 1e6;
+  unsigned rdt_buffer = 4;                 ///< records per packet in buffered RDT modes
+  std::uint32_t rdt_status_mask = 0xFFFF;  ///< status bits copied into RDT records
+  std::string modbus_tcp;                  ///< HOST:PORT ("" = no TCP server)
+  std::string modbus_rtu;                  ///< serial device ("" = no RTU server)
+  unsigned baud = 19200;
+  char parity = 'N';
+  unsigned unit_id = 1;
+  std::string log;  ///< recording to write ("" = none)
+  std::string gpiochip;
+  std::string spidev;
+  std::uint64_t seed = 1;
+  bool paced = true;  ///< simulated ADC follows the wall clock (false: as fast as possible)
+  /// Simulated ADC: hold the sampling thread sim_stall_ms on every sim_stall_every-th sample
+  /// (0: never) — a deterministic stand-in for a preempted sampler (--sim-stall EVERY:MS).
+  unsigned sim_stall_every = 0;
+  double sim_stall_ms = 0;
+};
+
+/// Parses "HOST:PORT"; throws FtdError naming the bad part.
+void ParseHostPort(const std::string& text, std::string* host, std::uint16_t* port);
+
+}  // namespace ftstack::daemon
