@@ -87,7 +87,7 @@ FrameSolution::FrameSolution(FrameModel model) : m_(std::move(model)) {
     }
   }
   for (const NodeSpring& s : m_.springs) {
-    const int d = DofOf(Anchor{-1, s.node, {}});
+    const int d = DofOf(Anchor{-1, s.node, Eigen::Vector3d::Zero()});
     k.block<6, 6>(d, d) += s.k;
   }
   Eigen::MatrixXd f = Eigen::MatrixXd::Zero(n, 6);

@@ -71,7 +71,7 @@ FrameModel GuidedFrame(const GuidedParams& p) {
           Anchor next{s.inner_body, -1, inner};
           if (e + 1 < n) {
             f.nodes_m.push_back(outer + (inner - outer) * (e + 1.0) / n);
-            next = Anchor{-1, static_cast<int>(f.nodes_m.size()) - 1, {}};
+            next = Anchor{-1, static_cast<int>(f.nodes_m.size()) - 1, Eigen::Vector3d::Zero()};
           }
           FrameElement el;
           el.a = prev;
