@@ -28,8 +28,9 @@ const char* ToString(LoadStatus s) {
 
 double CountsPerMvv(const hal::AdcInfo& adc) {
   // Rails may both be ≥ 0 (a unipolar converter: codes 0 … 2^B − 1 with zero input at 0).
-  if (adc.full_scale_nvv <= 0 || adc.max_counts <= 0 || adc.min_counts >= adc.max_counts)
+  if (adc.full_scale_nvv <= 0 || adc.max_counts <= 0 || adc.min_counts >= adc.max_counts) {
     return 0.0;
+  }
   return static_cast<double>(adc.max_counts) / (static_cast<double>(adc.full_scale_nvv) * 1e-6);
 }
 

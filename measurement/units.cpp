@@ -76,6 +76,52 @@ const char* ToString(AdcCoding coding) {
   return "?";
 }
 
+namespace {
+
+/// One `key=value` item of a converter description into `c` (throws naming `where`).
+void ApplyConverterItem(const std::string& item, const std::string& where, Converter* c,
+                        bool* have_bits) {
+  const std::size_t eq = item.find('=');
+  if (eq == std::string::npos) {
+    throw std::invalid_argument(where + ": converter item '" + item + "' is not key=value");
+  }
+  const std::string key = Trim(item.substr(0, eq));
+  const std::string value = Trim(item.substr(eq + 1));
+  if (key == "bits") {
+    const double v = ParsePositive(value, key, where);
+    if (v != std::floor(v) || v < 2 || v > 31) {
+      throw std::invalid_argument(where + ": converter bits = " + value + " is not 2 … 31");
+    }
+    c->bits = static_cast<int>(v);
+    *have_bits = true;
+  } else if (key == "coding") {
+    if (value == "signed" || value == "twos-complement") {
+      c->coding = AdcCoding::kSigned;
+    } else if (value == "unsigned") {
+      c->coding = AdcCoding::kUnsigned;
+    } else if (value == "offset-binary") {
+      c->coding = AdcCoding::kOffsetBinary;
+    } else {
+      throw std::invalid_argument(where + ": converter coding '" + value +
+                                  "' is not signed, unsigned or offset-binary");
+    }
+  } else if (key == "gain") {
+    c->gain = ParsePositive(value, key, where);
+  } else if (key == "ratiometric") {
+    c->ratiometric = ParseYesNo(value, key, where);
+  } else if (key == "reference_ratio") {
+    c->reference_ratio = ParsePositive(value, key, where);
+  } else if (key == "reference_v") {
+    c->reference_v = ParsePositive(value, key, where);
+  } else if (key == "full_scale_mvv") {
+    c->full_scale_mvv = ParsePositive(value, key, where);
+  } else {
+    throw std::invalid_argument(where + ": unknown converter key '" + key + "'");
+  }
+}
+
+}  // namespace
+
 Converter ParseConverter(const std::string& text, const std::string& where) {
   Converter c;
   bool have_bits = false;
@@ -85,44 +131,7 @@ Converter ParseConverter(const std::string& text, const std::string& where) {
     if (b == std::string::npos) b = text.size();
     const std::string item = Trim(text.substr(a, b - a));
     a = b + 1;
-    if (item.empty()) continue;
-    const std::size_t eq = item.find('=');
-    if (eq == std::string::npos) {
-      throw std::invalid_argument(where + ": converter item '" + item + "' is not key=value");
-    }
-    const std::string key = Trim(item.substr(0, eq));
-    const std::string value = Trim(item.substr(eq + 1));
-    if (key == "bits") {
-      const double v = ParsePositive(value, key, where);
-      if (v != std::floor(v) || v < 2 || v > 31) {
-        throw std::invalid_argument(where + ": converter bits = " + value + " is not 2 … 31");
-      }
-      c.bits = static_cast<int>(v);
-      have_bits = true;
-    } else if (key == "coding") {
-      if (value == "signed" || value == "twos-complement") {
-        c.coding = AdcCoding::kSigned;
-      } else if (value == "unsigned") {
-        c.coding = AdcCoding::kUnsigned;
-      } else if (value == "offset-binary") {
-        c.coding = AdcCoding::kOffsetBinary;
-      } else {
-        throw std::invalid_argument(where + ": converter coding '" + value +
-                                    "' is not signed, unsigned or offset-binary");
-      }
-    } else if (key == "gain") {
-      c.gain = ParsePositive(value, key, where);
-    } else if (key == "ratiometric") {
-      c.ratiometric = ParseYesNo(value, key, where);
-    } else if (key == "reference_ratio") {
-      c.reference_ratio = ParsePositive(value, key, where);
-    } else if (key == "reference_v") {
-      c.reference_v = ParsePositive(value, key, where);
-    } else if (key == "full_scale_mvv") {
-      c.full_scale_mvv = ParsePositive(value, key, where);
-    } else {
-      throw std::invalid_argument(where + ": unknown converter key '" + key + "'");
-    }
+    if (!item.empty()) ApplyConverterItem(item, where, &c, &have_bits);
   }
   if (!have_bits) throw std::invalid_argument(where + ": converter description lacks bits=");
   return c;
