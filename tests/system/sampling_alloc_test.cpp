@@ -16,6 +16,11 @@
 #include "sim/simulated_sensor.hpp"
 #include "sim/wrench_source.hpp"
 
+// This file replaces the global operator new/delete with malloc/free. GCC (12, -O1 and above,
+// more so under -fsanitize) then reports operator new paired with free as a mismatch, although
+// both halves of the pair are ours.
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+
 namespace {
 std::atomic<long> g_allocations{0};
 }  // namespace
