@@ -43,6 +43,20 @@ bool HasCapability(int bit) {
   return false;
 }
 
+/// VmLck of this process in kB (/proc/self/status), -1 when unreadable.
+long LockedKb() {
+  std::ifstream in("/proc/self/status");
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("VmLck:", 0) != 0) continue;
+    try {
+      return std::stol(line.substr(6));
+    } catch (const std::exception&) {
+      return -1;
+    }
+  }
+  return -1;
+}
+
 }  // namespace
 
 std::string LockMemory() {
@@ -57,6 +71,9 @@ std::string LockMemory() {
   if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
     return "memory not locked (mlockall: " + ErrnoText(errno) + ")";
   }
+  // Said only when the kernel shows it: AddressSanitizer, for one, makes mlockall a no-op that
+  // returns 0.
+  if (LockedKb() == 0) return "memory not locked (mlockall had no effect: VmLck 0 kB)";
   return "memory locked";
 }
 
