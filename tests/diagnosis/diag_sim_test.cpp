@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <ostream>
 
 #include "diagnosis/evaluation/scorecard.hpp"
 #include "sim/effects.hpp"
@@ -18,6 +19,13 @@ std::vector<ScoreCase> Cases() {
 }
 
 class DiagSim : public ::testing::TestWithParam<ScoreCase> {};
+
+}  // namespace
+
+// ctest lists a case by its effect and seed, not by the bytes of the struct.
+void PrintTo(const ScoreCase& c, std::ostream* os) { *os << c.effect << " seed " << c.seed; }
+
+namespace {
 
 TEST_P(DiagSim, DiagnosesTheConcealedEffect) {
   const ScoreCase& c = GetParam();
