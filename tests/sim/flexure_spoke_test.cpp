@@ -31,7 +31,7 @@ Wrench Axis(int k, double value) {
   return w;
 }
 
-class SpokeBody : public ::testing::TestWithParam<int> {};
+class FlexureSpokes : public ::testing::TestWithParam<int> {};
 
 // Spoke torque sensor. A hub rotation θ moves each spoke's hub end tangentially by r·θ and turns it
 // by θ, the rim end clamped. The end-stiffness coefficients of a clamped beam (Przemieniecki,
@@ -39,7 +39,7 @@ class SpokeBody : public ::testing::TestWithParam<int> {};
 // moment M₀ = EI/L³·(6 L r + 4 L²)·θ, hence the torque stiffness
 // k_θ = n·(r·F + M₀)/θ = n·4·E·I·(3 r² + 3 r L + L²)/L³ and the in-plane bending moment
 // M(s) = M₀ − F·s along the spoke; the side faces carry ε = M·(w/2)/(E·I).
-TEST_P(SpokeBody, MzFollowsTheSpokeTorqueSensorClosedForm) {
+TEST_P(FlexureSpokes, MzFollowsTheSpokeTorqueSensorClosedForm) {
   const int n = GetParam();
   const FlexureBody body(Spokes(n));
   const double r = body.geometry().hub_radius_m;
@@ -80,7 +80,7 @@ TEST_P(SpokeBody, MzFollowsTheSpokeTorqueSensorClosedForm) {
 // beams (the hub does not turn: Σ sin θᵢ = 0). Each spoke takes Fₜ = 2·Fx·|sin θᵢ|/n, the hub
 // stiffness is (n/2)·12·E·I_z/L³ and the side strain M·(w/2)/(E·I_z) with M = Fₜ·(L/2 − s).
 // With a rigid rim the same force also meets the axial stiffness: K_xx = (n/2)(12 E I_z/L³ + EA/L).
-TEST_P(SpokeBody, FloatingBeamsCarryALateralForceByTangentialBendingOnly) {
+TEST_P(FlexureSpokes, FloatingBeamsCarryALateralForceByTangentialBendingOnly) {
   const int n = GetParam();
   FlexureGeometry g = Spokes(n);
   const FlexureBody rigid(g);
@@ -114,7 +114,7 @@ TEST_P(SpokeBody, FloatingBeamsCarryALateralForceByTangentialBendingOnly) {
 
 // A vertical rim spring c_z in series with each guided spoke: K_zz = n/(L³/(12 E I_y) + c_z), and
 // the spoke still bends as a guided beam, root moment (Fz/n)·L/2, whatever the spring.
-TEST_P(SpokeBody, VerticalRimComplianceActsInSeriesWithTheGuidedSpokes) {
+TEST_P(FlexureSpokes, VerticalRimComplianceActsInSeriesWithTheGuidedSpokes) {
   const int n = GetParam();
   FlexureGeometry g = Spokes(n);
   g.rim_compliance = {0, 0, 2e-7, 0, 0, 0};
@@ -129,7 +129,7 @@ TEST_P(SpokeBody, VerticalRimComplianceActsInSeriesWithTheGuidedSpokes) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(ThreeAndFourSpokes, SpokeBody, ::testing::Values(3, 4));
+INSTANTIATE_TEST_SUITE_P(ThreeAndFourSpokes, FlexureSpokes, ::testing::Values(3, 4));
 
 }  // namespace
 }  // namespace ftstack::sim
