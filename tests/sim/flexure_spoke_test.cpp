@@ -1,5 +1,5 @@
-// Hub-and-spoke body against textbook closed forms not covered elsewhere: the spoke torque
-// sensor under Mz, floating beams (radial release) under a lateral force, rim springs in series.
+// Hub-and-spoke body against textbook closed forms: spoke torque sensor, floating beams, rim
+// springs.
 #include <gtest/gtest.h>
 
 #include <cmath>
