@@ -5,7 +5,8 @@
 #   ftstack_hal          the HAL interface (header-only)              -> nothing of ours
 #   ftstack_hal_*        HAL backends (sim ADC, HX711, SPI ADC, GPIO) -> hal_if
 #   ftstack_fw_*         firmware: integer core, device, Modbus       -> hal_if, fw
-#   ftstack_measurement  host types: wrench, units, recording format  -> nothing of ours
+#   ftstack_measurement  host types: wrench, units, recording format, -> nothing of ours
+#                        effect vocabulary, shared numerics
 #   ftstack_cal_file     what a board loads: calibration file, slots  -> hal_if, fw
 #   ftstack_cal_fit      fitting, fit reports, ATI import             -> hal_if, fw, meas, calfile
 #   ftstack_sim*         physics simulator, rigs, recordings          -> hal_if, hal, meas, calfile, sim

@@ -552,7 +552,7 @@ std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
     best_bic = bic;
     e.params["tau_s"] = tau;
     e.sigma["tau_s"] = JsonNum(tau * sl);
-    PutChannelCoef(cx, f, 0, "amplitude", &e);
+    PutChannelCoef(cx, f, 0, "fraction", &e);
     best = std::move(e);
   }
   best.channels = ActiveChannels(cx, best.pred);
@@ -561,7 +561,7 @@ std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
       Fmt("during load holds b%d keeps moving toward a new value with τ = %.1f s (%.2f %% of the "
           "load) and recovers after unloading, r = %.2f",
           c, best.params["tau_s"].get<double>(),
-          100.0 * best.params["amplitude"][static_cast<std::size_t>(c)].get<double>(),
+          100.0 * best.params["fraction"][static_cast<std::size_t>(c)].get<double>(),
           RowCorr(cx, target, best.pred, c));
   return best;
 }

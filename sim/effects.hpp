@@ -11,6 +11,7 @@
 
 #include <Eigen/Dense>
 
+#include "measurement/effect_vocabulary.hpp"
 #include "sim/load_profile.hpp"
 #include "sim/sensor_model.hpp"
 
@@ -22,32 +23,14 @@ class EffectSpecError : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
-/// The effect vocabulary of the diagnosis spec, in its order (names are exact).
-enum class EffectKind {
-  kNone,
-  kZeroOffset,
-  kZeroDrift,
-  kThermalZeroDrift,
-  kThermalSpanDrift,
-  kExcitationDrift,
-  kCreep,
-  kHysteresis,
-  kBridgeNonlinearity,
-  kGeometricNonlinearity,
-  kLoadStiffening,
-  kMisalignment,
-  kGainError,
-  kTimeSkew,
-  kSaturation,
-  kOverloadShift,
-  kMainsInterference,
-  kResonance,
-};
+/// The effect kinds of the vocabulary (measurement/effect_vocabulary.hpp, docs/spec/diagnosis.md).
+using ftstack::EffectKind;
 
 /// All effect names, in vocabulary order.
 [[nodiscard]] const std::vector<std::string>& EffectNames();
-/// Keys an effect accepts (throws EffectSpecError for an unknown name).
-[[nodiscard]] const std::vector<std::string>& EffectKeys(const std::string& name);
+/// Keys the injector accepts for an effect, from the vocabulary (throws EffectSpecError for an
+/// unknown name). Aliases (older keys, docs/effects.md) are accepted too and read as these keys.
+[[nodiscard]] std::vector<std::string> EffectKeys(const std::string& name);
 
 /// A parsed `NAME[:k=v,k=v,...]`. Values are kept as text until resolved against a sensor.
 /// Lists are written `[a,b,c]` or `a/b/c`; channels are 0-based bridge indices or `all`.
@@ -110,13 +93,5 @@ void InsertOverload(const Effect& e, LoadProfile& profile, const Wrench& rated);
 /// corner_hz, random phases), zero at t[0] and scaled to RMS `amplitude` over t.
 [[nodiscard]] std::vector<double> Wander(const std::vector<double>& t_s, double amplitude,
                                          double corner_hz, std::uint64_t seed);
-
-/// Exact discretisation of a linear system ẋ = A·x + B·u for an input linear between samples
-/// (first-order hold): x[k+1] = Φ·x[k] + Γ1·u[k] + Γ2·(u[k+1] − u[k]).
-struct FohSystem {
-  Eigen::MatrixXd phi, gamma1, gamma2;
-};
-[[nodiscard]] FohSystem DiscretiseFoh(const Eigen::MatrixXd& a, const Eigen::VectorXd& b,
-                                      double h_s);
 
 }  // namespace ftstack::sim

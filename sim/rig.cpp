@@ -6,12 +6,11 @@
 #include <stdexcept>
 
 #include "hal/sim/sim_adc.hpp"
+#include "measurement/wrench.hpp"
 #include "sim/simulated_sensor.hpp"
 
 namespace ftstack::sim {
 namespace {
-
-const char* const kAxisNames[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
 
 std::string Pct(double f) {
   char buf[32];
@@ -30,7 +29,7 @@ void SingleAxisSweeps(const Wrench& rated, const std::vector<double>& levels, do
         RigStep s;
         s.wrench(a) = sign * seq[i] * rated(a);
         s.temperature_c = temp;
-        s.label = std::string(kAxisNames[a]) + " " + Pct(sign * seq[i]) +
+        s.label = std::string(kWrenchAxisNames[a]) + " " + Pct(sign * seq[i]) +
                   (i < levels.size() ? " up" : " down");
         out->push_back(s);
       }
@@ -48,8 +47,8 @@ void Combined(const Wrench& rated, double temp, std::vector<RigStep>* out) {
         s.wrench(p[0]) = sa * rated(p[0]);
         s.wrench(p[1]) = sb * rated(p[1]);
         s.temperature_c = temp;
-        s.label = std::string(kAxisNames[p[0]]) + " " + Pct(sa) + " x " + kAxisNames[p[1]] + " " +
-                  Pct(sb);
+        s.label = std::string(kWrenchAxisNames[p[0]]) + " " + Pct(sa) + " x " +
+                  kWrenchAxisNames[p[1]] + " " + Pct(sb);
         out->push_back(s);
       }
     }
@@ -147,7 +146,8 @@ Recording SimulateRig(const sim::SensorDescription& sensor,
   rec.path = "(simulated rig)";
   rec.metadata.push_back("sensor: " + sensor.name);
   rec.metadata.push_back("source: ftcal design (simulated rig)");
-  rec.names = {"t", "Fx", "Fy", "Fz", "Mx", "My", "Mz"};
+  rec.names = {"t"};
+  rec.names.insert(rec.names.end(), kWrenchAxisNames.begin(), kWrenchAxisNames.end());
   for (const auto& b : BridgeColumns(n)) rec.names.push_back(b);
   rec.names.push_back("temp_C");
   if (with_pose) rec.names.push_back("pose");

@@ -9,12 +9,13 @@
 
 #include "diagnosis/effects.hpp"
 #include "diagnosis/signal.hpp"
+#include "measurement/wrench.hpp"
 
 namespace ftstack::diag {
 namespace {
 
 using Mat = Eigen::MatrixXd;
-constexpr const char* kAxis[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
+constexpr const auto& kAxis = kWrenchAxisNames;  // measurement/wrench.hpp
 /// Play widths of the Prandtl–Ishlinskii variant, as fractions of each axis's load range.
 constexpr std::array<double, 5> kPiWidths = {0.03, 0.08, 0.2, 0.5, 1.2};
 

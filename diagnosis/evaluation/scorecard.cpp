@@ -5,8 +5,10 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <string_view>
 
 #include "diagnosis/diagnose.hpp"
+#include "measurement/effect_vocabulary.hpp"
 #include "sim/record.hpp"
 
 namespace ftstack::diag {
@@ -18,43 +20,69 @@ std::string Fmt(const char* f, double v) {
   return b;
 }
 
+/// `key=value` for an injector parameter of `kind`, the key checked against the vocabulary.
+std::string Arg(EffectKind kind, std::string_view key, const std::string& value) {
+  return std::string(ParamKey(kind, key, kInjected)) + "=" + value;
+}
+
+/// `NAME:arg,arg,…` (just NAME without arguments).
+std::string Spec(EffectKind kind, const std::vector<std::string>& args = {}) {
+  std::string out(EffectOf(kind).name);
+  for (std::size_t i = 0; i < args.size(); ++i) out += (i == 0 ? ":" : ",") + args[i];
+  return out;
+}
+
 /// The --effect argument of `effect` scaled by `factor` from the simulator's default size.
 std::string SpecFor(const std::string& effect, double f, std::uint64_t seed) {
   const double sign = seed % 2 == 0 ? -1.0 : 1.0;
-  if (effect == "zero_offset") return "zero_offset:offset=" + Fmt("%.3g", 4e-4 * f * sign);
-  if (effect == "zero_drift") return "zero_drift:amplitude=" + Fmt("%.3g", 4e-4 * f);
-  if (effect == "thermal_zero_drift")
-    return "thermal_zero_drift:coef_per_K=" + Fmt("%.3g", 5e-5 * f * sign);
-  if (effect == "thermal_span_drift")
-    return "thermal_span_drift:coef_per_K=" + Fmt("%.3g", -1.5e-4 * f * sign);
-  if (effect == "excitation_drift") return "excitation_drift:amplitude=" + Fmt("%.3g", 1.5e-3 * f);
-  if (effect == "creep") {
-    const double tau[3] = {6.0, 10.0, 20.0};
-    return "creep:fraction=" + Fmt("%.3g", 4e-3 * f) + ",tau_s=" + Fmt("%g", tau[seed % 3]);
+  const EffectDef* def = ftstack::FindEffect(effect);
+  if (def == nullptr) return effect;
+  const EffectKind k = def->kind;
+  switch (k) {
+    case EffectKind::kZeroOffset:
+      return Spec(k, {Arg(k, "offset", Fmt("%.3g", 4e-4 * f * sign))});
+    case EffectKind::kZeroDrift:
+      return Spec(k, {Arg(k, "amplitude_mvv", Fmt("%.3g", 4e-4 * f))});
+    case EffectKind::kThermalZeroDrift:
+      return Spec(k, {Arg(k, "coef_per_K", Fmt("%.3g", 5e-5 * f * sign))});
+    case EffectKind::kThermalSpanDrift:
+      return Spec(k, {Arg(k, "coef_per_K", Fmt("%.3g", -1.5e-4 * f * sign))});
+    case EffectKind::kExcitationDrift:
+      return Spec(k, {Arg(k, "amplitude", Fmt("%.3g", 1.5e-3 * f))});
+    case EffectKind::kCreep: {
+      const double tau[3] = {6.0, 10.0, 20.0};
+      return Spec(k, {Arg(k, "fraction", Fmt("%.3g", 4e-3 * f)),
+                      Arg(k, "tau_s", Fmt("%g", tau[seed % 3]))});
+    }
+    case EffectKind::kHysteresis:
+      return Spec(k, {Arg(k, "amplitude", Fmt("%.3g", 1.5e-3 * f))});
+    case EffectKind::kBridgeNonlinearity:
+      return Spec(k, {Arg(k, "coef", Fmt("%.3g", -2e-3 * f))});
+    case EffectKind::kGeometricNonlinearity:
+      return Spec(k, {Arg(k, "coef", Fmt("%.3g", -3e-3 * f * sign))});
+    case EffectKind::kLoadStiffening:
+      return Spec(k, {Arg(k, "coef", Fmt("%.3g", -8e-3 * f * sign))});
+    case EffectKind::kMisalignment: {
+      const char* axes[3] = {"z", "x", "y"};
+      return Spec(
+          k, {Arg(k, "axis", axes[seed % 3]), Arg(k, "angle_deg", Fmt("%.3g", 0.15 * f * sign))});
+    }
+    case EffectKind::kGainError:
+      return Spec(k, {Arg(k, "gain", Fmt("%.6g", 1.0 + 2.5e-3 * f * sign))});
+    case EffectKind::kTimeSkew:
+      return Spec(k, {Arg(k, "delay_s", Fmt("%.4g", 0.005 * f))});
+    case EffectKind::kOverloadShift:
+      return Spec(k, {Arg(k, "shift", Fmt("%.3g", 6e-4 * f * sign))});
+    case EffectKind::kMainsInterference:
+      return Spec(k, {Arg(k, "amplitude_mvv", Fmt("%.3g", 2.5e-4 * f)),
+                      Arg(k, "freq_hz", seed % 2 ? "50" : "60")});
+    case EffectKind::kResonance: {
+      const double fr[3] = {25.0, 18.0, 37.0};
+      return Spec(k, {Arg(k, "freq_hz", Fmt("%g", fr[seed % 3]))});
+    }
+    default:
+      return Spec(k);
   }
-  if (effect == "hysteresis") return "hysteresis:amplitude=" + Fmt("%.3g", 1.5e-3 * f);
-  if (effect == "bridge_nonlinearity") return "bridge_nonlinearity:coef=" + Fmt("%.3g", -2e-3 * f);
-  if (effect == "geometric_nonlinearity")
-    return "geometric_nonlinearity:coef=" + Fmt("%.3g", -3e-3 * f * sign);
-  if (effect == "load_stiffening") return "load_stiffening:coef=" + Fmt("%.3g", -8e-3 * f * sign);
-  if (effect == "misalignment") {
-    const char* axes[3] = {"z", "x", "y"};
-    return std::string("misalignment:axis=") + axes[seed % 3] +
-           ",angle_deg=" + Fmt("%.3g", 0.15 * f * sign);
-  }
-  if (effect == "gain_error") return "gain_error:gain=" + Fmt("%.6g", 1.0 + 2.5e-3 * f * sign);
-  if (effect == "time_skew") return "time_skew:delay_s=" + Fmt("%.4g", 0.005 * f);
-  if (effect == "saturation") return "saturation";
-  if (effect == "overload_shift") return "overload_shift:shift=" + Fmt("%.3g", 6e-4 * f * sign);
-  if (effect == "mains_interference") {
-    return "mains_interference:amplitude=" + Fmt("%.3g", 2.5e-4 * f) +
-           ",freq_hz=" + (seed % 2 ? "50" : "60");
-  }
-  if (effect == "resonance") {
-    const double fr[3] = {25.0, 18.0, 37.0};
-    return "resonance:freq_hz=" + Fmt("%g", fr[seed % 3]);
-  }
-  return effect;
 }
 
 /// The claimed effect named `name`, if the report names it as identified (an effect the report
@@ -75,7 +103,6 @@ void Judge(const sim::RecordResult& rec, const Report& r, const sim::Effect& t,
            const ClaimedEffect* c, ScoreResult* out) {
   const std::string& n = t.name;
   const auto& p = c != nullptr ? c->fit.params : nlohmann::json::object();
-  auto has = [&](const char* k) { return c != nullptr && p.contains(k); };
   // Footprint: the truth's strongest channel must be among the located mismatch channels.
   int strongest = -1;
   for (const auto& te : rec.truth["effects"]) {
@@ -101,48 +128,83 @@ void Judge(const sim::RecordResult& rec, const Report& r, const sim::Effect& t,
     out->param_error = err;
     out->param_ok = err <= tol;
   };
-  if (n == "creep" && has("tau_s")) {
-    set("tau_s", RelErr(p["tau_s"].get<double>(), t.num.at("tau_s")), 0.25);
-  } else if (n == "thermal_zero_drift" && has("coef_per_K")) {
-    // Compare on the channel with the largest true coefficient.
+  // The fitted parameter named `key` in the report, the key checked against the vocabulary.
+  auto fitted = [&](std::string_view key) -> const nlohmann::json* {
+    const std::string k(ParamKey(t.kind, key, kReported));
+    return p.contains(k) ? &p[k] : nullptr;
+  };
+  // Index of the channel with the largest true per-channel value.
+  auto largest = [&] {
     std::size_t k = 0;
     for (std::size_t i = 0; i < t.per_channel.size(); ++i) {
       if (std::fabs(t.per_channel[i]) > std::fabs(t.per_channel[k])) k = i;
     }
-    set("coef_per_K", RelErr(p["coef_per_K"][k].get<double>(), t.per_channel[k]), 0.2);
-  } else if (n == "thermal_span_drift" && has("coef_per_K")) {
-    set("coef_per_K", RelErr(p["coef_per_K"].get<double>(), t.num.at("coef_per_K")), 0.2);
-  } else if (n == "zero_offset" && has("offset")) {
-    std::size_t k = 0;
-    for (std::size_t i = 0; i < t.per_channel.size(); ++i) {
-      if (std::fabs(t.per_channel[i]) > std::fabs(t.per_channel[k])) k = i;
-    }
-    set("offset", RelErr(p["offset"][k].get<double>(), t.per_channel[k]), 0.1);
-  } else if (n == "gain_error" && has("gain")) {
-    const bool same = c->fit.channels == t.channels;
-    out->located = out->located && same;
-    const double g = p["gain"][0].get<double>();
-    set("gain-1", RelErr(g - 1.0, t.num.at("gain") - 1.0), 0.2);
-  } else if (n == "bridge_nonlinearity" && has("channels")) {
-    std::vector<int> got = p["channels"].get<std::vector<int>>();
-    out->located = out->located && got == t.channels;
-  } else if (n == "misalignment" && has("angle_deg")) {
-    const char axis[2] = {static_cast<char>('x' + t.axis), 0};
-    out->located = out->located && p["axis"] == axis;
-    set("angle_deg", RelErr(p["angle_deg"].get<double>(), t.num.at("angle_deg")), 0.2);
-  } else if (n == "time_skew" && has("delay_s")) {
-    set("delay_s", RelErr(p["delay_s"].get<double>(), t.num.at("delay_s")), 0.25);
-    out->located = out->located && out->param_ok;
-  } else if (n == "saturation" && has("limit")) {
-    set("limit", RelErr(p["limit"].get<double>(), t.num.at("limit")), 0.02);
-  } else if (n == "overload_shift" && has("onset_s")) {
-    const double err = std::fabs(p["onset_s"].get<double>() - t.num.at("onset_s"));
-    set("onset_s (s)", err, 1.0);
-    out->located = out->located && out->param_ok;
-  } else if ((n == "mains_interference" || n == "resonance") && has("freq_hz")) {
-    set("freq_hz", RelErr(p["freq_hz"].get<double>(), t.num.at("freq_hz")),
-        n == "resonance" ? 0.03 : 0.002);
-    out->located = out->located && out->param_ok;
+    return k;
+  };
+  const nlohmann::json* v = nullptr;
+  switch (t.kind) {
+    case EffectKind::kCreep:
+      if ((v = fitted("tau_s"))) set("tau_s", RelErr(v->get<double>(), t.num.at("tau_s")), 0.25);
+      break;
+    case EffectKind::kThermalZeroDrift:
+      if ((v = fitted("coef_per_K"))) {
+        const std::size_t k = largest();
+        set("coef_per_K", RelErr((*v)[k].get<double>(), t.per_channel[k]), 0.2);
+      }
+      break;
+    case EffectKind::kThermalSpanDrift:
+      if ((v = fitted("coef_per_K")))
+        set("coef_per_K", RelErr(v->get<double>(), t.num.at("coef_per_K")), 0.2);
+      break;
+    case EffectKind::kZeroOffset:
+      if ((v = fitted("offset"))) {
+        const std::size_t k = largest();
+        set("offset", RelErr((*v)[k].get<double>(), t.per_channel[k]), 0.1);
+      }
+      break;
+    case EffectKind::kGainError:
+      if ((v = fitted("gain"))) {
+        out->located = out->located && c->fit.channels == t.channels;
+        set("gain-1", RelErr((*v)[0].get<double>() - 1.0, t.num.at("gain") - 1.0), 0.2);
+      }
+      break;
+    case EffectKind::kBridgeNonlinearity:
+      if ((v = fitted("channels")))
+        out->located = out->located && v->get<std::vector<int>>() == t.channels;
+      break;
+    case EffectKind::kMisalignment:
+      if ((v = fitted("angle_deg"))) {
+        const char axis[2] = {static_cast<char>('x' + t.axis), 0};
+        const nlohmann::json* a = fitted("axis");
+        out->located = out->located && a != nullptr && *a == axis;
+        set("angle_deg", RelErr(v->get<double>(), t.num.at("angle_deg")), 0.2);
+      }
+      break;
+    case EffectKind::kTimeSkew:
+      if ((v = fitted("delay_s"))) {
+        set("delay_s", RelErr(v->get<double>(), t.num.at("delay_s")), 0.25);
+        out->located = out->located && out->param_ok;
+      }
+      break;
+    case EffectKind::kSaturation:
+      if ((v = fitted("limit"))) set("limit", RelErr(v->get<double>(), t.num.at("limit")), 0.02);
+      break;
+    case EffectKind::kOverloadShift:
+      if ((v = fitted("onset_s"))) {
+        set("onset_s (s)", std::fabs(v->get<double>() - t.num.at("onset_s")), 1.0);
+        out->located = out->located && out->param_ok;
+      }
+      break;
+    case EffectKind::kMainsInterference:
+    case EffectKind::kResonance:
+      if ((v = fitted("freq_hz"))) {
+        set("freq_hz", RelErr(v->get<double>(), t.num.at("freq_hz")),
+            t.kind == EffectKind::kResonance ? 0.03 : 0.002);
+        out->located = out->located && out->param_ok;
+      }
+      break;
+    default:
+      break;
   }
 }
 

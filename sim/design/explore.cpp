@@ -9,11 +9,10 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "measurement/wrench.hpp"
+
 namespace ftstack::sim::design {
 namespace {
-
-const char* const kAxis[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
-const char* const kUnit[6] = {"N", "N", "N", "N·m", "N·m", "N·m"};
 
 std::string LineColumn(const std::string& text, std::size_t byte) {
   std::size_t line = 1, col = 1;
@@ -355,13 +354,13 @@ void PrintDesign(std::ostream& out, const Candidate& c, const DesignOptions& o) 
   }
   out << fmt::format("\n  capacity alone (SF {:.2f}):", o.safety_factor);
   for (int k = 0; k < 6; ++k) {
-    out << fmt::format(" {} {:.4g} {} [{}]", kAxis[k], f.capacity(k), kUnit[k],
-                       ToString(f.binding[static_cast<std::size_t>(k)]));
+    out << fmt::format(" {} {:.4g} {} [{}]", kWrenchAxisNames[k], f.capacity(k),
+                       kWrenchAxisUnits[k], ToString(f.binding[static_cast<std::size_t>(k)]));
   }
   out << fmt::format("\n  combined-load rule: capacities x {:.3f}\n", f.combined_scale);
   out << fmt::format("  resolution (1σ, {:.0f} Hz):", f.bandwidth_hz);
   for (int k = 0; k < 6; ++k)
-    out << fmt::format(" {} {:.3g} {}", kAxis[k], f.resolution(k), kUnit[k]);
+    out << fmt::format(" {} {:.3g} {}", kWrenchAxisNames[k], f.resolution(k), kWrenchAxisUnits[k]);
   out << "\n  stiffness diagonal:";
   for (int k = 0; k < 6; ++k) {
     out << fmt::format(" {:.3g} {}", f.stiffness(k, k), k < 3 ? "N/m" : "N·m/rad");

@@ -279,6 +279,28 @@ TEST(RecordEffectSpec, ParsesKeysListsAndRejectsBadInput) {
   EXPECT_NE(SpecError("none:x=1").find("keys: none"), std::string::npos);
 }
 
+// Keys come from the effect vocabulary (measurement/effect_vocabulary.hpp): an unknown key names
+// itself and every valid key with its alias; an older key (alias) is read as its canonical key.
+TEST(RecordEffectSpec, KeysAndAliasesFromTheVocabulary) {
+  EXPECT_NE(SpecError("mains_interference:amp=1e-4")
+                .find("unknown key 'amp' for mains_interference (keys: freq_hz, amplitude_mvv "
+                      "(alias amplitude), phase_deg, channels)"),
+            std::string::npos);
+  const EffectSpec old_key = ParseEffectSpec("mains_interference:amplitude=3e-4");
+  ASSERT_EQ(old_key.params.size(), 1u);
+  EXPECT_EQ(old_key.params[0].first, "amplitude_mvv");
+  EXPECT_NE(SpecError("zero_drift:amplitude=1e-4,amplitude_mvv=2e-4").find("given twice"),
+            std::string::npos);
+  const std::vector<std::string> keys = {"freq_hz", "amplitude_mvv", "phase_deg", "channels"};
+  EXPECT_EQ(EffectKeys("mains_interference"), keys);
+  // The old and the new key make the same recording; the truth carries the canonical key.
+  const RecordResult a = MakeRecording(TestRequest("taps", {"zero_drift:amplitude=3e-4"}, 5.0));
+  const RecordResult b = MakeRecording(TestRequest("taps", {"zero_drift:amplitude_mvv=3e-4"}, 5.0));
+  EXPECT_EQ(a.real.columns, b.real.columns);
+  EXPECT_DOUBLE_EQ(b.truth["effects"][0]["params"]["amplitude_mvv"].get<double>(), 3e-4);
+  EXPECT_FALSE(b.truth["effects"][0]["params"].contains("amplitude"));
+}
+
 TEST(RecordEffectSpec, RangesCheckedAgainstTheSensor) {
   auto err = [](const std::string& text) {
     try {
