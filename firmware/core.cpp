@@ -97,13 +97,16 @@ void WrenchCore::BuildPlan() {
   }
   plan_.narrow = cal_.narrow;
   plan_.narrow_shift = cal_.narrow_shift;
-  for (std::size_t j = 0; j < p && plan_.narrow; ++j) {
-    for (std::size_t r = 0; r < kAxes; ++r) {
+  plan_.narrow_product_shift = cal_.narrow_product_shift;
+  for (std::size_t r = 0; r < kAxes && plan_.narrow; ++r) {
+    std::uint64_t sum = 0;
+    for (std::size_t j = 0; j < p; ++j) {
       // |q'| ≤ 2^31 − 1 (NarrowRow): q' + 2^31 fits 32 bits.
-      plan_.quad_u[j][r] =
-          static_cast<std::uint64_t>(RoundShift(plan_.quad[j][r], plan_.narrow_shift[r]) + kHalf32);
-      plan_.quad_u_sum[r] += plan_.quad_u[j][r];
+      plan_.quad_u[j][r] = static_cast<std::uint64_t>(
+          RoundShift(plan_.quad[j][r], plan_.narrow_product_shift[r]) + kHalf32);
+      sum += plan_.quad_u[j][r];
     }
+    plan_.quad_k[r] = (sum << 31) - (std::uint64_t{p} << 62);  // modulo 2^64
   }
   for (std::size_t r = 0; r < kAxes; ++r) {
     if ((cal_.invalid_axes & (1u << r)) != 0) continue;  // a zero row
@@ -140,16 +143,15 @@ void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
   eff_dt_ = dt_mdegc;
   if (!plan_.narrow) return;
   const std::size_t n = plan_.channels;
-  const std::uint64_t features = n + plan_.products;
   for (std::size_t r = 0; r < kAxes; ++r) {
-    std::uint64_t sum = plan_.quad_u_sum[r];
+    std::uint64_t sum = 0;
     for (std::size_t c = 0; c < n; ++c) {
       // |eff'| ≤ 2^31 − 1 at every ΔT in range (NarrowRow).
       eff_u_[c][r] =
           static_cast<std::uint64_t>(RoundShift(eff_[c][r], plan_.narrow_shift[r]) + kHalf32);
       sum += eff_u_[c][r];
     }
-    narrow_k_[r] = (sum << 31) - (features << 62);  // modulo 2^64
+    narrow_k_[r] = (sum << 31) - (std::uint64_t{n} << 62);  // modulo 2^64
   }
 }
 
@@ -172,52 +174,54 @@ void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
   }
 }
 
-// Inlined into Apply: the narrow form of Accumulate (see Plan::narrow).
+// Inlined into Apply: the narrow form of Accumulate (see Plan::narrow): one 64-bit sum of
+// unsigned 32-bit products per axis for the counts and one for the second-order features.
 [[gnu::always_inline]] inline void WrenchCore::AccumulateNarrow(
     const std::array<std::int32_t, kMaxChannels>& v, std::array<std::int64_t, kAxes>& acc) const {
   const std::size_t n = plan_.channels;
   std::array<std::int64_t, kMaxChannels> x{};  // x̃ = counts − zero, |x̃| < 2^31 (NarrowRow)
-  std::uint64_t xsum = 0;                      // Σ x'_u
-  std::array<std::uint64_t, kAxes> sum{};
+  std::array<std::uint64_t, 2> xsum{};         // Σ x'_u: counts, products
+  std::array<std::array<std::uint64_t, kAxes>, 2> sum{};
 #if defined(__SSE2__)
   // pmuludq multiplies the low 32 bits of each 64-bit lane: two axes per instruction.
-  __m128i s0 = _mm_setzero_si128();
-  __m128i s1 = s0;
-  __m128i s2 = s0;
-  auto madd = [&](const std::array<std::uint64_t, kAxes>& col, std::uint64_t xu) {
+  __m128i s[2][3] = {};  // NOLINT: vector registers (std::array drops their attributes)
+  auto madd = [&](std::size_t g, const std::array<std::uint64_t, kAxes>& col, std::uint64_t xu) {
     const __m128i xb = _mm_set1_epi64x(static_cast<long long>(xu));
     const auto* p = reinterpret_cast<const __m128i*>(col.data());  // NOLINT
-    s0 = _mm_add_epi64(s0, _mm_mul_epu32(_mm_loadu_si128(p), xb));
-    s1 = _mm_add_epi64(s1, _mm_mul_epu32(_mm_loadu_si128(p + 1), xb));
-    s2 = _mm_add_epi64(s2, _mm_mul_epu32(_mm_loadu_si128(p + 2), xb));
+    s[g][0] = _mm_add_epi64(s[g][0], _mm_mul_epu32(_mm_loadu_si128(p), xb));
+    s[g][1] = _mm_add_epi64(s[g][1], _mm_mul_epu32(_mm_loadu_si128(p + 1), xb));
+    s[g][2] = _mm_add_epi64(s[g][2], _mm_mul_epu32(_mm_loadu_si128(p + 2), xb));
   };
 #else
-  auto madd = [&](const std::array<std::uint64_t, kAxes>& col, std::uint64_t xu) {
-    for (std::size_t r = 0; r < kAxes; ++r) sum[r] += col[r] * xu;
+  auto madd = [&](std::size_t g, const std::array<std::uint64_t, kAxes>& col, std::uint64_t xu) {
+    for (std::size_t r = 0; r < kAxes; ++r) sum[g][r] += col[r] * xu;
   };
 #endif
   for (std::size_t c = 0; c < n; ++c) {
     x[c] = std::int64_t{v[c]} - plan_.zero[c];
     const auto xu = static_cast<std::uint64_t>(x[c] + kHalf32);
-    xsum += xu;
-    madd(eff_u_[c], xu);
+    xsum[0] += xu;
+    madd(0, eff_u_[c], xu);
   }
   for (std::size_t j = 0; j < plan_.products; ++j) {
     const std::int64_t p = (x[plan_.a[j]] * x[plan_.b[j]] + plan_.half[j]) >> plan_.shift[j];
     const auto pu = static_cast<std::uint64_t>(p + kHalf32);  // |p| < 2^31 (NarrowRow)
-    xsum += pu;
-    madd(plan_.quad_u[j], pu);
+    xsum[1] += pu;
+    madd(1, plan_.quad_u[j], pu);
   }
 #if defined(__SSE2__)
-  auto* out = reinterpret_cast<__m128i*>(sum.data());  // NOLINT
-  _mm_storeu_si128(out, s0);
-  _mm_storeu_si128(out + 1, s1);
-  _mm_storeu_si128(out + 2, s2);
+  for (std::size_t g = 0; g < 2; ++g) {
+    auto* out = reinterpret_cast<__m128i*>(sum[g].data());  // NOLINT
+    for (std::size_t i = 0; i < 3; ++i) _mm_storeu_si128(out + i, s[g][i]);
+  }
 #endif
   for (std::size_t r = 0; r < kAxes; ++r) {
-    // The true Σ c'·x (|·|·2^k bounded by the loader), scaled back by 2^k, modulo 2^64.
-    const std::uint64_t s = sum[r] - narrow_k_[r] - (xsum << 31);
-    acc[r] += static_cast<std::int64_t>(s << plan_.narrow_shift[r]);
+    // The true Σ c'·x of each group (|·|·2^k bounded by the loader), scaled back by 2^k, modulo
+    // 2^64.
+    const std::uint64_t lin = sum[0][r] - narrow_k_[r] - (xsum[0] << 31);
+    const std::uint64_t quad = sum[1][r] - plan_.quad_k[r] - (xsum[1] << 31);
+    acc[r] += static_cast<std::int64_t>((lin << plan_.narrow_shift[r]) +
+                                        (quad << plan_.narrow_product_shift[r]));
   }
 }
 

@@ -144,9 +144,10 @@ class WrenchCore {
     /// uint64 (SSE2 pmuludq / NEON umlal lanes), then Σ c·x = Σ c'_u·x'_u − 2^31·Σ c'_u −
     /// 2^31·Σ x'_u + F·2^62 modulo 2^64, exact because the loader bounds the true sum.
     bool narrow = false;
-    std::array<std::uint8_t, kAxes> narrow_shift{};
+    std::array<std::uint8_t, kAxes> narrow_shift{};                       ///< k of the counts
+    std::array<std::uint8_t, kAxes> narrow_product_shift{};               ///< k of the products
     std::array<std::array<std::uint64_t, kAxes>, kMaxProducts> quad_u{};  ///< q' + 2^31
-    std::array<std::uint64_t, kAxes> quad_u_sum{};                        ///< Σ_j of it
+    std::array<std::uint64_t, kAxes> quad_k{};  ///< 2^31·Σ_j q'_u − P·2^62 mod 2^64
   };
 
   FixedCalibration cal_{};
@@ -157,7 +158,7 @@ class WrenchCore {
   mutable std::array<std::int64_t, kAxes> konst_{};  ///< constant at eff_dt_ minus tare_acc_
   mutable std::int32_t eff_dt_ = 0;
   mutable ColumnsU eff_u_{};                             ///< narrow eff_ (+ 2^31)
-  mutable std::array<std::uint64_t, kAxes> narrow_k_{};  ///< 2^31·Σ c'_u − F·2^62 mod 2^64
+  mutable std::array<std::uint64_t, kAxes> narrow_k_{};  ///< 2^31·Σ c'_u − N·2^62 mod 2^64
   /// The untared sum at the tare (zero without one): subtracting it makes every feature relative
   /// to its value at the tare and drops the bias.
   std::array<std::int64_t, kAxes> tare_acc_{};

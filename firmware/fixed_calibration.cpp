@@ -102,14 +102,14 @@ std::uint64_t ProductBound(const FixedFeature& e,
 /// x̃_c = counts_c − zero_c, with d_c(ΔT) = round(C_c·ΔT / 2^h_c) (C_c, h_c: the ΔT-product
 /// feature of channel c) computed once per temperature, and subtracts the same sum at the tare.
 /// Proves |C_c|·ΔT_max + 2^(h_c−1) ≤ 2^63 − 1 (no wrap in d_c) and U = |bias| + |coef_ΔT|·ΔT_max
-/// + Σ_c (|coef_c|·|zero_c| + (|coef_c| + D_c + slack)·x_max,c) + Σ_k (|q_k| + slack)·p_max,k
+/// + Σ_c (|coef_c|·|zero_c| + (|coef_c| + D_c + slack)·x_max,c) + Σ_k (|q_k| + slack_p)·p_max,k
 /// ≤ 2^61 (DriftBounds): every partial sum of one evaluation is then ≤ U, a tared one (minus the
 /// tare's sum) ≤ 2U ≤ 2^62, and adding the final rounding half (≤ 2^61) stays below 2^63. `slack`
 /// covers the narrow form's coefficients (NarrowRow), off by up to 2^(k−1) from these.
 bool EvaluationFits(const std::array<std::int64_t, kMaxFeatures>& coef, std::int64_t bias,
                     const FixedCalibration& fixed,
                     const std::array<std::uint64_t, kMaxChannels>& xmax, std::uint64_t dt_max,
-                    std::uint64_t slack) {
+                    std::uint64_t slack, std::uint64_t product_slack) {
   const std::size_t n = fixed.channel_count;
   std::array<std::uint64_t, kMaxChannels> drift{};
   if (!DriftBounds(coef, fixed, dt_max, &drift)) return false;
@@ -123,7 +123,9 @@ bool EvaluationFits(const std::array<std::int64_t, kMaxFeatures>& coef, std::int
   for (std::size_t k = 0; k < fixed.extra_count; ++k) {
     const FixedFeature& e = fixed.extra[k];
     if (e.kind == FeatureKind::kTemperature) add(Mag(coef[n + k]), 0, dt_max);
-    if (e.kind == FeatureKind::kProduct) add(Mag(coef[n + k]), slack, ProductBound(e, xmax));
+    if (e.kind == FeatureKind::kProduct) {
+      add(Mag(coef[n + k]), product_slack, ProductBound(e, xmax));
+    }
   }
   for (std::size_t c = 0; c < n; ++c) {
     std::uint64_t e = 0;
@@ -134,42 +136,53 @@ bool EvaluationFits(const std::array<std::int64_t, kMaxFeatures>& coef, std::int
   return ok && total <= kAccLimit;
 }
 
+/// Smallest k with (c_max + 2^(k−1)) / 2^k ≤ 2^31 − 1: the narrow coefficients' right shift.
+std::uint8_t NarrowShift(std::uint64_t cmax) {
+  constexpr std::uint64_t kMax32 = (std::uint64_t{1} << 31) - 1;
+  std::uint8_t k = 0;
+  while (k < 62 && ((cmax + (k > 0 ? std::uint64_t{1} << (k - 1) : 0)) >> k) > kMax32) ++k;
+  return k;
+}
+
 /// The narrow form of row r (the core's SIMD path): 32-bit coefficients round(c / 2^k) for the
-/// counts (at every ΔT: |coef_c + d_c| ≤ |coef_c| + D_c) and the products, features x̃ and p
-/// within ±(2^31 − 1), multiplied into 64-bit sums that the core scales back by 2^k. Picks the
-/// smallest k; refuses (false) when a feature is too wide, the bound with slack 2^(k−1) fails, or
-/// the added error 2^(k−1)/2^s · Σ f_max (twice with a tare) exceeds kNarrowErrorLsb.
-constexpr double kNarrowErrorLsb = 1.0 / 64.0;
+/// counts (k = k_c; at every ΔT: |coef_c + d_c| ≤ |coef_c| + D_c) and for the products (k = k_p),
+/// features x̃ and p within ±(2^31 − 1), multiplied into two 64-bit sums that the core scales
+/// back by 2^k_c and 2^k_p. Picks the smallest shifts; refuses (false) when a feature is too
+/// wide, the bound with slack 2^(k−1) fails, or the added error Σ 2^(k−1)/2^s · f_max (twice with
+/// a tare) exceeds kNarrowErrorLsb.
+constexpr double kNarrowErrorLsb = 1.0 / 16.0;
 bool NarrowRow(const FixedCalibration& fixed, std::size_t r,
                const std::array<std::uint64_t, kMaxChannels>& xmax, std::uint64_t dt_max,
-               std::uint8_t* k_out, double* err_out) {
+               std::array<std::uint8_t, 2>* k_out, double* err_out) {
   constexpr std::uint64_t kMax32 = (std::uint64_t{1} << 31) - 1;
   const std::size_t n = fixed.channel_count;
   std::array<std::uint64_t, kMaxChannels> drift{};
   if (!DriftBounds(fixed.coef[r], fixed, dt_max, &drift)) return false;
-  std::uint64_t cmax = 0;  // largest coefficient magnitude
-  double fsum = 0.0;       // Σ of the features' one-sided bounds
+  std::array<std::uint64_t, 2> cmax{};  // largest coefficient magnitude: counts, products
+  std::array<double, 2> fsum{};         // Σ of the features' one-sided bounds
   for (std::size_t c = 0; c < n; ++c) {
     if (xmax[c] > kMax32) return false;
-    cmax = std::max(cmax, Mag(fixed.coef[r][c]) + drift[c]);
-    fsum += static_cast<double>(xmax[c]);
+    cmax[0] = std::max(cmax[0], Mag(fixed.coef[r][c]) + drift[c]);
+    fsum[0] += static_cast<double>(xmax[c]);
   }
   for (std::size_t k = 0; k < fixed.extra_count; ++k) {
     const FixedFeature& e = fixed.extra[k];
     if (e.kind != FeatureKind::kProduct) continue;
     if (ProductBound(e, xmax) > kMax32) return false;
-    cmax = std::max(cmax, Mag(fixed.coef[r][n + k]));
-    fsum += static_cast<double>(ProductBound(e, xmax));
+    cmax[1] = std::max(cmax[1], Mag(fixed.coef[r][n + k]));
+    fsum[1] += static_cast<double>(ProductBound(e, xmax));
   }
-  std::uint8_t k = 0;
-  while (k < 62 && ((cmax + (k > 0 ? std::uint64_t{1} << (k - 1) : 0)) >> k) > kMax32) ++k;
-  const std::uint64_t slack = k > 0 ? std::uint64_t{1} << (k - 1) : 0;
-  const double err = 2.0 * std::ldexp(static_cast<double>(slack), -fixed.shift[r]) * fsum;
+  std::array<std::uint64_t, 2> slack{};
+  double err = 0.0;
+  for (std::size_t g = 0; g < 2; ++g) {
+    (*k_out)[g] = NarrowShift(cmax[g]);
+    slack[g] = (*k_out)[g] > 0 ? std::uint64_t{1} << ((*k_out)[g] - 1) : 0;
+    err += 2.0 * std::ldexp(static_cast<double>(slack[g]), -fixed.shift[r]) * fsum[g];
+  }
   if (err > kNarrowErrorLsb ||
-      !EvaluationFits(fixed.coef[r], fixed.bias[r], fixed, xmax, dt_max, slack)) {
+      !EvaluationFits(fixed.coef[r], fixed.bias[r], fixed, xmax, dt_max, slack[0], slack[1])) {
     return false;
   }
-  *k_out = k;
   *err_out = err;
   return true;
 }
@@ -398,7 +411,7 @@ RealRow MakeRealRow(const FloatCalibration& cal, const FixedCalibration& fixed,
     fixed->bias[r] = std::llround(row.bias_lsb * scale);
     if (AccumulatorFits(fixed->coef[r], fixed->bias[r], lay.fmax_int, lay.count) &&
         EvaluationFits(fixed->coef[r], fixed->bias[r], *fixed, lay.xmax_int,
-                       static_cast<std::uint64_t>(lay.dt_max), 0)) {
+                       static_cast<std::uint64_t>(lay.dt_max), 0, 0)) {
       break;
     }
     if (s == 0) {
@@ -454,15 +467,21 @@ LoadStatus LoadCalibration(const FloatCalibration& cal, const hal::AdcInfo& adc,
     const LoadStatus row = QuantiseRow(MakeRealRow(cal, fixed, lay, r), lay, r, &fixed, &rep);
     if (row != LoadStatus::kOk) return finish(row);
   }
-  // The narrow (32-bit coefficient) form when every row has one within kNarrowErrorLsb.
+  // The narrow (32-bit coefficient) form when every row has one within kNarrowErrorLsb that
+  // keeps the row's bound within 1 LSB.
   std::array<double, kAxes> narrow_err{};
   fixed.narrow = true;
   for (std::size_t r = 0; r < kAxes && fixed.narrow; ++r) {
-    fixed.narrow = NarrowRow(fixed, r, lay.xmax_int, static_cast<std::uint64_t>(lay.dt_max),
-                             &fixed.narrow_shift[r], &narrow_err[r]);
+    std::array<std::uint8_t, 2> k{};
+    fixed.narrow = NarrowRow(fixed, r, lay.xmax_int, static_cast<std::uint64_t>(lay.dt_max), &k,
+                             &narrow_err[r]) &&
+                   rep.worst_case_error_lsb[r] + narrow_err[r] <= 1.0;  // never past 1 LSB
+    fixed.narrow_shift[r] = k[0];
+    fixed.narrow_product_shift[r] = k[1];
   }
   if (!fixed.narrow) {
     fixed.narrow_shift = {};
+    fixed.narrow_product_shift = {};
   } else {
     for (std::size_t r = 0; r < kAxes; ++r) {
       rep.worst_case_error_lsb[r] += narrow_err[r];

@@ -88,11 +88,13 @@ struct FixedCalibration {
   std::int32_t temp_min_mdegc = 0;                ///< compensated range, m°C
   std::int32_t temp_max_mdegc = 0;
   std::uint8_t invalid_axes = 0;  ///< bit r: axis r not calibrated (see FloatCalibration)
-  /// The core may sum 32-bit coefficients round(coef / 2^narrow_shift[r]) (at every ΔT) times
-  /// 32-bit features into 64-bit sums scaled back by 2^narrow_shift[r] (SIMD-friendly): proven by
-  /// the loader with the same bounds, its extra rounding included in the reported error.
+  /// The core may sum 32-bit coefficients round(coef / 2^narrow_shift[r]) (counts, at every ΔT)
+  /// and round(coef / 2^narrow_product_shift[r]) (products) times 32-bit features into 64-bit
+  /// sums scaled back by those powers of two (SIMD-friendly): proven by the loader with the same
+  /// bounds, its extra rounding included in the reported error.
   bool narrow = false;
   std::array<std::uint8_t, kAxes> narrow_shift{};
+  std::array<std::uint8_t, kAxes> narrow_product_shift{};
   bool valid = false;
 };
 
