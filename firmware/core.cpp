@@ -179,10 +179,13 @@ void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
 [[gnu::always_inline]] inline void WrenchCore::AccumulateNarrow(
     const std::array<std::int32_t, kMaxChannels>& v, std::array<std::int64_t, kAxes>& acc) const {
   const std::size_t n = plan_.channels;
-  std::array<std::int64_t, kMaxChannels> x{};  // x̃ = counts − zero, |x̃| < 2^31 (NarrowRow)
-  std::array<std::uint64_t, 2> xsum{};         // Σ x'_u: counts, products
-  std::array<std::array<std::uint64_t, kAxes>, 2> sum{};
+  // x̃ = counts − zero, |x̃| < 2^31 (NarrowRow); only [0, n) is written and read.
+  std::array<std::int64_t, kMaxChannels> x;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+  std::array<std::uint64_t, 2> xsum{};       // Σ x'_u: counts, products
 #if defined(__SSE2__)
+  // Every lane is stored from the vector sums below.
+  std::array<std::array<std::uint64_t, kAxes>, 2>
+      sum;  // NOLINT(cppcoreguidelines-pro-type-member-init)
   // pmuludq multiplies the low 32 bits of each 64-bit lane: two axes per instruction.
   __m128i s[2][3] = {};  // NOLINT: vector registers (std::array drops their attributes)
   auto madd = [&](std::size_t g, const std::array<std::uint64_t, kAxes>& col, std::uint64_t xu) {
@@ -193,6 +196,7 @@ void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
     s[g][2] = _mm_add_epi64(s[g][2], _mm_mul_epu32(_mm_loadu_si128(p + 2), xb));
   };
 #else
+  std::array<std::array<std::uint64_t, kAxes>, 2> sum{};
   auto madd = [&](std::size_t g, const std::array<std::uint64_t, kAxes>& col, std::uint64_t xu) {
     for (std::size_t r = 0; r < kAxes; ++r) sum[g][r] += col[r] * xu;
   };
@@ -215,13 +219,16 @@ void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
     for (std::size_t i = 0; i < 3; ++i) _mm_storeu_si128(out + i, s[g][i]);
   }
 #endif
+  // The true Σ c'·x of each group (|·|·2^k bounded by the loader), scaled back by 2^k, modulo
+  // 2^64.
   for (std::size_t r = 0; r < kAxes; ++r) {
-    // The true Σ c'·x of each group (|·|·2^k bounded by the loader), scaled back by 2^k, modulo
-    // 2^64.
     const std::uint64_t lin = sum[0][r] - narrow_k_[r] - (xsum[0] << 31);
+    acc[r] += static_cast<std::int64_t>(lin << plan_.narrow_shift[r]);
+  }
+  if (plan_.products == 0) return;
+  for (std::size_t r = 0; r < kAxes; ++r) {
     const std::uint64_t quad = sum[1][r] - plan_.quad_k[r] - (xsum[1] << 31);
-    acc[r] += static_cast<std::int64_t>((lin << plan_.narrow_shift[r]) +
-                                        (quad << plan_.narrow_product_shift[r]));
+    acc[r] += static_cast<std::int64_t>(quad << plan_.narrow_product_shift[r]);
   }
 }
 
