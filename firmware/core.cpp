@@ -184,8 +184,8 @@ void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
   std::array<std::uint64_t, 2> xsum{};       // Σ x'_u: counts, products
 #if defined(__SSE2__)
   // Every lane is stored from the vector sums below.
-  std::array<std::array<std::uint64_t, kAxes>, 2>
-      sum;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+  // NOLINTNEXTLINE(cppcoreguidelines-pro-type-member-init)
+  std::array<std::array<std::uint64_t, kAxes>, 2> sum;
   // pmuludq multiplies the low 32 bits of each 64-bit lane: two axes per instruction.
   __m128i s[2][3] = {};  // NOLINT: vector registers (std::array drops their attributes)
   auto madd = [&](std::size_t g, const std::array<std::uint64_t, kAxes>& col, std::uint64_t xu) {
