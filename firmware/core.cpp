@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <limits>
 
-#if defined(__SSE2__)
+#ifdef __SSE2__
 #include <emmintrin.h>
 #endif
 
@@ -182,7 +182,7 @@ void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
   // x̃ = counts − zero, |x̃| < 2^31 (NarrowRow); only [0, n) is written and read.
   std::array<std::int64_t, kMaxChannels> x;  // NOLINT(cppcoreguidelines-pro-type-member-init)
   std::array<std::uint64_t, 2> xsum{};       // Σ x'_u: counts, products
-#if defined(__SSE2__)
+#ifdef __SSE2__
   // Every lane is stored from the vector sums below.
   // NOLINTNEXTLINE(cppcoreguidelines-pro-type-member-init)
   std::array<std::array<std::uint64_t, kAxes>, 2> sum;
@@ -213,7 +213,7 @@ void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
     xsum[1] += pu;
     madd(1, plan_.quad_u[j], pu);
   }
-#if defined(__SSE2__)
+#ifdef __SSE2__
   for (std::size_t g = 0; g < 2; ++g) {
     auto* out = reinterpret_cast<__m128i*>(sum[g].data());  // NOLINT
     for (std::size_t i = 0; i < 3; ++i) _mm_storeu_si128(out + i, s[g][i]);
