@@ -141,8 +141,8 @@ class WrenchCore {
     std::array<std::array<std::int64_t, kAxes>, kMaxProducts> quad{};  ///< [product][axis]
     std::array<std::int64_t, kAxes> round_half{};                      ///< of each row's shift
     /// Narrow form: with c' = round(c / 2^k_r) (|c'| < 2^31) and x' = x + 2^31, c'·x' summed in
-    /// uint64 (SSE2 pmuludq / NEON umlal lanes), then Σ c·x = Σ c'_u·x'_u − 2^31·Σ c'_u −
-    /// 2^31·Σ x'_u + F·2^62 modulo 2^64, exact because the loader bounds the true sum.
+    /// uint64 (SSE2 pmuludq lanes; a scalar loop elsewhere), then Σ c·x = Σ c'_u·x'_u − 2^31·Σ c'_u
+    /// − 2^31·Σ x'_u + F·2^62 modulo 2^64, exact because the loader bounds the true sum.
     bool narrow = false;
     std::array<std::uint8_t, kAxes> narrow_shift{};                       ///< k of the counts
     std::array<std::uint8_t, kAxes> narrow_product_shift{};               ///< k of the products
