@@ -98,6 +98,10 @@ void WrenchCore::BuildPlan() {
   plan_.narrow = cal_.narrow;
   plan_.narrow_shift = cal_.narrow_shift;
   plan_.narrow_product_shift = cal_.narrow_product_shift;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    const std::uint8_t k = plan_.narrow_shift[r];
+    plan_.narrow_half[r] = k > 0 ? std::int64_t{1} << (k - 1) : 0;  // RoundShift's half
+  }
   for (std::size_t r = 0; r < kAxes && plan_.narrow; ++r) {
     std::uint64_t sum = 0;
     for (std::size_t j = 0; j < p; ++j) {
@@ -143,15 +147,17 @@ void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
   eff_dt_ = dt_mdegc;
   if (!plan_.narrow) return;
   const std::size_t n = plan_.channels;
-  for (std::size_t r = 0; r < kAxes; ++r) {
-    std::uint64_t sum = 0;
-    for (std::size_t c = 0; c < n; ++c) {
-      // |eff'| ≤ 2^31 − 1 at every ΔT in range (NarrowRow).
-      eff_u_[c][r] =
-          static_cast<std::uint64_t>(RoundShift(eff_[c][r], plan_.narrow_shift[r]) + kHalf32);
-      sum += eff_u_[c][r];
+  std::array<std::uint64_t, kAxes> sum{};
+  for (std::size_t c = 0; c < n; ++c) {
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      // |eff'| ≤ 2^31 − 1 at every ΔT in range (NarrowRow): eff' + 2^31 fits 32 bits.
+      const std::int64_t e = (eff_[c][r] + plan_.narrow_half[r]) >> plan_.narrow_shift[r];
+      eff_u_[c][r] = static_cast<std::uint64_t>(e + kHalf32);
+      sum[r] += eff_u_[c][r];
     }
-    narrow_k_[r] = (sum << 31) - (std::uint64_t{n} << 62);  // modulo 2^64
+  }
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    narrow_k_[r] = (sum[r] << 31) - (std::uint64_t{n} << 62);  // modulo 2^64
   }
 }
 

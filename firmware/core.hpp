@@ -144,8 +144,9 @@ class WrenchCore {
     /// uint64 (SSE2 pmuludq lanes; a scalar loop elsewhere), then Σ c·x = Σ c'_u·x'_u − 2^31·Σ c'_u
     /// − 2^31·Σ x'_u + F·2^62 modulo 2^64, exact because the loader bounds the true sum.
     bool narrow = false;
-    std::array<std::uint8_t, kAxes> narrow_shift{};                       ///< k of the counts
-    std::array<std::uint8_t, kAxes> narrow_product_shift{};               ///< k of the products
+    std::array<std::uint8_t, kAxes> narrow_shift{};          ///< k of the counts
+    std::array<std::uint8_t, kAxes> narrow_product_shift{};  ///< k of the products
+    std::array<std::int64_t, kAxes> narrow_half{};           ///< rounding half of the counts' k
     std::array<std::array<std::uint64_t, kAxes>, kMaxProducts> quad_u{};  ///< q' + 2^31
     std::array<std::uint64_t, kAxes> quad_k{};  ///< 2^31·Σ_j q'_u − P·2^62 mod 2^64
   };
