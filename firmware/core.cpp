@@ -183,7 +183,8 @@ void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
 // Inlined into Apply: the narrow form of Accumulate (see Plan::narrow): one 64-bit sum of
 // unsigned 32-bit products per axis for the counts and one for the second-order features.
 [[gnu::always_inline]] inline void WrenchCore::AccumulateNarrow(
-    const std::array<std::int32_t, kMaxChannels>& v, std::array<std::int64_t, kAxes>& acc) const {
+    const std::array<std::int32_t, kMaxChannels>& counts, std::array<std::int64_t, kAxes>& acc,
+    bool& clamped) const {
   const std::size_t n = plan_.channels;
   // x̃ = counts − zero, |x̃| < 2^31 (NarrowRow); only [0, n) is written and read.
   std::array<std::int64_t, kMaxChannels> x;  // NOLINT(cppcoreguidelines-pro-type-member-init)
@@ -208,7 +209,9 @@ void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
   };
 #endif
   for (std::size_t c = 0; c < n; ++c) {
-    x[c] = std::int64_t{v[c]} - plan_.zero[c];
+    const std::int32_t v = std::min(std::max(counts[c], cal_.min_counts), cal_.max_counts);
+    clamped |= v != counts[c];
+    x[c] = std::int64_t{v} - plan_.zero[c];
     const auto xu = static_cast<std::uint64_t>(x[c] + kHalf32);
     xsum[0] += xu;
     madd(0, eff_u_[c], xu);
@@ -279,15 +282,7 @@ void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts,
   // K and eff cached per ΔT (temperature changes slowly); with a tare K holds minus the tare's
   // sum, so the bias drops out (see FixedCalibration).
   const std::size_t n = plan_.channels;
-  std::array<std::int32_t, kMaxChannels> v{};
   bool clamped = false;
-  const std::int32_t lo = cal_.min_counts;
-  const std::int32_t hi = cal_.max_counts;
-  for (std::size_t c = 0; c < n; ++c) {
-    const std::int32_t raw = counts[c];
-    v[c] = std::min(std::max(raw, lo), hi);  // branch-free
-    clamped |= v[c] != raw;
-  }
   if (plan_.temperature) {
     const std::int32_t dt = DeltaT(temperature_mdegc, has_temperature, temp_range);
     if (dt != eff_dt_) UpdateEffective(dt);
@@ -295,8 +290,13 @@ void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts,
   // The loader guarantees every partial sum stays within ±2^62 (EvaluationFits).
   std::array<std::int64_t, kAxes> acc = konst_;
   if (plan_.narrow) {
-    AccumulateNarrow(v, acc);
+    AccumulateNarrow(counts, acc, clamped);  // clamps the counts itself
   } else {
+    std::array<std::int32_t, kMaxChannels> v{};
+    for (std::size_t c = 0; c < n; ++c) {
+      v[c] = std::min(std::max(counts[c], cal_.min_counts), cal_.max_counts);  // branch-free
+      clamped |= v[c] != counts[c];
+    }
     Accumulate(v, eff_, acc);
   }
   // konst_ holds the rounding half. An axis the calibration does not determine has all-zero rows

@@ -110,9 +110,10 @@ class WrenchCore {
   /// Σ eff·v + Σ q·p (+ acc's start value) for clamped counts v: the per-sample sum.
   void Accumulate(const std::array<std::int32_t, kMaxChannels>& v, const Columns& eff,
                   std::array<std::int64_t, kAxes>& acc) const;
-  /// The same sum in the narrow form (FixedCalibration::narrow) with the cached eff_u_.
-  void AccumulateNarrow(const std::array<std::int32_t, kMaxChannels>& v,
-                        std::array<std::int64_t, kAxes>& acc) const;
+  /// The same sum in the narrow form (FixedCalibration::narrow) with the cached eff_u_, for raw
+  /// counts that it clamps to the rails (clamped set when it had to).
+  void AccumulateNarrow(const std::array<std::int32_t, kMaxChannels>& counts,
+                        std::array<std::int64_t, kAxes>& acc, bool& clamped) const;
   /// Unsigned 32-bit lanes (c + 2^31 in uint64): [channel or product][axis].
   using ColumnsU = std::array<std::array<std::uint64_t, kAxes>, kMaxChannels>;
 
