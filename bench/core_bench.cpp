@@ -59,18 +59,34 @@ fw::FloatCalibration RandomCal(std::uint8_t n, int terms, std::mt19937_64& rng) 
   return cal;
 }
 
-std::vector<hal::AdcSample> RandomSamples(std::uint8_t n, std::mt19937_64& rng) {
+/// Samples whose temperature changes every `temp_every` samples (a random step of up to ±20 m°C
+/// around 25 °C: a thermistor read more slowly than the bridges, or a new reading each sample
+/// when temp_every is 1). Counts are random every sample.
+std::vector<hal::AdcSample> RandomSamples(std::uint8_t n, std::mt19937_64& rng, int temp_every) {
   std::uniform_int_distribution<std::int32_t> d(-4000000, 4000000);
-  std::uniform_int_distribution<std::int32_t> t(0, 60000);
+  std::uniform_int_distribution<std::int32_t> step(-20, 20);
   std::vector<hal::AdcSample> v(kSamples);
-  for (auto& s : v) {
+  std::int32_t t = 25000;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    auto& s = v[i];
     s.channel_count = n;
     for (std::size_t c = 0; c < n; ++c) s.counts[c] = d(rng);
-    s.temperature_mdegc = t(rng);
+    if (i % static_cast<std::size_t>(temp_every) == 0) {
+      std::int32_t next = t;
+      while (next == t) next = t + step(rng);  // a reading that differs from the last one
+      t = next;
+    }
+    s.temperature_mdegc = t;
     s.has_temperature = true;
   }
   return v;
 }
+
+/// Samples per temperature reading in the benchmarks (third argument 0): 8 kHz bridges with a
+/// thermistor read at 125 Hz. Argument 1 gives every sample a new temperature (the worst case).
+constexpr int kTempEvery = 64;
+
+int TempEvery(const benchmark::State& state) { return state.range(2) != 0 ? 1 : kTempEvery; }
 
 bool LoadFixed(benchmark::State& state, fw::WrenchCore& core, std::uint8_t n, int terms,
                std::mt19937_64& rng) {
@@ -91,7 +107,7 @@ void BM_FixedCore(benchmark::State& state) {
   fw::WrenchCore core;
   if (!LoadFixed(state, core, n, kLinear, rng)) return;
   if (!core.SetFilterLength(static_cast<std::uint16_t>(state.range(1)))) return;
-  const auto samples = RandomSamples(n, rng);
+  const auto samples = RandomSamples(n, rng, kTempEvery);
   fw::CoreOutput out{};
   std::size_t i = 0;
   for (auto _ : state) {
@@ -110,7 +126,7 @@ void BM_FixedMatrix(benchmark::State& state) {
   std::mt19937_64 rng(1);
   fw::WrenchCore core;
   if (!LoadFixed(state, core, n, terms, rng)) return;
-  const auto samples = RandomSamples(n, rng);
+  const auto samples = RandomSamples(n, rng, TempEvery(state));
   fw::WrenchLsb y{};
   bool sat = false;
   bool temp_range = false;
@@ -163,18 +179,25 @@ class DoubleCore {
   }
 
   void Apply(const hal::AdcSample& s, Eigen::Matrix<double, 6, 1>& y) {
-    Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, fw::kMaxChannels, 1> x(n_);
+    // Bridge values on the stack, products from them, then the N bridge features (temperature
+    // folded in) written straight into the feature vector: plain loops for the O(N + P) steps,
+    // Eigen's matrix-vector product for the O(6·(N + P)) one.
+    std::array<double, fw::kMaxChannels> x;  // NOLINT(cppcoreguidelines-pro-type-member-init)
     for (int c = 0; c < n_; ++c) {
-      x(c) = s.counts[static_cast<std::size_t>(c)] * mvv_per_count_ - offset_(c);
+      const double xc = s.counts[static_cast<std::size_t>(c)] * mvv_per_count_ - offset_(c);
+      x[static_cast<std::size_t>(c)] = xc;
+      f_(c) = xc;
     }
     for (int k = 0; k < products_; ++k) {
-      f_(n_ + k) = x(a_[static_cast<std::size_t>(k)]) * x(b_[static_cast<std::size_t>(k)]);
+      const auto ku = static_cast<std::size_t>(k);
+      f_(n_ + k) = x[a_[ku]] * x[b_[ku]];
     }
     if (temp_) {
       const double dt = std::clamp(s.temperature_mdegc * 1e-3, t_min_, t_max_) - t_ref_;
-      f_.head(n_) = x - dt * (alpha_.head(n_) + gamma_.head(n_).cwiseProduct(x));
-    } else {
-      f_.head(n_) = x;
+      for (int c = 0; c < n_; ++c) {
+        const double xc = x[static_cast<std::size_t>(c)];
+        f_(c) = xc - dt * (alpha_(c) + gamma_(c) * xc);
+      }
     }
     y.noalias() = m_ * f_;
     y += bias_;
@@ -198,7 +221,7 @@ void BM_EigenDouble(benchmark::State& state) {
   const auto terms = static_cast<int>(state.range(1));
   std::mt19937_64 rng(1);
   DoubleCore core(RandomCal(n, terms, rng), Adc24(n));
-  const auto samples = RandomSamples(n, rng);
+  const auto samples = RandomSamples(n, rng, TempEvery(state));
   Eigen::Matrix<double, 6, 1> y;
   std::size_t i = 0;
   for (auto _ : state) {
@@ -209,10 +232,14 @@ void BM_EigenDouble(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 
-// Every configuration (N, terms) for fixed point and for double, measured in the same run.
+// Every configuration (N, terms, temperature every 64 samples) for fixed point and for double,
+// measured in the same run; with temperature terms also a new temperature every sample.
 void Configurations(benchmark::internal::Benchmark* b) {
   for (int n : {6, 8}) {
-    for (int terms : {kLinear, kSecondOrder, kTemperature, kBoth}) b->Args({n, terms});
+    for (int terms : {kLinear, kSecondOrder, kTemperature, kBoth}) b->Args({n, terms, 0});
+  }
+  for (int n : {6, 8}) {
+    for (int terms : {kTemperature, kBoth}) b->Args({n, terms, 1});
   }
 }
 BENCHMARK(BM_FixedMatrix)->Apply(Configurations);

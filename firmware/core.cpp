@@ -2,9 +2,19 @@
 
 #include "firmware/fixed_point.hpp"
 
+#include <algorithm>
+#include <limits>
+
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
 namespace ftstack::fw {
 
 namespace {
+
+/// 2^31: the offset that makes a signed 32-bit value an unsigned one (narrow form).
+constexpr std::int64_t kHalf32 = std::int64_t{1} << 31;
 
 /// Reciprocals of every moving-average fill 1 … kMaxFilterLength (index 0 unused).
 constexpr auto kFillReciprocal = [] {
@@ -36,68 +46,198 @@ void WrenchCore::ClearTare() {
   tare_active_ = false;
   tare_remaining_ = 0;
   tare_counts_ = {};
-  tare_extra_ = {};
   tare_offset_ = {};
-  tare_f_ = {};
+  tare_acc_ = {};
+  UpdateEffective(eff_dt_);
 }
 
 void WrenchCore::BuildPlan() {
   plan_ = Plan{};
+  eff_dt_ = 0;
   const std::size_t n = cal_.channel_count;
   if (!cal_.valid || n > kMaxChannels || cal_.extra_count > kMaxFeatures - kMaxChannels) return;
-  std::size_t j = 0;
-  auto add = [&](std::size_t cal_index) {  // cal_index: the feature's column in cal_.coef
-    for (std::size_t r = 0; r < kAxes; ++r) plan_.coef[j][r] = cal_.coef[r][cal_index];
-    if (cal_index >= n) {
-      const FixedFeature& e = cal_.extra[cal_index - n];
-      plan_.source[j] = static_cast<std::uint8_t>(cal_index - n);
-      plan_.a[j] = e.a;
-      plan_.b[j] = e.b;
-      plan_.shift[j] = e.shift;
-      plan_.half[j] = e.shift > 0 ? std::int64_t{1} << (e.shift - 1) : 0;
+  for (std::size_t c = 0; c < n; ++c) {
+    plan_.zero[c] = cal_.zero[c];
+    for (std::size_t r = 0; r < kAxes; ++r) plan_.coef[c][r] = cal_.coef[r][c];
+  }
+  std::size_t p = 0;
+  for (std::size_t k = 0; k < cal_.extra_count; ++k) {
+    const FixedFeature& e = cal_.extra[k];
+    const std::int64_t half = e.shift > 0 ? std::int64_t{1} << (e.shift - 1) : 0;
+    switch (e.kind) {
+      case FeatureKind::kTemperature:
+        for (std::size_t r = 0; r < kAxes; ++r) plan_.temp_coef[r] = cal_.coef[r][n + k];
+        plan_.temperature = true;
+        break;
+      case FeatureKind::kProduct:
+        plan_.a[p] = e.a;
+        plan_.b[p] = e.b;
+        plan_.shift[p] = e.shift;
+        plan_.half[p] = half;
+        for (std::size_t r = 0; r < kAxes; ++r) plan_.quad[p][r] = cal_.coef[r][n + k];
+        ++p;
+        break;
+      case FeatureKind::kTempProduct:
+        for (std::size_t r = 0; r < kAxes; ++r) plan_.drift[e.a][r] = cal_.coef[r][n + k];
+        plan_.drift_shift[e.a] = e.shift;
+        plan_.drift_half[e.a] = half;
+        plan_.temperature = true;
+        break;
     }
-    ++j;
-  };
-  for (std::size_t c = 0; c < n; ++c) add(c);
-  for (FeatureKind kind :
-       {FeatureKind::kTemperature, FeatureKind::kProduct, FeatureKind::kTempProduct}) {
-    for (std::size_t k = 0; k < cal_.extra_count; ++k) {
-      if (cal_.extra[k].kind == kind) add(n + k);
-    }
-    if (kind == FeatureKind::kTemperature) plan_.temp_end = static_cast<std::uint8_t>(j);
-    if (kind == FeatureKind::kProduct) plan_.product_end = static_cast<std::uint8_t>(j);
   }
   plan_.channels = static_cast<std::uint8_t>(n);
-  plan_.features = static_cast<std::uint8_t>(j);
+  plan_.products = static_cast<std::uint8_t>(p);
   for (std::size_t r = 0; r < kAxes; ++r) {
+    if ((cal_.invalid_axes & (1u << r)) == 0) continue;
+    // Not determined by the calibration: a zero row reads 0 (status bit 10), never a value.
+    for (auto& col : plan_.coef) col[r] = 0;
+    for (auto& col : plan_.drift) col[r] = 0;
+    for (auto& col : plan_.quad) col[r] = 0;
+    plan_.temp_coef[r] = 0;
+  }
+  plan_.narrow = cal_.narrow;
+  plan_.narrow_shift = cal_.narrow_shift;
+  plan_.narrow_product_shift = cal_.narrow_product_shift;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    const std::uint8_t k = plan_.narrow_shift[r];
+    plan_.narrow_half[r] = k > 0 ? std::int64_t{1} << (k - 1) : 0;  // RoundShift's half
+  }
+  for (std::size_t r = 0; r < kAxes && plan_.narrow; ++r) {
+    std::uint64_t sum = 0;
+    for (std::size_t j = 0; j < p; ++j) {
+      // |q'| ≤ 2^31 − 1 (NarrowRow): q' + 2^31 fits 32 bits.
+      plan_.quad_u[j][r] = static_cast<std::uint64_t>(
+          RoundShift(plan_.quad[j][r], plan_.narrow_product_shift[r]) + kHalf32);
+      sum += plan_.quad_u[j][r];
+    }
+    plan_.quad_k[r] = (sum << 31) - (std::uint64_t{p} << 62);  // modulo 2^64
+  }
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    if ((cal_.invalid_axes & (1u << r)) != 0) continue;  // a zero row
+    // The bias with the counts' origin moved to zero (Σ coef_c·counts_c = Σ coef_c·x̃_c + this).
+    plan_.bias[r] = cal_.bias[r];
+    for (std::size_t c = 0; c < n; ++c) plan_.bias[r] += cal_.coef[r][c] * cal_.zero[c];
     plan_.round_half[r] = cal_.shift[r] > 0 ? std::int64_t{1} << (cal_.shift[r] - 1) : 0;
   }
 }
 
-void WrenchCore::BuildTareFeatures() {
-  const std::size_t n = cal_.channel_count;
-  tare_f_ = {};
-  if (!tare_active_) return;
-  for (std::size_t c = 0; c < n; ++c) tare_f_[c] = tare_counts_[c];
-  for (std::size_t j = n; j < plan_.features; ++j) tare_f_[j] = tare_extra_[plan_.source[j]];
+void WrenchCore::Effective(std::int32_t dt_mdegc, Columns& eff,
+                           std::array<std::int64_t, kAxes>& k) const {
+  // K = bias + Σ_c coef_c·zero_c + coef_ΔT·ΔT and eff_c = coef_c + d_c with d_c =
+  // round(C_c·ΔT / 2^h_c), multiplied by x̃_c = counts_c − zero_c: C_c·x̃_c·ΔT/2^h rounded once
+  // per temperature. The loader proved |C_c·ΔT| + half < 2^63 and the sums' bound
+  // (EvaluationFits).
+  const std::int64_t dt = dt_mdegc;
+  for (std::size_t r = 0; r < kAxes; ++r) k[r] = plan_.bias[r] + plan_.temp_coef[r] * dt;
+  for (std::size_t c = 0; c < plan_.channels; ++c) {
+    const std::uint8_t h = plan_.drift_shift[c];
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      const std::int64_t d = (plan_.drift[c][r] * dt + plan_.drift_half[c]) >> h;
+      eff[c][r] = plan_.coef[c][r] + d;
+    }
+  }
 }
 
-void WrenchCore::ComputeTareOffset() {
-  // Untared y = Σ coef·x + Σ coef·f + bias; tared y = Σ coef·(x − tare) + Σ coef·(f − f_tare).
-  // Their difference is Σ coef·tare + Σ coef·f_tare + bias, a constant of the tare. The loader
-  // bounds every such sum below 2^62 for counts between the rails (tare counts are averages of
-  // such counts), so the accumulation cannot overflow. Rounding each separately: ≤ 1 LSB apart.
-  const std::size_t n = cal_.channel_count;
-  bool clipped = false;
-  for (std::size_t r = 0; r < kAxes; ++r) {
-    if ((cal_.invalid_axes & (1u << r)) != 0) {
-      tare_offset_[r] = 0;  // an axis the calibration does not determine stays 0
-      continue;
+void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
+  std::array<std::int64_t, kAxes> k{};
+  Effective(dt_mdegc, eff_, k);
+  // With the final rounding half: Apply shifts acc right without adding it (the loader's bound
+  // covers every partial sum plus the half, in any order).
+  for (std::size_t r = 0; r < kAxes; ++r) konst_[r] = k[r] - tare_acc_[r] + plan_.round_half[r];
+  eff_dt_ = dt_mdegc;
+  if (!plan_.narrow) return;
+  const std::size_t n = plan_.channels;
+  std::array<std::uint64_t, kAxes> sum{};
+  for (std::size_t c = 0; c < n; ++c) {
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      // |eff'| ≤ 2^31 − 1 at every ΔT in range (NarrowRow): eff' + 2^31 fits 32 bits.
+      const std::int64_t e = (eff_[c][r] + plan_.narrow_half[r]) >> plan_.narrow_shift[r];
+      eff_u_[c][r] = static_cast<std::uint64_t>(e + kHalf32);
+      sum[r] += eff_u_[c][r];
     }
-    std::int64_t acc = cal_.bias[r];
-    for (std::size_t c = 0; c < n; ++c) acc += cal_.coef[r][c] * tare_counts_[c];
-    for (std::size_t k = 0; k < cal_.extra_count; ++k) acc += cal_.coef[r][n + k] * tare_extra_[k];
-    tare_offset_[r] = SatToI32(RoundShift(acc, cal_.shift[r]), &clipped);
+  }
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    narrow_k_[r] = (sum[r] << 31) - (std::uint64_t{n} << 62);  // modulo 2^64
+  }
+}
+
+// Inlined into Apply: the per-sample sum over the counts and the second-order features.
+[[gnu::always_inline]] inline void WrenchCore::Accumulate(
+    const std::array<std::int32_t, kMaxChannels>& v, const Columns& eff,
+    std::array<std::int64_t, kAxes>& acc) const {
+  const std::size_t n = plan_.channels;
+  std::array<std::int64_t, kMaxChannels> x{};  // x̃ = counts − zero
+  for (std::size_t c = 0; c < n; ++c) {
+    const std::int64_t xc = std::int64_t{v[c]} - plan_.zero[c];
+    x[c] = xc;
+    for (std::size_t r = 0; r < kAxes; ++r) acc[r] += eff[c][r] * xc;
+  }
+  // The loader checked |x̃_a·x̃_b| + half ≤ 2^63 − 1 (kFeatureOverflow) and sized the shifts.
+  for (std::size_t j = 0; j < plan_.products; ++j) {
+    const std::int64_t p = (x[plan_.a[j]] * x[plan_.b[j]] + plan_.half[j]) >> plan_.shift[j];
+    const auto& q = plan_.quad[j];
+    for (std::size_t r = 0; r < kAxes; ++r) acc[r] += q[r] * p;
+  }
+}
+
+// Inlined into Apply: the narrow form of Accumulate (see Plan::narrow): one 64-bit sum of
+// unsigned 32-bit products per axis for the counts and one for the second-order features.
+[[gnu::always_inline]] inline void WrenchCore::AccumulateNarrow(
+    const std::array<std::int32_t, kMaxChannels>& counts, std::array<std::int64_t, kAxes>& acc,
+    bool& clamped) const {
+  const std::size_t n = plan_.channels;
+  // x̃ = counts − zero, |x̃| < 2^31 (NarrowRow); only [0, n) is written and read.
+  std::array<std::int64_t, kMaxChannels> x;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+  std::array<std::uint64_t, 2> xsum{};       // Σ x'_u: counts, products
+#ifdef __SSE2__
+  // Every lane is stored from the vector sums below.
+  // NOLINTNEXTLINE(cppcoreguidelines-pro-type-member-init)
+  std::array<std::array<std::uint64_t, kAxes>, 2> sum;
+  // pmuludq multiplies the low 32 bits of each 64-bit lane: two axes per instruction.
+  __m128i s[2][3] = {};  // NOLINT: vector registers (std::array drops their attributes)
+  auto madd = [&](std::size_t g, const std::array<std::uint64_t, kAxes>& col, std::uint64_t xu) {
+    const __m128i xb = _mm_set1_epi64x(static_cast<long long>(xu));
+    const auto* p = reinterpret_cast<const __m128i*>(col.data());  // NOLINT
+    s[g][0] = _mm_add_epi64(s[g][0], _mm_mul_epu32(_mm_loadu_si128(p), xb));
+    s[g][1] = _mm_add_epi64(s[g][1], _mm_mul_epu32(_mm_loadu_si128(p + 1), xb));
+    s[g][2] = _mm_add_epi64(s[g][2], _mm_mul_epu32(_mm_loadu_si128(p + 2), xb));
+  };
+#else
+  std::array<std::array<std::uint64_t, kAxes>, 2> sum{};
+  auto madd = [&](std::size_t g, const std::array<std::uint64_t, kAxes>& col, std::uint64_t xu) {
+    for (std::size_t r = 0; r < kAxes; ++r) sum[g][r] += col[r] * xu;
+  };
+#endif
+  for (std::size_t c = 0; c < n; ++c) {
+    const std::int32_t v = std::min(std::max(counts[c], cal_.min_counts), cal_.max_counts);
+    clamped |= v != counts[c];
+    x[c] = std::int64_t{v} - plan_.zero[c];
+    const auto xu = static_cast<std::uint64_t>(x[c] + kHalf32);
+    xsum[0] += xu;
+    madd(0, eff_u_[c], xu);
+  }
+  for (std::size_t j = 0; j < plan_.products; ++j) {
+    const std::int64_t p = (x[plan_.a[j]] * x[plan_.b[j]] + plan_.half[j]) >> plan_.shift[j];
+    const auto pu = static_cast<std::uint64_t>(p + kHalf32);  // |p| < 2^31 (NarrowRow)
+    xsum[1] += pu;
+    madd(1, plan_.quad_u[j], pu);
+  }
+#ifdef __SSE2__
+  for (std::size_t g = 0; g < 2; ++g) {
+    auto* out = reinterpret_cast<__m128i*>(sum[g].data());  // NOLINT
+    for (std::size_t i = 0; i < 3; ++i) _mm_storeu_si128(out + i, s[g][i]);
+  }
+#endif
+  // The true Σ c'·x of each group (|·|·2^k bounded by the loader), scaled back by 2^k, modulo
+  // 2^64.
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    const std::uint64_t lin = sum[0][r] - narrow_k_[r] - (xsum[0] << 31);
+    acc[r] += static_cast<std::int64_t>(lin << plan_.narrow_shift[r]);
+  }
+  if (plan_.products == 0) return;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    const std::uint64_t quad = sum[1][r] - plan_.quad_k[r] - (xsum[1] << 31);
+    acc[r] += static_cast<std::int64_t>(quad << plan_.narrow_product_shift[r]);
   }
 }
 
@@ -135,76 +275,41 @@ std::int32_t WrenchCore::DeltaT(std::int32_t temperature_mdegc, bool has_tempera
   return t - cal_.temp_ref_mdegc;
 }
 
-void WrenchCore::ExtraFeatures(const std::array<std::int32_t, kMaxChannels>& counts,
-                               std::int32_t dt_mdegc,
-                               std::array<std::int64_t, kMaxFeatures - kMaxChannels>& f) const {
-  for (std::size_t k = 0; k < cal_.extra_count; ++k) {
-    const FixedFeature& e = cal_.extra[k];
-    switch (e.kind) {
-      case FeatureKind::kTemperature:
-        f[k] = dt_mdegc;
-        break;
-      case FeatureKind::kProduct: {
-        // The loader proved |x̃_a·x̃_b| + 2^(shift−1) ≤ 2^63 − 1 (RawProductFits): no overflow.
-        const std::int64_t xa = static_cast<std::int64_t>(counts[e.a]) - cal_.zero[e.a];
-        const std::int64_t xb = static_cast<std::int64_t>(counts[e.b]) - cal_.zero[e.b];
-        f[k] = RoundShift(xa * xb, e.shift);
-        break;
-      }
-      case FeatureKind::kTempProduct: {
-        const std::int64_t xa = static_cast<std::int64_t>(counts[e.a]) - cal_.zero[e.a];
-        f[k] = RoundShift(xa * dt_mdegc, e.shift);
-        break;
-      }
-    }
-  }
-}
-
 void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts,
                        std::int32_t temperature_mdegc, bool has_temperature, WrenchLsb& y,
                        bool* saturated, bool* temp_range) const {
-  // The hot path: y_r = round((Σ_j coef[r][j]·f_j + bias_r) / 2^shift_r), features in plan order.
-  // Without a tare tare_f_ is zero; with one the bias drops out (see FixedCalibration).
+  // The hot path: y_r = round((K_r + Σ_c eff[c][r]·v_c + Σ_j quad[j][r]·p_j) / 2^shift_r) with
+  // K and eff cached per ΔT (temperature changes slowly); with a tare K holds minus the tare's
+  // sum, so the bias drops out (see FixedCalibration).
   const std::size_t n = plan_.channels;
-  const std::size_t nf = plan_.features;
-  // Features; only [0, nf) are written and read (zeroing all 53 each sample would cost time).
-  std::array<std::int64_t, kMaxFeatures> f;  // NOLINT(cppcoreguidelines-pro-type-member-init)
-  std::array<std::int64_t, kMaxChannels> x_zero{};  // clamped counts − zero (products' origin)
   bool clamped = false;
-  for (std::size_t c = 0; c < n; ++c) {
-    const std::int32_t raw = counts[c];
-    const std::int32_t v =
-        raw > cal_.max_counts ? cal_.max_counts : (raw < cal_.min_counts ? cal_.min_counts : raw);
-    clamped |= v != raw;
-    f[c] = v - tare_f_[c];
-    x_zero[c] = static_cast<std::int64_t>(v) - cal_.zero[c];
+  if (plan_.temperature) {
+    const std::int32_t dt = DeltaT(temperature_mdegc, has_temperature, temp_range);
+    if (dt != eff_dt_) UpdateEffective(dt);
   }
-  if (nf > n) {
-    const std::int64_t dt = DeltaT(temperature_mdegc, has_temperature, temp_range);
-    std::size_t j = n;
-    for (; j < plan_.temp_end; ++j) f[j] = dt;
-    // The loader checked |x̃_a·x̃_b| + half ≤ 2^63 − 1 (kFeatureOverflow) and sized the shifts.
-    for (; j < plan_.product_end; ++j) {
-      f[j] = (x_zero[plan_.a[j]] * x_zero[plan_.b[j]] + plan_.half[j]) >> plan_.shift[j];
+  // The loader guarantees every partial sum stays within ±2^62 (EvaluationFits).
+  std::array<std::int64_t, kAxes> acc = konst_;
+  if (plan_.narrow) {
+    AccumulateNarrow(counts, acc, clamped);  // clamps the counts itself
+  } else {
+    std::array<std::int32_t, kMaxChannels> v{};
+    for (std::size_t c = 0; c < n; ++c) {
+      v[c] = std::min(std::max(counts[c], cal_.min_counts), cal_.max_counts);  // branch-free
+      clamped |= v[c] != counts[c];
     }
-    for (; j < nf; ++j) f[j] = (x_zero[plan_.a[j]] * dt + plan_.half[j]) >> plan_.shift[j];
-    for (j = n; j < nf; ++j) f[j] -= tare_f_[j];
+    Accumulate(v, eff_, acc);
   }
-  // The loader guarantees Σ|coef|·|f| + |bias| ≤ 2^61 for every input between the rails, so no
-  // partial sum in any order can overflow.
-  std::array<std::int64_t, kAxes> acc{};
-  for (std::size_t r = 0; r < kAxes; ++r) acc[r] = tare_active_ ? 0 : cal_.bias[r];
-  for (std::size_t j = 0; j < nf; ++j) {
-    const std::int64_t fj = f[j];
-    const auto& col = plan_.coef[j];
-    for (std::size_t r = 0; r < kAxes; ++r) acc[r] += col[r] * fj;
-  }
+  // konst_ holds the rounding half. An axis the calibration does not determine has all-zero rows
+  // in the plan: it reads 0.
+  std::array<std::int64_t, kAxes> q{};
+  std::uint64_t outside = 0;  // bits ≥ 32 set when some q is outside int32
   for (std::size_t r = 0; r < kAxes; ++r) {
-    if ((cal_.invalid_axes & (1u << r)) != 0) {
-      y[r] = 0;  // not determined by the calibration: never a value (status bit 10)
-      continue;
-    }
-    y[r] = SatToI32((acc[r] + plan_.round_half[r]) >> cal_.shift[r], &clamped);
+    q[r] = acc[r] >> cal_.shift[r];
+    outside |= static_cast<std::uint64_t>(q[r]) + (std::uint64_t{1} << 31);
+    y[r] = static_cast<std::int32_t>(q[r]);
+  }
+  if ((outside >> 32) != 0) {
+    for (std::size_t r = 0; r < kAxes; ++r) y[r] = SatToI32(q[r], &clamped);
   }
   if (clamped) *saturated = true;
 }
@@ -258,15 +363,28 @@ void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts,
   tare_temp_sum_ += dt_mdegc;
   if (--tare_remaining_ == 0) {
     for (std::size_t c = 0; c < n; ++c) {
-      tare_counts_[c] = static_cast<std::int32_t>(RoundDiv(tare_sum_[c], tare_total_));
+      const std::int64_t avg = RoundDiv(tare_sum_[c], tare_total_);  // between the rails
+      tare_counts_[c] = static_cast<std::int32_t>(
+          avg > cal_.max_counts ? cal_.max_counts
+                                : (avg < cal_.min_counts ? cal_.min_counts : avg));
     }
-    if (cal_.extra_count > 0) {
-      ExtraFeatures(tare_counts_, static_cast<std::int32_t>(RoundDiv(tare_temp_sum_, tare_total_)),
-                    tare_extra_);
+    // The untared sum at the tare, as Apply computes it (bounded by the loader like any sample):
+    // tared sums subtract it, so every feature is taken relative to its value at the tare.
+    const auto dt_tare = static_cast<std::int32_t>(RoundDiv(tare_temp_sum_, tare_total_));
+    Columns eff{};
+    std::array<std::int64_t, kAxes> acc{};
+    Effective(dt_tare, eff, acc);
+    Accumulate(tare_counts_, eff, acc);
+    bool clipped = false;
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      tare_acc_[r] = acc[r];
+      // The wrench of the tare itself (untared − tared): an undetermined axis stays 0.
+      tare_offset_[r] = (cal_.invalid_axes & (1u << r)) != 0
+                            ? 0
+                            : SatToI32(RoundShift(acc[r], cal_.shift[r]), &clipped);
     }
     tare_active_ = true;
-    BuildTareFeatures();
-    ComputeTareOffset();
+    UpdateEffective(eff_dt_);
     ResetFilter();
   }
 }

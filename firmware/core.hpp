@@ -97,40 +97,73 @@ class WrenchCore {
   void ResetFilter();
   /// Rearranges the installed calibration for the per-sample path (see Plan).
   void BuildPlan();
-  /// Copies the tare's features into plan order (tare_f_): zero without an active tare.
-  void BuildTareFeatures();
-  /// Fills the derived features (ΔT, products) for clamped counts and a clamped temperature.
-  void ExtraFeatures(const std::array<std::int32_t, kMaxChannels>& counts, std::int32_t dt_mdegc,
-                     std::array<std::int64_t, kMaxFeatures - kMaxChannels>& f) const;
-  /// The wrench of the tare itself (what the tare removes), LSB: computed once per tare.
-  void ComputeTareOffset();
   /// Clamps a temperature into the compensated range and returns ΔT, m°C.
   std::int32_t DeltaT(std::int32_t temperature_mdegc, bool has_temperature,
                       bool* out_of_range) const;
 
-  /// The calibration as the per-sample path reads it: features ordered channels, ΔT, products,
-  /// ΔT products (each group one branch-free loop), coefficients feature-major so one feature
-  /// multiplies into all six accumulators, rounding halves precomputed. The same integers as
-  /// cal_ (a permutation of the terms of each row's sum), so the loader's proof holds unchanged.
+  /// Row-interleaved coefficients: [channel or product][axis].
+  using Columns = std::array<std::array<std::int64_t, kAxes>, kMaxChannels>;
+  /// The counts coefficients and the constant of every row at ΔT (m°C), untared.
+  void Effective(std::int32_t dt_mdegc, Columns& eff, std::array<std::int64_t, kAxes>& k) const;
+  /// Recomputes the cache (eff_, konst_) for ΔT; a constant of the temperature and the tare.
+  void UpdateEffective(std::int32_t dt_mdegc) const;
+  /// Σ eff·v + Σ q·p (+ acc's start value) for clamped counts v: the per-sample sum.
+  void Accumulate(const std::array<std::int32_t, kMaxChannels>& v, const Columns& eff,
+                  std::array<std::int64_t, kAxes>& acc) const;
+  /// The same sum in the narrow form (FixedCalibration::narrow) with the cached eff_u_, for raw
+  /// counts that it clamps to the rails (clamped set when it had to).
+  void AccumulateNarrow(const std::array<std::int32_t, kMaxChannels>& counts,
+                        std::array<std::int64_t, kAxes>& acc, bool& clamped) const;
+  /// Unsigned 32-bit lanes (c + 2^31 in uint64): [channel or product][axis].
+  using ColumnsU = std::array<std::array<std::uint64_t, kAxes>, kMaxChannels>;
+
+  /// The calibration as the per-sample path reads it. Temperature terms never reach the
+  /// per-sample sum: the ΔT feature, and each ΔT product C_c·round(x̃_c·ΔT/2^h) evaluated as
+  /// round(C_c·ΔT/2^h)·x̃_c, fold into counts coefficients and a constant that are recomputed
+  /// only when ΔT changes (Effective). What remains per sample is one product per counts
+  /// coefficient and per second-order coefficient, feature-major so each feature multiplies into
+  /// six independent accumulators. LoadCalibration proves the bounds of this evaluation order
+  /// (EvaluationFits in fixed_calibration.cpp) and its rounding error.
   struct Plan {
-    std::uint8_t channels = 0;                   ///< bridge features (0 for an invalid calibration)
-    std::uint8_t features = 0;                   ///< channels + extra features
-    std::uint8_t temp_end = 0;                   ///< ΔT features are [channel_count, temp_end)
-    std::uint8_t product_end = 0;                ///< products are [temp_end, product_end)
-    std::array<std::uint8_t, kMaxFeatures> a{};  ///< first bridge of a derived feature
-    std::array<std::uint8_t, kMaxFeatures> b{};  ///< second bridge of a product
-    std::array<std::uint8_t, kMaxFeatures> shift{};   ///< right shift of a derived feature
-    std::array<std::int64_t, kMaxFeatures> half{};    ///< its rounding half (0 for shift 0)
-    std::array<std::uint8_t, kMaxFeatures> source{};  ///< index in cal_.extra of a plan feature
-    std::array<std::int64_t, kAxes> round_half{};     ///< rounding half of each row's shift
-    std::array<std::array<std::int64_t, kAxes>, kMaxFeatures> coef{};  ///< coef[feature][axis]
+    std::uint8_t channels = 0;  ///< bridges (0 for an invalid calibration)
+    std::uint8_t products = 0;  ///< second-order features
+    bool temperature = false;   ///< ΔT terms present (the cache depends on ΔT)
+    std::array<std::int32_t, kMaxChannels> zero{};  ///< x̃ origin, counts
+    Columns coef{};                                 ///< counts coefficients at ΔT = 0
+    Columns drift{};                                ///< C_c per axis (0 without a ΔT product)
+    std::array<std::uint8_t, kMaxChannels> drift_shift{};
+    std::array<std::int64_t, kMaxChannels> drift_half{};
+    std::array<std::int64_t, kAxes> temp_coef{};  ///< coefficient of ΔT
+    std::array<std::int64_t, kAxes> bias{};
+    std::array<std::uint8_t, kMaxProducts> a{};  ///< bridges of a product
+    std::array<std::uint8_t, kMaxProducts> b{};
+    std::array<std::uint8_t, kMaxProducts> shift{};                    ///< its rounded shift
+    std::array<std::int64_t, kMaxProducts> half{};                     ///< its rounding half
+    std::array<std::array<std::int64_t, kAxes>, kMaxProducts> quad{};  ///< [product][axis]
+    std::array<std::int64_t, kAxes> round_half{};                      ///< of each row's shift
+    /// Narrow form: with c' = round(c / 2^k_r) (|c'| < 2^31) and x' = x + 2^31, c'·x' summed in
+    /// uint64 (SSE2 pmuludq lanes; a scalar loop elsewhere), then Σ c·x = Σ c'_u·x'_u − 2^31·Σ c'_u
+    /// − 2^31·Σ x'_u + F·2^62 modulo 2^64, exact because the loader bounds the true sum.
+    bool narrow = false;
+    std::array<std::uint8_t, kAxes> narrow_shift{};          ///< k of the counts
+    std::array<std::uint8_t, kAxes> narrow_product_shift{};  ///< k of the products
+    std::array<std::int64_t, kAxes> narrow_half{};           ///< rounding half of the counts' k
+    std::array<std::array<std::uint64_t, kAxes>, kMaxProducts> quad_u{};  ///< q' + 2^31
+    std::array<std::uint64_t, kAxes> quad_k{};  ///< 2^31·Σ_j q'_u − P·2^62 mod 2^64
   };
 
   FixedCalibration cal_{};
   Plan plan_{};
-  /// Every feature's value at the active tare, plan order (channels: the tare counts); all zero
-  /// without an active tare, so the per-sample path subtracts it unconditionally.
-  std::array<std::int64_t, kMaxFeatures> tare_f_{};
+  // A cache of values derived from the calibration, the tare and the last ΔT (mutable: Apply is
+  // const; WrenchCore is single-threaded by contract).
+  mutable Columns eff_{};                            ///< counts coefficients at eff_dt_
+  mutable std::array<std::int64_t, kAxes> konst_{};  ///< constant at eff_dt_ minus tare_acc_
+  mutable std::int32_t eff_dt_ = 0;
+  mutable ColumnsU eff_u_{};                             ///< narrow eff_ (+ 2^31)
+  mutable std::array<std::uint64_t, kAxes> narrow_k_{};  ///< 2^31·Σ c'_u − N·2^62 mod 2^64
+  /// The untared sum at the tare (zero without one): subtracting it makes every feature relative
+  /// to its value at the tare and drops the bias.
+  std::array<std::int64_t, kAxes> tare_acc_{};
   CoreLimits limits_{};
   std::array<std::int32_t, kMaxChannels> tare_counts_{};
   bool tare_active_ = false;
@@ -138,9 +171,7 @@ class WrenchCore {
   std::uint16_t tare_total_ = 0;
   std::array<std::int64_t, kMaxChannels> tare_sum_{};
   std::int64_t tare_temp_sum_ = 0;  ///< Σ clamped ΔT over the tare, m°C
-  std::array<std::int64_t, kMaxFeatures - kMaxChannels>
-      tare_extra_{};         ///< derived features at the tare
-  WrenchLsb tare_offset_{};  ///< untared − tared wrench while a tare is active, LSB
+  WrenchLsb tare_offset_{};         ///< untared − tared wrench while a tare is active, LSB
 
   std::uint16_t filter_length_ = 1;
   std::uint16_t filter_fill_ = 0;

@@ -71,6 +71,122 @@ bool RawProductFits(std::uint64_t amax, std::uint64_t bmax, std::uint8_t shift) 
   return p <= static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
 }
 
+std::uint64_t Mag(std::int64_t v) {
+  return v < 0 ? 0 - static_cast<std::uint64_t>(v) : static_cast<std::uint64_t>(v);
+}
+
+/// D_c = ⌊|C_c|·ΔT_max / 2^h_c⌋ + 1 ≥ |round(C_c·ΔT / 2^h_c)| for the ΔT product of channel c
+/// (0 without one); false when C_c·ΔT plus its rounding half could leave int64.
+bool DriftBounds(const std::array<std::int64_t, kMaxFeatures>& coef, const FixedCalibration& fixed,
+                 std::uint64_t dt_max, std::array<std::uint64_t, kMaxChannels>* drift) {
+  *drift = {};
+  for (std::size_t k = 0; k < fixed.extra_count; ++k) {
+    const FixedFeature& e = fixed.extra[k];
+    if (e.kind != FeatureKind::kTempProduct) continue;
+    const std::uint64_t q = Mag(coef[fixed.channel_count + k]);
+    std::uint64_t p = 0;
+    if (__builtin_mul_overflow(q, dt_max, &p) || !RawProductFits(q, dt_max, e.shift)) return false;
+    (*drift)[e.a] = (p >> e.shift) + 1;
+  }
+  return true;
+}
+
+/// One-sided bound on a product feature round(x̃_a·x̃_b / 2^shift) (RawProductFits holds).
+std::uint64_t ProductBound(const FixedFeature& e,
+                           const std::array<std::uint64_t, kMaxChannels>& xmax) {
+  return ((xmax[e.a] * xmax[e.b]) >> e.shift) + 1;
+}
+
+/// Exact check with integers for the core's evaluation order (WrenchCore): per sample it sums
+///   K + Σ_c (coef_c + d_c(ΔT))·x̃_c + Σ_k q_k·p_k,  K = bias + Σ_c coef_c·zero_c + coef_ΔT·ΔT,
+/// x̃_c = counts_c − zero_c, with d_c(ΔT) = round(C_c·ΔT / 2^h_c) (C_c, h_c: the ΔT-product
+/// feature of channel c) computed once per temperature, and subtracts the same sum at the tare.
+/// Proves |C_c|·ΔT_max + 2^(h_c−1) ≤ 2^63 − 1 (no wrap in d_c) and U = |bias| + |coef_ΔT|·ΔT_max
+/// + Σ_c (|coef_c|·|zero_c| + (|coef_c| + D_c + slack)·x_max,c) + Σ_k (|q_k| + slack_p)·p_max,k
+/// ≤ 2^61 (DriftBounds): every partial sum of one evaluation is then ≤ U, a tared one (minus the
+/// tare's sum) ≤ 2U ≤ 2^62, and adding the final rounding half (≤ 2^61) stays below 2^63. `slack`
+/// covers the narrow form's coefficients (NarrowRow), off by up to 2^(k−1) from these.
+bool EvaluationFits(const std::array<std::int64_t, kMaxFeatures>& coef, std::int64_t bias,
+                    const FixedCalibration& fixed,
+                    const std::array<std::uint64_t, kMaxChannels>& xmax, std::uint64_t dt_max,
+                    std::uint64_t slack, std::uint64_t product_slack) {
+  const std::size_t n = fixed.channel_count;
+  std::array<std::uint64_t, kMaxChannels> drift{};
+  if (!DriftBounds(coef, fixed, dt_max, &drift)) return false;
+  std::uint64_t total = Mag(bias);
+  bool ok = true;
+  auto add = [&](std::uint64_t a, std::uint64_t a2, std::uint64_t b) {
+    std::uint64_t t = 0;
+    ok = ok && !__builtin_add_overflow(a, a2, &a) && !__builtin_mul_overflow(a, b, &t) &&
+         !__builtin_add_overflow(total, t, &total);
+  };
+  for (std::size_t k = 0; k < fixed.extra_count; ++k) {
+    const FixedFeature& e = fixed.extra[k];
+    if (e.kind == FeatureKind::kTemperature) add(Mag(coef[n + k]), 0, dt_max);
+    if (e.kind == FeatureKind::kProduct) {
+      add(Mag(coef[n + k]), product_slack, ProductBound(e, xmax));
+    }
+  }
+  for (std::size_t c = 0; c < n; ++c) {
+    std::uint64_t e = 0;
+    ok = ok && !__builtin_add_overflow(Mag(coef[c]), drift[c], &e);
+    add(e, slack, xmax[c]);
+    add(Mag(coef[c]), 0, Mag(fixed.zero[c]));
+  }
+  return ok && total <= kAccLimit;
+}
+
+/// Smallest k with (c_max + 2^(k−1)) / 2^k ≤ 2^31 − 1: the narrow coefficients' right shift.
+std::uint8_t NarrowShift(std::uint64_t cmax) {
+  constexpr std::uint64_t kMax32 = (std::uint64_t{1} << 31) - 1;
+  std::uint8_t k = 0;
+  while (k < 62 && ((cmax + (k > 0 ? std::uint64_t{1} << (k - 1) : 0)) >> k) > kMax32) ++k;
+  return k;
+}
+
+/// The narrow form of row r (the core's SIMD path): 32-bit coefficients round(c / 2^k) for the
+/// counts (k = k_c; at every ΔT: |coef_c + d_c| ≤ |coef_c| + D_c) and for the products (k = k_p),
+/// features x̃ and p within ±(2^31 − 1), multiplied into two 64-bit sums that the core scales
+/// back by 2^k_c and 2^k_p. Picks the smallest shifts; refuses (false) when a feature is too
+/// wide, the bound with slack 2^(k−1) fails, or the added error Σ 2^(k−1)/2^s · f_max (twice with
+/// a tare) exceeds kNarrowErrorLsb.
+constexpr double kNarrowErrorLsb = 1.0 / 16.0;
+bool NarrowRow(const FixedCalibration& fixed, std::size_t r,
+               const std::array<std::uint64_t, kMaxChannels>& xmax, std::uint64_t dt_max,
+               std::array<std::uint8_t, 2>* k_out, double* err_out) {
+  constexpr std::uint64_t kMax32 = (std::uint64_t{1} << 31) - 1;
+  const std::size_t n = fixed.channel_count;
+  std::array<std::uint64_t, kMaxChannels> drift{};
+  if (!DriftBounds(fixed.coef[r], fixed, dt_max, &drift)) return false;
+  std::array<std::uint64_t, 2> cmax{};  // largest coefficient magnitude: counts, products
+  std::array<double, 2> fsum{};         // Σ of the features' one-sided bounds
+  for (std::size_t c = 0; c < n; ++c) {
+    if (xmax[c] > kMax32) return false;
+    cmax[0] = std::max(cmax[0], Mag(fixed.coef[r][c]) + drift[c]);
+    fsum[0] += static_cast<double>(xmax[c]);
+  }
+  for (std::size_t k = 0; k < fixed.extra_count; ++k) {
+    const FixedFeature& e = fixed.extra[k];
+    if (e.kind != FeatureKind::kProduct) continue;
+    if (ProductBound(e, xmax) > kMax32) return false;
+    cmax[1] = std::max(cmax[1], Mag(fixed.coef[r][n + k]));
+    fsum[1] += static_cast<double>(ProductBound(e, xmax));
+  }
+  std::array<std::uint64_t, 2> slack{};
+  double err = 0.0;
+  for (std::size_t g = 0; g < 2; ++g) {
+    (*k_out)[g] = NarrowShift(cmax[g]);
+    slack[g] = (*k_out)[g] > 0 ? std::uint64_t{1} << ((*k_out)[g] - 1) : 0;
+    err += 2.0 * std::ldexp(static_cast<double>(slack[g]), -fixed.shift[r]) * fsum[g];
+  }
+  if (err > kNarrowErrorLsb ||
+      !EvaluationFits(fixed.coef[r], fixed.bias[r], fixed, xmax, dt_max, slack[0], slack[1])) {
+    return false;
+  }
+  *err_out = err;
+  return true;
+}
+
 /// Stage 1: refuses a calibration the fixed-point form cannot represent (counts, NaN, terms).
 [[nodiscard]] LoadStatus CheckInputs(const FloatCalibration& cal, const hal::AdcInfo& adc) {
   const std::size_t n = cal.channel_count;
@@ -256,7 +372,8 @@ RealRow MakeRealRow(const FloatCalibration& cal, const FixedCalibration& fixed,
       // ΔT_true = ΔT_int + dt_ref_err: the product's share is linear in x̃_c.
       m[c] += g * dt_ref_err;
       row.bias_lsb -= g * dt_ref_err * fixed.zero[c];
-      if (f.shift > 0) row.rounding_error += 2.0 * 0.5 * std::fabs(m[lay.temp_product_index[c]]);
+      // The core rounds C·ΔT / 2^shift (once per temperature), not this feature: QuantiseRow adds
+      // that rounding once s is known.
     }
     m[lay.temp_index] = a_r;
     row.bias_lsb += a_r * dt_ref_err;
@@ -292,7 +409,11 @@ RealRow MakeRealRow(const FloatCalibration& cal, const FixedCalibration& fixed,
     const double scale = std::ldexp(1.0, s);
     for (std::size_t k = 0; k < lay.count; ++k) fixed->coef[r][k] = std::llround(row.m[k] * scale);
     fixed->bias[r] = std::llround(row.bias_lsb * scale);
-    if (AccumulatorFits(fixed->coef[r], fixed->bias[r], lay.fmax_int, lay.count)) break;
+    if (AccumulatorFits(fixed->coef[r], fixed->bias[r], lay.fmax_int, lay.count) &&
+        EvaluationFits(fixed->coef[r], fixed->bias[r], *fixed, lay.xmax_int,
+                       static_cast<std::uint64_t>(lay.dt_max), 0, 0)) {
+      break;
+    }
     if (s == 0) {
       rep->failing_axis = static_cast<std::uint8_t>(r);
       return LoadStatus::kOutputOverflow;
@@ -301,8 +422,21 @@ RealRow MakeRealRow(const FloatCalibration& cal, const FixedCalibration& fixed,
   fixed->shift[r] = static_cast<std::uint8_t>(s);
   const double scale = std::ldexp(1.0, s);
   // Each coefficient and the bias are off by at most half a unit of 2^-s; derived features
-  // are rounded to ±1/2 (twice with a tare); the final rounding adds half an LSB.
-  const double err = 0.5 / scale * fsum + row.rounding_error + 0.5;
+  // are rounded to ±1/2 (twice with a tare); the core's per-temperature drift coefficients
+  // round(C_c·ΔT / 2^h) are off by ≤ 1/2 unit of 2^-s per count of |counts − zero| ≤ x_max,c
+  // (twice with a tare); the final rounding adds half an LSB.
+  double drift_rounding = 0.0;
+  for (std::size_t k = 0; k < fixed->extra_count; ++k) {
+    const FixedFeature& e = fixed->extra[k];
+    if (e.kind == FeatureKind::kTempProduct && e.shift > 0) {
+      drift_rounding += 2.0 * 0.5 * lay.xmax[e.a] / scale;
+    }
+  }
+  if (real_bound + row.rounding_error + drift_rounding + 1.0 > kInt32Max) {
+    rep->failing_axis = static_cast<std::uint8_t>(r);
+    return LoadStatus::kOutputOverflow;
+  }
+  const double err = 0.5 / scale * fsum + row.rounding_error + drift_rounding + 0.5;
   rep->worst_case_error_lsb[r] = err;
   rep->worst_case_error_si[r] = err * lsb;
   return LoadStatus::kOk;
@@ -332,6 +466,27 @@ LoadStatus LoadCalibration(const FloatCalibration& cal, const hal::AdcInfo& adc,
   for (std::size_t r = 0; r < kAxes; ++r) {
     const LoadStatus row = QuantiseRow(MakeRealRow(cal, fixed, lay, r), lay, r, &fixed, &rep);
     if (row != LoadStatus::kOk) return finish(row);
+  }
+  // The narrow (32-bit coefficient) form when every row has one within kNarrowErrorLsb that
+  // keeps the row's bound within 1 LSB.
+  std::array<double, kAxes> narrow_err{};
+  fixed.narrow = true;
+  for (std::size_t r = 0; r < kAxes && fixed.narrow; ++r) {
+    std::array<std::uint8_t, 2> k{};
+    fixed.narrow = NarrowRow(fixed, r, lay.xmax_int, static_cast<std::uint64_t>(lay.dt_max), &k,
+                             &narrow_err[r]) &&
+                   rep.worst_case_error_lsb[r] + narrow_err[r] <= 1.0;  // never past 1 LSB
+    fixed.narrow_shift[r] = k[0];
+    fixed.narrow_product_shift[r] = k[1];
+  }
+  if (!fixed.narrow) {
+    fixed.narrow_shift = {};
+    fixed.narrow_product_shift = {};
+  } else {
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      rep.worst_case_error_lsb[r] += narrow_err[r];
+      rep.worst_case_error_si[r] = rep.worst_case_error_lsb[r] * AxisLsb(r);
+    }
   }
   fixed.invalid_axes = static_cast<std::uint8_t>(cal.invalid_axes & ((1u << kAxes) - 1));
   fixed.valid = true;

@@ -71,8 +71,11 @@ struct FixedFeature {
 /// channels, then `extra_count` features (ΔT, products) described by `extra`. For row r:
 ///   y_r[LSB] = round((Σ_k coef[r][k] · f_k + bias[r]) / 2^shift[r])
 /// with 64-bit accumulation (with an active tare every f is taken relative to its value at the
-/// tare and the bias is dropped). The loader proves that no partial sum can leave ±2^62 and that
-/// the result fits in int32 for every input between the ADC rails.
+/// tare and the bias is dropped). The core evaluates it in another order (temperature terms folded
+/// into per-ΔT counts coefficients, C_c·round(x̃_c·ΔT/2^h) taken as round(C_c·ΔT/2^h)·x̃_c,
+/// optionally the narrow form below); the loader proves for that order that no partial sum can
+/// leave ±2^62, that the result fits in int32 for every input between the ADC rails, and bounds
+/// its error (LoadReport).
 struct FixedCalibration {
   std::uint8_t channel_count = 0;
   std::array<std::array<std::int64_t, kMaxFeatures>, kAxes> coef{};  ///< LSB/feature · 2^shift
@@ -88,6 +91,13 @@ struct FixedCalibration {
   std::int32_t temp_min_mdegc = 0;                ///< compensated range, m°C
   std::int32_t temp_max_mdegc = 0;
   std::uint8_t invalid_axes = 0;  ///< bit r: axis r not calibrated (see FloatCalibration)
+  /// The core may sum 32-bit coefficients round(coef / 2^narrow_shift[r]) (counts, at every ΔT)
+  /// and round(coef / 2^narrow_product_shift[r]) (products) times 32-bit features into 64-bit
+  /// sums scaled back by those powers of two (SIMD-friendly): proven by the loader with the same
+  /// bounds, its extra rounding included in the reported error.
+  bool narrow = false;
+  std::array<std::uint8_t, kAxes> narrow_shift{};
+  std::array<std::uint8_t, kAxes> narrow_product_shift{};
   bool valid = false;
 };
 

@@ -317,3 +317,100 @@ TEST(FixedTerms, MissingTemperatureUsesTheReferenceAndRaisesTheStatusBit) {
 
 }  // namespace
 }  // namespace ftstack
+
+namespace ftstack {
+namespace {
+
+/// The cached per-ΔT coefficients at the edges of the compensated range and beyond (clamped),
+/// the temperature jumping between them so every sample recomputes the cache, untared and with a
+/// tare taken at the opposite edge: within the proven bound of the long-double reference.
+TEST(FixedTerms, TemperatureRangeEdgesWithinProvenBound) {
+  std::mt19937_64 rng(11);
+  for (int trial = 0; trial < 60; ++trial) {
+    const Case c = RandomCase(rng, trial % 2 == 0, true);
+    fw::FixedCalibration fixed{};
+    fw::LoadReport rep{};
+    ASSERT_EQ(fw::LoadCalibration(c.cal, c.adc, &fixed, &rep), fw::LoadStatus::kOk);
+    const std::int32_t lo = fixed.temp_min_mdegc;
+    const std::int32_t hi = fixed.temp_max_mdegc;
+    const std::array<std::int32_t, 7> temps = {lo,     hi,    lo + 1, hi - 1, fixed.temp_ref_mdegc,
+                                               lo - 1, hi + 1};
+    fw::WrenchCore core;
+    core.SetLimits(fw::CoreLimits{0, 0});
+    core.SetCalibration(fixed);
+    ExpectWithinBound(
+        c, core, rep, rng, 70, [&](int s) { return temps[static_cast<std::size_t>(s) % 7]; }, {},
+        nullptr);
+    // Tare at one edge, evaluate at the other (and everywhere in between).
+    hal::AdcSample s{};
+    s.channel_count = c.cal.channel_count;
+    s.counts = RandomCounts(rng, c.adc);
+    for (auto& v : s.counts) v /= 2;  // a tare sample away from the rails
+    s.has_temperature = true;
+    s.temperature_mdegc = trial % 3 == 0 ? lo : hi;
+    ASSERT_TRUE(core.RequestTare(1));
+    fw::CoreOutput out{};
+    core.Process(s, false, out);
+    ASSERT_TRUE(core.tare_active());
+    const auto ref_tare = Reference(c, s.counts, s.temperature_mdegc);
+    ExpectWithinBound(
+        c, core, rep, rng, 70, [&](int k) { return temps[static_cast<std::size_t>(k) % 7]; },
+        ref_tare, nullptr);
+  }
+}
+
+/// The narrow form (32-bit coefficients, SIMD sums) and the 64-bit form of the same calibration
+/// both stay within the loader's bound and differ by at most one LSB; a calibration whose narrow
+/// rounding would cost more than 1/16 LSB (outputs near the int32 range) is left in the 64-bit
+/// form and stays within 1 LSB of the reference.
+TEST(FixedTerms, NarrowFormOnlyWhereProvenAndWithinTheBound) {
+  std::mt19937_64 rng(12);
+  std::uniform_int_distribution<std::int32_t> temp(-15000, 65000);
+  for (int trial = 0; trial < 80; ++trial) {
+    const Case c = RandomCase(rng, trial % 2 == 0, trial % 4 < 2);
+    fw::FixedCalibration fixed{};
+    fw::LoadReport rep{};
+    ASSERT_EQ(fw::LoadCalibration(c.cal, c.adc, &fixed, &rep), fw::LoadStatus::kOk);
+    ASSERT_TRUE(fixed.narrow) << "trial " << trial;  // realistic calibrations run narrow
+    fw::FixedCalibration wide = fixed;
+    wide.narrow = false;
+    fw::WrenchCore narrow_core;
+    fw::WrenchCore wide_core;
+    narrow_core.SetCalibration(fixed);
+    wide_core.SetCalibration(wide);
+    for (int s = 0; s < 100; ++s) {
+      const auto x = RandomCounts(rng, c.adc);
+      const std::int32_t t = temp(rng);
+      fw::WrenchLsb yn{};
+      fw::WrenchLsb yw{};
+      bool sat = false;
+      bool range = false;
+      narrow_core.Apply(x, t, true, yn, &sat, &range);
+      wide_core.Apply(x, t, true, yw, &sat, &range);
+      const auto ref = Reference(c, x, t);
+      for (std::size_t r = 0; r < 6; ++r) {
+        ASSERT_LE(std::fabs(yn[r] - ref[r]), rep.worst_case_error_lsb[r]);
+        ASSERT_LE(std::fabs(yw[r] - ref[r]), rep.worst_case_error_lsb[r]);
+        ASSERT_LE(std::abs(yn[r] - yw[r]), 1);
+      }
+    }
+  }
+  // A linear calibration scaled up until the outputs reach ~2^28 LSB: the narrow rounding would
+  // exceed 1/16 LSB, the 64-bit form keeps its ~0.5 LSB bound.
+  Case big = RandomCase(rng, false, false);
+  for (std::size_t r = 0; r < 6; ++r) {
+    for (auto& v : big.cal.matrix[r]) v *= 20.0;
+  }
+  fw::FixedCalibration fixed{};
+  fw::LoadReport rep{};
+  ASSERT_EQ(fw::LoadCalibration(big.cal, big.adc, &fixed, &rep), fw::LoadStatus::kOk);
+  EXPECT_FALSE(fixed.narrow);
+  fw::WrenchCore core;
+  core.SetCalibration(fixed);
+  for (std::size_t r = 0; r < 6; ++r) EXPECT_LE(rep.worst_case_error_lsb[r], 1.0);
+  ExpectWithinBound(
+      big, core, rep, rng, 300, [&](int) { return temp(rng); }, {}, nullptr);
+}
+
+}  // namespace
+}  // namespace ftstack
