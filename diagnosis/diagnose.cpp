@@ -70,12 +70,9 @@ Scored ScoreFit(const Context& cx, const Mat& target, EffectFit fit, double base
   return s;
 }
 
-void Locate(Report& r) {
+/// Channels: slow (window means of m rows) and fast (mean square) χ² tests.
+void LocateChannels(Report& r, int m, int blocks) {
   const Context& cx = r.cx;
-  const auto& d = *cx.data;
-  const auto m = static_cast<int>(std::llround(cx.block_s * cx.rate_hz));
-  const int blocks = std::max(1, cx.n / std::max(1, m));
-  // Channels: slow (window means) and fast (mean square) χ² tests.
   for (int c = 0; c < cx.nc; ++c) {
     double xlow = 0.0;
     double xfull = 0.0;
@@ -92,7 +89,12 @@ void Locate(Report& r) {
     const double zfull = ChiSquareZ(xfull, cx.n);
     if (zlow > 6.0 || (zfull > 6.0 && xfull / cx.n > 1.05)) r.mismatch_channels.push_back(c);
   }
-  if (r.mismatch_channels.empty()) return;
+}
+
+/// Time windows: blocks of m rows flagged on the mismatching channels, merged.
+void LocateWindows(Report& r, int m, int blocks) {
+  const Context& cx = r.cx;
+  const auto& d = *cx.data;
   const auto nf = static_cast<double>(r.mismatch_channels.size());
   std::vector<bool> flag(static_cast<std::size_t>(blocks), false);
   for (int b = 0; b < blocks; ++b) {
@@ -139,7 +141,13 @@ void Locate(Report& r) {
     r.windows.emplace_back(d.t_s[static_cast<std::size_t>(i0)],
                            d.t_s[static_cast<std::size_t>(i1)]);
   }
-  // Load region: where in the load space the excess over noise lives.
+}
+
+/// Load region: where in the load space the excess over noise lives.
+void LocateLoadRegion(Report& r) {
+  const Context& cx = r.cx;
+  const auto& d = *cx.data;
+  const auto nf = static_cast<double>(r.mismatch_channels.size());
   if (!d.has_wrench()) return;
   std::vector<double> excess(static_cast<std::size_t>(cx.n));
   double mean_ex = 0.0;
@@ -206,6 +214,16 @@ void Locate(Report& r) {
   }
 }
 
+void Locate(Report& r) {
+  const Context& cx = r.cx;
+  const auto m = static_cast<int>(std::llround(cx.block_s * cx.rate_hz));
+  const int blocks = std::max(1, cx.n / std::max(1, m));
+  LocateChannels(r, m, blocks);
+  if (r.mismatch_channels.empty()) return;
+  LocateWindows(r, m, blocks);
+  LocateLoadRegion(r);
+}
+
 void Progress(const DiagnoseOptions& o, double f, const char* what) {
   if (o.progress != nullptr) o.progress(f, what, o.progress_user);
 }
@@ -246,6 +264,194 @@ std::vector<Confounding> DropUnidentifiedPartner(const Context& cx, double z_cla
   return partner_conf;
 }
 
+/// The residual spectrum for the report, whitened and averaged over channels.
+void ReportSpectrum(Report& r) {
+  const Context& cx = r.cx;
+  const auto rows = static_cast<std::size_t>(cx.n);
+  const std::size_t seg = WelchSegment(rows);
+  if (rows >= seg && seg >= 32) {
+    for (int c = 0; c < cx.nc; ++c) {
+      const Spectrum s = Welch(cx.resid.col(c).data(), rows, cx.rate_hz, seg);
+      if (r.spectrum_power.empty()) {
+        r.spectrum_hz = s.freq_hz;
+        r.spectrum_power.assign(s.power.size(), 0.0);
+      }
+      for (std::size_t k = 0; k < s.power.size(); ++k)
+        r.spectrum_power[k] += s.power[k] * cx.weight(c) / cx.nc;
+    }
+  }
+}
+
+/// Every effect fitted alone to the residual and scored on the held-out rows, best first; each is
+/// listed among the report's candidates.
+std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const Sums& base) {
+  const Context& cx = r.cx;
+  std::vector<Scored> singles;
+  const auto& effects = Effects();
+  for (std::size_t j = 0; j < effects.size(); ++j) {
+    Progress(options, 0.05 + 0.6 * static_cast<double>(j) / static_cast<double>(effects.size()),
+             effects[j].name);
+    auto fit = effects[j].fit(cx, cx.resid);
+    if (!fit) continue;
+    singles.push_back(ScoreFit(cx, cx.resid, std::move(*fit), base.hold_sse, options.z_claim));
+  }
+  std::sort(singles.begin(), singles.end(),
+            [](const Scored& a, const Scored& b) { return a.score > b.score; });
+  for (const auto& s : singles) {
+    CandidateScore c;
+    c.name = s.fit.name;
+    c.variant = s.fit.variant;
+    c.n_params = s.fit.n_params;
+    c.hold_rms_after = HoldRms(cx, cx.resid, &s.fit.pred);
+    c.z = s.z;
+    c.score = s.score;
+    c.eligible = s.eligible;
+    r.candidates.push_back(c);
+  }
+  return singles;
+}
+
+/// Pairs: the best single with each other eligible candidate among the top six, backfitted.
+/// True with *pa, *pb set when a pair beats every model so far.
+bool BestPair(const Context& cx, const DiagnoseOptions& options, const std::vector<Scored>& singles,
+              const Sums& base, EffectFit* pa, EffectFit* pb) {
+  const Scored& best = singles.front();
+  const auto& effects = Effects();
+  bool have_pair = false;
+  double pair_score = best.score;
+  // Forward selection from each of the three best eligible singles: every other effect is fitted
+  // to what the first leaves, the two best partners are kept, the first is refitted to what the
+  // partner leaves, and the pair is scored on the held-out rows.
+  std::vector<std::size_t> top;
+  for (std::size_t j = 0; j < singles.size() && top.size() < 3; ++j) {
+    if (singles[j].eligible && singles[j].score >= 0.5 * best.score) top.push_back(j);
+  }
+  std::size_t step = 0;
+  for (std::size_t x : top) {
+    const Scored& first = singles[x];
+    const Mat rest = cx.resid - first.fit.pred;
+    const Sums rest_base = Score(cx, rest, nullptr);
+    std::vector<std::pair<double, std::string>> partners;
+    for (const auto& spec : effects) {
+      Progress(options,
+               0.65 + 0.33 * static_cast<double>(step++) / static_cast<double>(3 * effects.size()),
+               "pairs");
+      if (first.fit.name == spec.name) continue;
+      // Partners come from the effects that were claimable on their own.
+      const bool claimable = std::any_of(singles.begin(), singles.end(), [&](const Scored& q) {
+        return q.eligible && q.fit.name == spec.name;
+      });
+      if (!claimable) continue;
+      auto fb = spec.fit(cx, rest);
+      if (!fb) continue;
+      const Scored sb = ScoreFit(cx, rest, std::move(*fb), rest_base.hold_sse, options.z_claim);
+      if (sb.eligible) partners.emplace_back(sb.score, spec.name);
+    }
+    std::sort(partners.rbegin(), partners.rend());
+    for (std::size_t y = 0; y < std::min<std::size_t>(3, partners.size()); ++y) {
+      const EffectSpec* sa = FindEffect(first.fit.name);
+      const EffectSpec* sb = FindEffect(partners[y].second);
+      EffectFit fa;
+      EffectFit fb;
+      if (!FitPair(cx, cx.resid, *sa, *sb, first.fit, &fa, &fb)) continue;
+      Mat both = fa.pred + fb.pred;
+      const Sums s = Score(cx, cx.resid, &both);
+      const double delta = base.hold_sse - s.hold_sse;
+      const double score = delta - (fa.n_params + fb.n_params) * HoldPenalty(cx);
+      // The partner must add a significant held-out improvement over the first alone …
+      const Mat diff = both - first.fit.pred;
+      double dd = 0.0;
+      for (int c = 0; c < cx.nc; ++c) {
+        for (int i = 0; i < cx.n; ++i) {
+          if (!cx.train[static_cast<std::size_t>(i)]) dd += diff(i, c) * diff(i, c) * cx.weight(c);
+        }
+      }
+      const double inc = first.hold_sse - s.hold_sse;
+      const double z_inc = dd > 0 ? inc / (2.0 * std::sqrt(dd)) : 0.0;
+      // … and carry a visible share (≥ 0.2 %) of the excess over noise, not a misfit's remainder.
+      const double excess = base.hold_sse - static_cast<double>(cx.n_hold) * cx.nc;
+      if (std::getenv("FTDIAG_DEBUG") != nullptr) {
+        std::fprintf(
+            stderr, "pair %s + %s: score %.1f (best single %.1f) z_inc %.1f inc %.1f excess %.1f\n",
+            fa.name.c_str(), fb.name.c_str(), score, best.score, z_inc, inc, excess);
+      }
+      // … and the pair must beat every model so far on the penalised held-out score.
+      if (z_inc > options.z_claim && inc > 0.002 * excess && score > pair_score) {
+        pair_score = score;
+        *pa = std::move(fa);
+        *pb = std::move(fb);
+        have_pair = true;
+      }
+    }
+  }
+  return have_pair;
+}
+
+/// Thermal refinement of the claimed effects (see the comment inside).
+void RefineThermal(const Context& cx, std::vector<EffectFit>* claimed_effects) {
+  std::vector<EffectFit>& claimed = *claimed_effects;
+  // A claimed thermal_zero_drift is refined with a thermometer lag τ ≥ 0 where the lag pays for
+  // itself (effects/thermal_lag.cpp); ranked without it, so a lag never wins a claim on its own.
+  // A claimed zero_drift is replaced by a lagged thermal_zero_drift where temperature exists and
+  // the lagged model scores better on the held-out rows (penalised like the ranking): a gauge
+  // temperature lagging the thermometer otherwise loses to a drift in time.
+  const double log_hold = std::log(std::max<double>(2.0, static_cast<double>(cx.n_hold)));
+  for (std::size_t k = 0; k < claimed.size(); ++k) {
+    const bool thermal = claimed[k].name == "thermal_zero_drift";
+    if (!thermal && !(claimed[k].name == "zero_drift" && !cx.dtemp.empty())) continue;
+    Mat rest = cx.resid;
+    for (std::size_t o = 0; o < claimed.size(); ++o) {
+      if (o != k) rest -= claimed[o].pred;
+    }
+    auto lagged = FitThermalZeroLagged(cx, rest);
+    if (!lagged || !lagged->params.contains("lag_s")) continue;
+    const double cost_old =
+        Score(cx, rest, &claimed[k].pred).hold_sse + claimed[k].n_params * log_hold;
+    const double cost_new = Score(cx, rest, &lagged->pred).hold_sse + lagged->n_params * log_hold;
+    if (thermal || cost_new < cost_old) claimed[k] = std::move(*lagged);
+  }
+}
+
+/// The claimed effects into the report, each with its held-out gain and confounders; the verdict.
+void RecordClaims(Report& r, const DiagnoseOptions& options, std::vector<EffectFit>& claimed,
+                  const std::vector<Confounding>& partner_conf) {
+  const Context& cx = r.cx;
+  Mat cum = Mat::Zero(cx.n, cx.nc);
+  for (std::size_t k = 0; k < claimed.size(); ++k) {
+    EffectFit& f = claimed[k];
+    ClaimedEffect ce;
+    ce.hold_rms_before = HoldRms(cx, cx.resid, &cum);
+    cum += f.pred;
+    ce.hold_rms_after = HoldRms(cx, cx.resid, &cum);
+    ce.rms_after = ChannelRms(cx.resid - cum);
+    // Each effect is tested against its confounders on what the other claimed effects leave.
+    const Confounding conf =
+        k == 1 && !partner_conf.empty()
+            ? partner_conf.front()
+            : CheckConfounders(cx, cx.resid - (cum - f.pred), f, options.z_claim);
+    ce.confounded_with = conf.with;
+    ce.confounding = conf.words;
+    ce.fit = std::move(f);
+    r.effects.push_back(std::move(ce));
+  }
+  r.model = cum;
+  r.verdict = "undetermined";
+  for (const auto& e : r.effects) {
+    if (e.confounded_with.empty()) {
+      r.verdict = e.fit.name;
+      break;
+    }
+  }
+  // The noise reported is re-estimated once the claimed effects are removed (broadband effects
+  // such as ringing or skew on fast edges lift the spectrum's median a little).
+  for (int c = 0; c < cx.nc; ++c) {
+    const Vec rest = cx.resid.col(c) - cum.col(c);
+    r.noise_rms(c) = std::min(r.noise_rms(c),
+                              RobustNoise(rest.data(), static_cast<std::size_t>(cx.n), cx.rate_hz));
+  }
+  r.hold_rms_after = HoldRms(cx, cx.resid, &cum);
+}
+
 }  // namespace
 
 Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
@@ -281,123 +487,16 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
   r.hold_rms_after = r.hold_rms_before;
   r.model = Mat::Zero(cx.n, cx.nc);
   Locate(r);
-  // Spectrum for the report.
-  const std::size_t seg = WelchSegment(data.rows());
-  if (data.rows() >= seg && seg >= 32) {
-    for (int c = 0; c < cx.nc; ++c) {
-      const Spectrum s = Welch(cx.resid.col(c).data(), data.rows(), cx.rate_hz, seg);
-      if (r.spectrum_power.empty()) {
-        r.spectrum_hz = s.freq_hz;
-        r.spectrum_power.assign(s.power.size(), 0.0);
-      }
-      for (std::size_t k = 0; k < s.power.size(); ++k)
-        r.spectrum_power[k] += s.power[k] * cx.weight(c) / cx.nc;
-    }
-  }
+  ReportSpectrum(r);
   const Sums base = Score(cx, cx.resid, nullptr);
-  // Singles.
-  std::vector<Scored> singles;
-  const auto& effects = Effects();
-  for (std::size_t j = 0; j < effects.size(); ++j) {
-    Progress(options, 0.05 + 0.6 * static_cast<double>(j) / static_cast<double>(effects.size()),
-             effects[j].name);
-    auto fit = effects[j].fit(cx, cx.resid);
-    if (!fit) continue;
-    singles.push_back(ScoreFit(cx, cx.resid, std::move(*fit), base.hold_sse, options.z_claim));
-  }
-  std::sort(singles.begin(), singles.end(),
-            [](const Scored& a, const Scored& b) { return a.score > b.score; });
-  for (const auto& s : singles) {
-    CandidateScore c;
-    c.name = s.fit.name;
-    c.variant = s.fit.variant;
-    c.n_params = s.fit.n_params;
-    c.hold_rms_after = HoldRms(cx, cx.resid, &s.fit.pred);
-    c.z = s.z;
-    c.score = s.score;
-    c.eligible = s.eligible;
-    r.candidates.push_back(c);
-  }
+  const std::vector<Scored> singles = FitSingles(r, options, base);
   if (singles.empty() || !singles.front().eligible) {
     Progress(options, 1.0, "done");
     return r;
   }
-  const Scored& best = singles.front();
-  // Pairs: the best single with each other eligible candidate among the top six, backfitted.
-  bool have_pair = false;
   EffectFit pa;
   EffectFit pb;
-  double pair_score = best.score;
-  if (options.pairs) {
-    // Forward selection from each of the three best eligible singles: every other effect is fitted
-    // to what the first leaves, the two best partners are kept, the first is refitted to what the
-    // partner leaves, and the pair is scored on the held-out rows.
-    std::vector<std::size_t> top;
-    for (std::size_t j = 0; j < singles.size() && top.size() < 3; ++j) {
-      if (singles[j].eligible && singles[j].score >= 0.5 * best.score) top.push_back(j);
-    }
-    std::size_t step = 0;
-    for (std::size_t x : top) {
-      const Scored& first = singles[x];
-      const Mat rest = cx.resid - first.fit.pred;
-      const Sums rest_base = Score(cx, rest, nullptr);
-      std::vector<std::pair<double, std::string>> partners;
-      for (const auto& spec : effects) {
-        Progress(
-            options,
-            0.65 + 0.33 * static_cast<double>(step++) / static_cast<double>(3 * effects.size()),
-            "pairs");
-        if (first.fit.name == spec.name) continue;
-        // Partners come from the effects that were claimable on their own.
-        const bool claimable = std::any_of(singles.begin(), singles.end(), [&](const Scored& q) {
-          return q.eligible && q.fit.name == spec.name;
-        });
-        if (!claimable) continue;
-        auto fb = spec.fit(cx, rest);
-        if (!fb) continue;
-        const Scored sb = ScoreFit(cx, rest, std::move(*fb), rest_base.hold_sse, options.z_claim);
-        if (sb.eligible) partners.emplace_back(sb.score, spec.name);
-      }
-      std::sort(partners.rbegin(), partners.rend());
-      for (std::size_t y = 0; y < std::min<std::size_t>(3, partners.size()); ++y) {
-        const EffectSpec* sa = FindEffect(first.fit.name);
-        const EffectSpec* sb = FindEffect(partners[y].second);
-        EffectFit fa;
-        EffectFit fb;
-        if (!FitPair(cx, cx.resid, *sa, *sb, first.fit, &fa, &fb)) continue;
-        Mat both = fa.pred + fb.pred;
-        const Sums s = Score(cx, cx.resid, &both);
-        const double delta = base.hold_sse - s.hold_sse;
-        const double score = delta - (fa.n_params + fb.n_params) * HoldPenalty(cx);
-        // The partner must add a significant held-out improvement over the first alone …
-        const Mat diff = both - first.fit.pred;
-        double dd = 0.0;
-        for (int c = 0; c < cx.nc; ++c) {
-          for (int i = 0; i < cx.n; ++i) {
-            if (!cx.train[static_cast<std::size_t>(i)])
-              dd += diff(i, c) * diff(i, c) * cx.weight(c);
-          }
-        }
-        const double inc = first.hold_sse - s.hold_sse;
-        const double z_inc = dd > 0 ? inc / (2.0 * std::sqrt(dd)) : 0.0;
-        // … and carry a visible share (≥ 0.2 %) of the excess over noise, not a misfit's remainder.
-        const double excess = base.hold_sse - static_cast<double>(cx.n_hold) * cx.nc;
-        if (std::getenv("FTDIAG_DEBUG") != nullptr) {
-          std::fprintf(
-              stderr,
-              "pair %s + %s: score %.1f (best single %.1f) z_inc %.1f inc %.1f excess %.1f\n",
-              fa.name.c_str(), fb.name.c_str(), score, best.score, z_inc, inc, excess);
-        }
-        // … and the pair must beat every model so far on the penalised held-out score.
-        if (z_inc > options.z_claim && inc > 0.002 * excess && score > pair_score) {
-          pair_score = score;
-          pa = std::move(fa);
-          pb = std::move(fb);
-          have_pair = true;
-        }
-      }
-    }
-  }
+  const bool have_pair = options.pairs && BestPair(cx, options, singles, base, &pa, &pb);
   std::vector<EffectFit> claimed;
   if (have_pair) {
     // Stronger first: the one whose removal from the pair costs more on held-out rows.
@@ -407,64 +506,12 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
     claimed.push_back(std::move(pa));
     claimed.push_back(std::move(pb));
   } else {
-    claimed.push_back(best.fit);
+    claimed.push_back(singles.front().fit);
   }
-  // A claimed thermal_zero_drift is refined with a thermometer lag τ ≥ 0 where the lag pays for
-  // itself (effects/thermal_lag.cpp); ranked without it, so a lag never wins a claim on its own.
-  // A claimed zero_drift is replaced by a lagged thermal_zero_drift where temperature exists and
-  // the lagged model scores better on the held-out rows (penalised like the ranking): a gauge
-  // temperature lagging the thermometer otherwise loses to a drift in time.
-  const double log_hold = std::log(std::max<double>(2.0, static_cast<double>(cx.n_hold)));
-  for (std::size_t k = 0; k < claimed.size(); ++k) {
-    const bool thermal = claimed[k].name == "thermal_zero_drift";
-    if (!thermal && !(claimed[k].name == "zero_drift" && !cx.dtemp.empty())) continue;
-    Mat rest = cx.resid;
-    for (std::size_t o = 0; o < claimed.size(); ++o) {
-      if (o != k) rest -= claimed[o].pred;
-    }
-    auto lagged = FitThermalZeroLagged(cx, rest);
-    if (!lagged || !lagged->params.contains("lag_s")) continue;
-    const double cost_old =
-        Score(cx, rest, &claimed[k].pred).hold_sse + claimed[k].n_params * log_hold;
-    const double cost_new = Score(cx, rest, &lagged->pred).hold_sse + lagged->n_params * log_hold;
-    if (thermal || cost_new < cost_old) claimed[k] = std::move(*lagged);
-  }
+  RefineThermal(cx, &claimed);
   const std::vector<Confounding> partner_conf =
       DropUnidentifiedPartner(cx, options.z_claim, &claimed, &r.dropped);
-  Mat cum = Mat::Zero(cx.n, cx.nc);
-  for (std::size_t k = 0; k < claimed.size(); ++k) {
-    EffectFit& f = claimed[k];
-    ClaimedEffect ce;
-    ce.hold_rms_before = HoldRms(cx, cx.resid, &cum);
-    cum += f.pred;
-    ce.hold_rms_after = HoldRms(cx, cx.resid, &cum);
-    ce.rms_after = ChannelRms(cx.resid - cum);
-    // Each effect is tested against its confounders on what the other claimed effects leave.
-    const Confounding conf =
-        k == 1 && !partner_conf.empty()
-            ? partner_conf.front()
-            : CheckConfounders(cx, cx.resid - (cum - f.pred), f, options.z_claim);
-    ce.confounded_with = conf.with;
-    ce.confounding = conf.words;
-    ce.fit = std::move(f);
-    r.effects.push_back(std::move(ce));
-  }
-  r.model = cum;
-  r.verdict = "undetermined";
-  for (const auto& e : r.effects) {
-    if (e.confounded_with.empty()) {
-      r.verdict = e.fit.name;
-      break;
-    }
-  }
-  // The noise reported is re-estimated once the claimed effects are removed (broadband effects
-  // such as ringing or skew on fast edges lift the spectrum's median a little).
-  for (int c = 0; c < cx.nc; ++c) {
-    const Vec rest = cx.resid.col(c) - cum.col(c);
-    r.noise_rms(c) = std::min(r.noise_rms(c),
-                              RobustNoise(rest.data(), static_cast<std::size_t>(cx.n), cx.rate_hz));
-  }
-  r.hold_rms_after = HoldRms(cx, cx.resid, &cum);
+  RecordClaims(r, options, claimed, partner_conf);
   Progress(options, 1.0, "done");
   return r;
 }
