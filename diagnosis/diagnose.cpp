@@ -55,7 +55,13 @@ struct Scored {
   double z = 0.0;
   double score = 0.0;
   bool eligible = false;
+  double hold_rms_after = 0.0;  ///< held-out RMS after removing the prediction
 };
+
+/// Pairs start from at most this many of the best eligible singles (BestPair).
+constexpr std::size_t kPairStarts = 3;
+/// Partners tried with each start (the best by their score on what the start leaves).
+constexpr std::size_t kPairPartners = 3;
 
 Scored ScoreFit(const Context& cx, const Mat& target, EffectFit fit, double base_hold,
                 double z_claim) {
@@ -229,13 +235,18 @@ void Progress(const DiagnoseOptions& o, double f, const char* what) {
 }
 
 /// Backfits two effects, twice: B on target − A (A first fitted alone), then A on target − B.
+/// b0, when given, is B already fitted to target − A0 (the same fit the first step would make).
 bool FitPair(const Context& cx, const Mat& target, const EffectSpec& a, const EffectSpec& b,
-             const EffectFit& a0, EffectFit* fa, EffectFit* fb) {
+             const EffectFit& a0, EffectFit* b0, EffectFit* fa, EffectFit* fb) {
   const EffectFit* first = &a0;
   for (int it = 0; it < 2; ++it) {
-    auto nb = b.fit(cx, target - first->pred);
-    if (!nb) return false;
-    *fb = std::move(*nb);
+    if (it == 0 && b0 != nullptr) {
+      *fb = std::move(*b0);
+    } else {
+      auto nb = b.fit(cx, target - first->pred);
+      if (!nb) return false;
+      *fb = std::move(*nb);
+    }
     auto na = a.fit(cx, target - fb->pred);
     if (!na) return false;
     *fa = std::move(*na);
@@ -294,6 +305,24 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
     auto fit = effects[j].fit(cx, cx.resid);
     if (!fit) continue;
     singles.push_back(ScoreFit(cx, cx.resid, std::move(*fit), base.hold_sse, options.z_claim));
+    Scored& s = singles.back();
+    s.hold_rms_after = HoldRms(cx, cx.resid, &s.fit.pred);
+    // Memory (n × N per prediction): only the kPairStarts best eligible singles are used again
+    // (the claim and the pair starts); every other prediction is released at once.
+    if (!s.eligible) {
+      s.fit.pred = Mat();
+      continue;
+    }
+    std::vector<Scored*> kept;
+    for (auto& q : singles) {
+      if (q.eligible && q.fit.pred.size() > 0) kept.push_back(&q);
+    }
+    if (kept.size() > kPairStarts) {
+      auto lowest =
+          std::min_element(kept.begin(), kept.end(),
+                           [](const Scored* a, const Scored* b) { return a->score < b->score; });
+      (*lowest)->fit.pred = Mat();
+    }
   }
   std::sort(singles.begin(), singles.end(),
             [](const Scored& a, const Scored& b) { return a.score > b.score; });
@@ -302,7 +331,7 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
     c.name = s.fit.name;
     c.variant = s.fit.variant;
     c.n_params = s.fit.n_params;
-    c.hold_rms_after = HoldRms(cx, cx.resid, &s.fit.pred);
+    c.hold_rms_after = s.hold_rms_after;
     c.z = s.z;
     c.score = s.score;
     c.eligible = s.eligible;
@@ -323,8 +352,11 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, const std::vect
   // to what the first leaves, the two best partners are kept, the first is refitted to what the
   // partner leaves, and the pair is scored on the held-out rows.
   std::vector<std::size_t> top;
-  for (std::size_t j = 0; j < singles.size() && top.size() < 3; ++j) {
-    if (singles[j].eligible && singles[j].score >= 0.5 * best.score) top.push_back(j);
+  for (std::size_t j = 0; j < singles.size() && top.size() < kPairStarts; ++j) {
+    if (singles[j].eligible && singles[j].fit.pred.size() > 0 &&
+        singles[j].score >= 0.5 * best.score) {
+      top.push_back(j);
+    }
   }
   std::size_t step = 0;
   for (std::size_t x : top) {
@@ -332,6 +364,9 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, const std::vect
     const Mat rest = cx.resid - first.fit.pred;
     const Sums rest_base = Score(cx, rest, nullptr);
     std::vector<std::pair<double, std::string>> partners;
+    // The fits of the best partners so far, reused as the first step of the backfit (FitPair);
+    // the others are released at once (memory: n × N each).
+    std::vector<std::pair<std::pair<double, std::string>, EffectFit>> partner_fits;
     for (const auto& spec : effects) {
       Progress(options,
                0.65 + 0.33 * static_cast<double>(step++) / static_cast<double>(3 * effects.size()),
@@ -344,26 +379,38 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, const std::vect
       if (!claimable) continue;
       auto fb = spec.fit(cx, rest);
       if (!fb) continue;
-      const Scored sb = ScoreFit(cx, rest, std::move(*fb), rest_base.hold_sse, options.z_claim);
-      if (sb.eligible) partners.emplace_back(sb.score, spec.name);
+      Scored sb = ScoreFit(cx, rest, std::move(*fb), rest_base.hold_sse, options.z_claim);
+      if (!sb.eligible) continue;
+      partners.emplace_back(sb.score, spec.name);
+      partner_fits.emplace_back(partners.back(), std::move(sb.fit));
+      if (partner_fits.size() > kPairPartners) {
+        partner_fits.erase(
+            std::min_element(partner_fits.begin(), partner_fits.end(),
+                             [](const auto& u, const auto& v) { return u.first < v.first; }));
+      }
     }
     std::sort(partners.rbegin(), partners.rend());
-    for (std::size_t y = 0; y < std::min<std::size_t>(3, partners.size()); ++y) {
+    for (std::size_t y = 0; y < std::min<std::size_t>(kPairPartners, partners.size()); ++y) {
       const EffectSpec* sa = FindEffect(first.fit.name);
       const EffectSpec* sb = FindEffect(partners[y].second);
+      EffectFit* b0 = nullptr;
+      for (auto& pf : partner_fits) {
+        if (pf.first == partners[y]) b0 = &pf.second;
+      }
       EffectFit fa;
       EffectFit fb;
-      if (!FitPair(cx, cx.resid, *sa, *sb, first.fit, &fa, &fb)) continue;
+      if (!FitPair(cx, cx.resid, *sa, *sb, first.fit, b0, &fa, &fb)) continue;
       Mat both = fa.pred + fb.pred;
       const Sums s = Score(cx, cx.resid, &both);
       const double delta = base.hold_sse - s.hold_sse;
       const double score = delta - (fa.n_params + fb.n_params) * HoldPenalty(cx);
       // The partner must add a significant held-out improvement over the first alone …
-      const Mat diff = both - first.fit.pred;
       double dd = 0.0;
       for (int c = 0; c < cx.nc; ++c) {
         for (int i = 0; i < cx.n; ++i) {
-          if (!cx.train[static_cast<std::size_t>(i)]) dd += diff(i, c) * diff(i, c) * cx.weight(c);
+          if (cx.train[static_cast<std::size_t>(i)]) continue;
+          const double diff = both(i, c) - first.fit.pred(i, c);
+          dd += diff * diff * cx.weight(c);
         }
       }
       const double inc = first.hold_sse - s.hold_sse;
@@ -468,6 +515,7 @@ Report Diagnose(const DiagData& data, const DiagnoseOptions& options) {
       lower = lower || r.noise_rms(c) < 0.8 * r.cx.sigma(c);
     if (lower) {
       const Eigen::VectorXd sigma = r.noise_rms;
+      r = Report();  // release the first pass (its context and model) before the second
       r = DiagnoseOnce(data, options, &sigma);
     }
   }
@@ -485,12 +533,12 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
   r.rms_before = ChannelRms(cx.resid);
   r.hold_rms_before = HoldRms(cx, cx.resid, nullptr);
   r.hold_rms_after = r.hold_rms_before;
-  r.model = Mat::Zero(cx.n, cx.nc);
   Locate(r);
   ReportSpectrum(r);
   const Sums base = Score(cx, cx.resid, nullptr);
   const std::vector<Scored> singles = FitSingles(r, options, base);
   if (singles.empty() || !singles.front().eligible) {
+    r.model = Mat::Zero(cx.n, cx.nc);  // allocated only now: nothing claimed
     Progress(options, 1.0, "done");
     return r;
   }
@@ -514,68 +562,6 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
   RecordClaims(r, options, claimed, partner_conf);
   Progress(options, 1.0, "done");
   return r;
-}
-
-nlohmann::json ToJson(const Report& r) {
-  auto vec = [](const Vec& v) {
-    auto a = nlohmann::json::array();
-    for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v(i));
-    return a;
-  };
-  nlohmann::json j;
-  j["schema"] = "ftdiag-report/1";
-  j["rate_hz"] = r.rate_hz;
-  j["noise_rms"] = vec(r.noise_rms);
-  j["rms_before"] = vec(r.rms_before);
-  auto windows = nlohmann::json::array();
-  for (const auto& [a, b] : r.windows) windows.push_back({a, b});
-  j["mismatch"] = {{"channels", r.mismatch_channels}, {"windows", windows}};
-  if (!r.load_region.is_null()) j["mismatch"]["load_region"] = r.load_region;
-  if (!r.cx.peak_hz.empty()) {
-    j["mismatch"]["spectral_peaks_hz"] = r.cx.peak_hz;
-  }
-  j["verdict"] = r.verdict;
-  auto effects = nlohmann::json::array();
-  for (const auto& e : r.effects) {
-    nlohmann::json ej;
-    ej["name"] = e.fit.name;
-    ej["channels"] = e.fit.channels;
-    ej["params"] = e.fit.params;
-    ej["uncertainty"] = e.fit.sigma;
-    ej["evidence"] = e.fit.evidence;
-    ej["rms_after"] = vec(e.rms_after);
-    ej["holdout"] = {{"rms_before", e.hold_rms_before}, {"rms_after", e.hold_rms_after}};
-    ej["model"] = e.fit.variant;
-    ej["n_params"] = e.fit.n_params;
-    ej["identifiable"] = e.confounded_with.empty();
-    if (!e.confounded_with.empty()) {
-      ej["confounded_with"] = e.confounded_with;
-      ej["confounding"] = e.confounding;
-    }
-    effects.push_back(ej);
-  }
-  j["effects"] = effects;
-  if (!r.dropped.empty()) j["not_claimed"] = r.dropped;
-  j["holdout"] = {{"rms_before", r.hold_rms_before},
-                  {"rms_after", r.hold_rms_after},
-                  {"rows", r.cx.n_hold},
-                  {"block_s", r.cx.block_s},
-                  {"scheme",
-                   "every third block of block_s held out; fits use the other rows; blocks "
-                   "restart at every segment"},
-                  {"segments", r.cx.segments}};
-  auto cands = nlohmann::json::array();
-  for (const auto& c : r.candidates) {
-    cands.push_back({{"name", c.name},
-                     {"model", c.variant},
-                     {"n_params", c.n_params},
-                     {"holdout_rms_after", c.hold_rms_after},
-                     {"z", c.z},
-                     {"score", c.score},
-                     {"eligible", c.eligible}});
-  }
-  j["candidates"] = cands;
-  return j;
 }
 
 }  // namespace ftstack::diag

@@ -21,8 +21,9 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Mat& target) {
       for (int i = 0; i < cx.n; i += st) {
         const bool tr = cx.train[static_cast<std::size_t>(i)] != 0;
         if (!tr && out == nullptr) continue;
-        const double v = InterpolateAt(d.t_s.data(), s, static_cast<std::size_t>(cx.n),
-                                       d.t_s[static_cast<std::size_t>(i)] - delay, cx.uniform) -
+        const double v = InterpolateNear(d.t_s.data(), s, static_cast<std::size_t>(cx.n),
+                                         d.t_s[static_cast<std::size_t>(i)] - delay, cx.uniform,
+                                         static_cast<std::size_t>(i)) -
                          s[i];
         if (out != nullptr) (*out)(i, c) = v;
         if (tr) acc += (target(i, c) - v) * (target(i, c) - v);
