@@ -73,14 +73,22 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Mat& target) {
 std::optional<EffectFit> FitMains(const Context& cx, const Mat& target) {
   if (cx.peak_hz.empty()) return std::nullopt;
   const auto& d = *cx.data;
+  // cos and sin of the phase once per row for every channel (the same values FitChannels would
+  // otherwise compute per row and channel).
+  std::vector<double> cs(static_cast<std::size_t>(cx.n));
+  std::vector<double> sn(static_cast<std::size_t>(cx.n));
   auto fit_at = [&](double f, Mat* out, ChannelFit* cf) {
     const double w = 2.0 * M_PI * f;
+    for (std::size_t i = 0; i < cs.size(); ++i) {
+      const double ph = w * d.t_s[i];
+      cs[i] = std::cos(ph);
+      sn[i] = std::sin(ph);
+    }
     auto r = FitChannels(
         cx, target, 2,
         [&](int i, int, double* x) {
-          const double ph = w * d.t_s[static_cast<std::size_t>(i)];
-          x[0] = std::cos(ph);
-          x[1] = std::sin(ph);
+          x[0] = cs[static_cast<std::size_t>(i)];
+          x[1] = sn[static_cast<std::size_t>(i)];
         },
         out);
     if (cf != nullptr) *cf = r;
