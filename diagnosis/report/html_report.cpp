@@ -397,6 +397,17 @@ std::string HtmlReport(const DiagData& data, const Report& r) {
            " The verdict does not name it.</p>";
     }
   }
+  // Partners of a pair left unclaimed (JSON "not_claimed": "name: reason"), in words.
+  for (const auto& d : r.dropped) {
+    const std::size_t colon = d.find(": ");
+    const std::string name = colon == std::string::npos ? d : d.substr(0, colon);
+    const std::string why = colon == std::string::npos ? "" : d.substr(colon + 2);
+    h += "<h2>" + Esc(name) + " (not claimed)</h2><p class=\"conf\"><b>Not claimed.</b> " +
+         Esc(name) +
+         " improved the held-out rows beside the claimed effect, but one offset per load hold "
+         "explains that improvement as well, so it is left out of the effects and the verdict. " +
+         Esc(why) + "</p>";
+  }
   h += HtmlChannels(r);
   h += HtmlPlots(data, r);
   h += HtmlCandidates(r);
