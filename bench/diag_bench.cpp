@@ -4,6 +4,7 @@
 #include <cmath>
 #include <random>
 
+#include "bench/diag_jitter_data.hpp"
 #include "diagnosis/diagnose.hpp"
 #include "sim/record.hpp"
 
@@ -44,49 +45,12 @@ void BM_Diagnose60kNone(benchmark::State& state) {
 }
 BENCHMARK(BM_Diagnose60kNone)->Unit(benchmark::kMillisecond)->Iterations(3);
 
-/// 8 bridges, `rows` rows at a nominal 150 Hz, timestamps uniform or jittered by ±30 % of the
-/// period (uniform random); a staircase of random loads seen through a fixed 8 × 6 sensitivity,
-/// the real side adds a first-order creep (τ = 20 s, integrated with the actual dt) and noise.
-diag::DiagData MakeJitterData(int rows, bool jitter) {
-  std::mt19937_64 rng(17);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::normal_distribution<double> g(0.0, 1.0);
-  diag::DiagData d;
-  d.sim_name = "bench";
-  d.real_name = jitter ? "jittered" : "uniform";
-  d.t_s.resize(static_cast<std::size_t>(rows));
-  d.wrench.resize(rows, 6);
-  d.sim_mvv.resize(rows, 8);
-  d.real_mvv.resize(rows, 8);
-  Eigen::MatrixXd s(8, 6);
-  for (int c = 0; c < 8; ++c) {
-    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
-  }
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(6);
-  Eigen::VectorXd creep = Eigen::VectorXd::Zero(8);
-  double t = 0.0;
-  for (int i = 0; i < rows; ++i) {
-    const double dt = (1.0 + (jitter ? 0.3 * u(rng) : 0.0)) / 150.0;
-    t += dt;
-    d.t_s[static_cast<std::size_t>(i)] = t;
-    if (i % 600 == 0) {
-      for (int a = 0; a < 6; ++a) w(a) = 50.0 * u(rng);
-    }
-    const Eigen::VectorXd b = s * w;
-    creep += (0.01 * b - creep) * (1.0 - std::exp(-dt / 20.0));
-    d.wrench.row(i) = w.transpose();
-    d.sim_mvv.row(i) = b.transpose();
-    for (int c = 0; c < 8; ++c) d.real_mvv(i, c) = b(c) + creep(c) + 2e-4 * g(rng);
-  }
-  return d;
-}
-
 // Uniform against ±30 % jittered timestamps, same size, same run (issue 12: ≤ 3 s for 10^5
 // rows × 8 channels, ≤ 20 s for 10^6).
 void BM_DiagnoseClock(benchmark::State& state) {
   const auto rows = static_cast<int>(state.range(0));
   const bool jitter = state.range(1) != 0;
-  const diag::DiagData data = MakeJitterData(rows, jitter);
+  const diag::DiagData data = bench::MakeJitterData(rows, jitter);
   for (auto _ : state) {
     auto r = diag::Diagnose(data);
     benchmark::DoNotOptimize(r.hold_rms_after);

@@ -55,7 +55,13 @@ struct Scored {
   double z = 0.0;
   double score = 0.0;
   bool eligible = false;
+  double hold_rms_after = 0.0;  ///< held-out RMS after removing the prediction
 };
+
+/// Pairs start from at most this many of the best eligible singles (BestPair).
+constexpr std::size_t kPairStarts = 3;
+/// Partners tried with each start (the best by their score on what the start leaves).
+constexpr std::size_t kPairPartners = 3;
 
 Scored ScoreFit(const Context& cx, const Mat& target, EffectFit fit, double base_hold,
                 double z_claim) {
@@ -70,12 +76,9 @@ Scored ScoreFit(const Context& cx, const Mat& target, EffectFit fit, double base
   return s;
 }
 
-void Locate(Report& r) {
+/// Channels: slow (window means of m rows) and fast (mean square) χ² tests.
+void LocateChannels(Report& r, int m, int blocks) {
   const Context& cx = r.cx;
-  const auto& d = *cx.data;
-  const auto m = static_cast<int>(std::llround(cx.block_s * cx.rate_hz));
-  const int blocks = std::max(1, cx.n / std::max(1, m));
-  // Channels: slow (window means) and fast (mean square) χ² tests.
   for (int c = 0; c < cx.nc; ++c) {
     double xlow = 0.0;
     double xfull = 0.0;
@@ -92,7 +95,12 @@ void Locate(Report& r) {
     const double zfull = ChiSquareZ(xfull, cx.n);
     if (zlow > 6.0 || (zfull > 6.0 && xfull / cx.n > 1.05)) r.mismatch_channels.push_back(c);
   }
-  if (r.mismatch_channels.empty()) return;
+}
+
+/// Time windows: blocks of m rows flagged on the mismatching channels, merged.
+void LocateWindows(Report& r, int m, int blocks) {
+  const Context& cx = r.cx;
+  const auto& d = *cx.data;
   const auto nf = static_cast<double>(r.mismatch_channels.size());
   std::vector<bool> flag(static_cast<std::size_t>(blocks), false);
   for (int b = 0; b < blocks; ++b) {
@@ -139,7 +147,13 @@ void Locate(Report& r) {
     r.windows.emplace_back(d.t_s[static_cast<std::size_t>(i0)],
                            d.t_s[static_cast<std::size_t>(i1)]);
   }
-  // Load region: where in the load space the excess over noise lives.
+}
+
+/// Load region: where in the load space the excess over noise lives.
+void LocateLoadRegion(Report& r) {
+  const Context& cx = r.cx;
+  const auto& d = *cx.data;
+  const auto nf = static_cast<double>(r.mismatch_channels.size());
   if (!d.has_wrench()) return;
   std::vector<double> excess(static_cast<std::size_t>(cx.n));
   double mean_ex = 0.0;
@@ -206,18 +220,33 @@ void Locate(Report& r) {
   }
 }
 
+void Locate(Report& r) {
+  const Context& cx = r.cx;
+  const auto m = static_cast<int>(std::llround(cx.block_s * cx.rate_hz));
+  const int blocks = std::max(1, cx.n / std::max(1, m));
+  LocateChannels(r, m, blocks);
+  if (r.mismatch_channels.empty()) return;
+  LocateWindows(r, m, blocks);
+  LocateLoadRegion(r);
+}
+
 void Progress(const DiagnoseOptions& o, double f, const char* what) {
   if (o.progress != nullptr) o.progress(f, what, o.progress_user);
 }
 
 /// Backfits two effects, twice: B on target − A (A first fitted alone), then A on target − B.
+/// b0, when given, is B already fitted to target − A0 (the same fit the first step would make).
 bool FitPair(const Context& cx, const Mat& target, const EffectSpec& a, const EffectSpec& b,
-             const EffectFit& a0, EffectFit* fa, EffectFit* fb) {
+             const EffectFit& a0, EffectFit* b0, EffectFit* fa, EffectFit* fb) {
   const EffectFit* first = &a0;
   for (int it = 0; it < 2; ++it) {
-    auto nb = b.fit(cx, target - first->pred);
-    if (!nb) return false;
-    *fb = std::move(*nb);
+    if (it == 0 && b0 != nullptr) {
+      *fb = std::move(*b0);
+    } else {
+      auto nb = b.fit(cx, target - first->pred);
+      if (!nb) return false;
+      *fb = std::move(*nb);
+    }
     auto na = a.fit(cx, target - fb->pred);
     if (!na) return false;
     *fa = std::move(*na);
@@ -246,46 +275,14 @@ std::vector<Confounding> DropUnidentifiedPartner(const Context& cx, double z_cla
   return partner_conf;
 }
 
-}  // namespace
-
-Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
-                    const Eigen::VectorXd* sigma);
-
-Report Diagnose(const DiagData& data, const DiagnoseOptions& options) {
-  Report r = DiagnoseOnce(data, options, nullptr);
-  // A strong broadband effect (skew on fast edges, ringing) lifts the spectrum's median and so the
-  // first noise estimate; when the claimed model reveals a clearly lower noise, diagnose again
-  // with it so that weaker effects are weighed against the true noise.
-  if (!r.effects.empty()) {
-    bool lower = false;
-    for (int c = 0; c < r.noise_rms.size(); ++c)
-      lower = lower || r.noise_rms(c) < 0.8 * r.cx.sigma(c);
-    if (lower) {
-      const Eigen::VectorXd sigma = r.noise_rms;
-      r = DiagnoseOnce(data, options, &sigma);
-    }
-  }
-  return r;
-}
-
-Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
-                    const Eigen::VectorXd* sigma) {
-  Report r;
-  Progress(options, 0.0, "noise and hold-out split");
-  r.cx = MakeContext(data, options.block_s, sigma);
+/// The residual spectrum for the report, whitened and averaged over channels.
+void ReportSpectrum(Report& r) {
   const Context& cx = r.cx;
-  r.rate_hz = cx.rate_hz;
-  r.noise_rms = cx.sigma;
-  r.rms_before = ChannelRms(cx.resid);
-  r.hold_rms_before = HoldRms(cx, cx.resid, nullptr);
-  r.hold_rms_after = r.hold_rms_before;
-  r.model = Mat::Zero(cx.n, cx.nc);
-  Locate(r);
-  // Spectrum for the report.
-  const std::size_t seg = WelchSegment(data.rows());
-  if (data.rows() >= seg && seg >= 32) {
+  const auto rows = static_cast<std::size_t>(cx.n);
+  const std::size_t seg = WelchSegment(rows);
+  if (rows >= seg && seg >= 32) {
     for (int c = 0; c < cx.nc; ++c) {
-      const Spectrum s = Welch(cx.resid.col(c).data(), data.rows(), cx.rate_hz, seg);
+      const Spectrum s = Welch(cx.resid.col(c).data(), rows, cx.rate_hz, seg);
       if (r.spectrum_power.empty()) {
         r.spectrum_hz = s.freq_hz;
         r.spectrum_power.assign(s.power.size(), 0.0);
@@ -294,8 +291,12 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
         r.spectrum_power[k] += s.power[k] * cx.weight(c) / cx.nc;
     }
   }
-  const Sums base = Score(cx, cx.resid, nullptr);
-  // Singles.
+}
+
+/// Every effect fitted alone to the residual and scored on the held-out rows, best first; each is
+/// listed among the report's candidates.
+std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const Sums& base) {
+  const Context& cx = r.cx;
   std::vector<Scored> singles;
   const auto& effects = Effects();
   for (std::size_t j = 0; j < effects.size(); ++j) {
@@ -304,6 +305,24 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
     auto fit = effects[j].fit(cx, cx.resid);
     if (!fit) continue;
     singles.push_back(ScoreFit(cx, cx.resid, std::move(*fit), base.hold_sse, options.z_claim));
+    Scored& s = singles.back();
+    s.hold_rms_after = HoldRms(cx, cx.resid, &s.fit.pred);
+    // Memory (n × N per prediction): only the kPairStarts best eligible singles are used again
+    // (the claim and the pair starts); every other prediction is released at once.
+    if (!s.eligible) {
+      s.fit.pred = Mat();
+      continue;
+    }
+    std::vector<Scored*> kept;
+    for (auto& q : singles) {
+      if (q.eligible && q.fit.pred.size() > 0) kept.push_back(&q);
+    }
+    if (kept.size() > kPairStarts) {
+      auto lowest =
+          std::min_element(kept.begin(), kept.end(),
+                           [](const Scored* a, const Scored* b) { return a->score < b->score; });
+      (*lowest)->fit.pred = Mat();
+    }
   }
   std::sort(singles.begin(), singles.end(),
             [](const Scored& a, const Scored& b) { return a.score > b.score; });
@@ -312,103 +331,112 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
     c.name = s.fit.name;
     c.variant = s.fit.variant;
     c.n_params = s.fit.n_params;
-    c.hold_rms_after = HoldRms(cx, cx.resid, &s.fit.pred);
+    c.hold_rms_after = s.hold_rms_after;
     c.z = s.z;
     c.score = s.score;
     c.eligible = s.eligible;
     r.candidates.push_back(c);
   }
-  if (singles.empty() || !singles.front().eligible) {
-    Progress(options, 1.0, "done");
-    return r;
-  }
+  return singles;
+}
+
+/// Pairs: the best single with each other eligible candidate among the top six, backfitted.
+/// True with *pa, *pb set when a pair beats every model so far.
+bool BestPair(const Context& cx, const DiagnoseOptions& options, const std::vector<Scored>& singles,
+              const Sums& base, EffectFit* pa, EffectFit* pb) {
   const Scored& best = singles.front();
-  // Pairs: the best single with each other eligible candidate among the top six, backfitted.
+  const auto& effects = Effects();
   bool have_pair = false;
-  EffectFit pa;
-  EffectFit pb;
   double pair_score = best.score;
-  if (options.pairs) {
-    // Forward selection from each of the three best eligible singles: every other effect is fitted
-    // to what the first leaves, the two best partners are kept, the first is refitted to what the
-    // partner leaves, and the pair is scored on the held-out rows.
-    std::vector<std::size_t> top;
-    for (std::size_t j = 0; j < singles.size() && top.size() < 3; ++j) {
-      if (singles[j].eligible && singles[j].score >= 0.5 * best.score) top.push_back(j);
+  // Forward selection from each of the three best eligible singles: every other effect is fitted
+  // to what the first leaves, the two best partners are kept, the first is refitted to what the
+  // partner leaves, and the pair is scored on the held-out rows.
+  std::vector<std::size_t> top;
+  for (std::size_t j = 0; j < singles.size() && top.size() < kPairStarts; ++j) {
+    if (singles[j].eligible && singles[j].fit.pred.size() > 0 &&
+        singles[j].score >= 0.5 * best.score) {
+      top.push_back(j);
     }
-    std::size_t step = 0;
-    for (std::size_t x : top) {
-      const Scored& first = singles[x];
-      const Mat rest = cx.resid - first.fit.pred;
-      const Sums rest_base = Score(cx, rest, nullptr);
-      std::vector<std::pair<double, std::string>> partners;
-      for (const auto& spec : effects) {
-        Progress(
-            options,
-            0.65 + 0.33 * static_cast<double>(step++) / static_cast<double>(3 * effects.size()),
-            "pairs");
-        if (first.fit.name == spec.name) continue;
-        // Partners come from the effects that were claimable on their own.
-        const bool claimable = std::any_of(singles.begin(), singles.end(), [&](const Scored& q) {
-          return q.eligible && q.fit.name == spec.name;
-        });
-        if (!claimable) continue;
-        auto fb = spec.fit(cx, rest);
-        if (!fb) continue;
-        const Scored sb = ScoreFit(cx, rest, std::move(*fb), rest_base.hold_sse, options.z_claim);
-        if (sb.eligible) partners.emplace_back(sb.score, spec.name);
+  }
+  std::size_t step = 0;
+  for (std::size_t x : top) {
+    const Scored& first = singles[x];
+    const Mat rest = cx.resid - first.fit.pred;
+    const Sums rest_base = Score(cx, rest, nullptr);
+    std::vector<std::pair<double, std::string>> partners;
+    // The fits of the best partners so far, reused as the first step of the backfit (FitPair);
+    // the others are released at once (memory: n × N each).
+    std::vector<std::pair<std::pair<double, std::string>, EffectFit>> partner_fits;
+    for (const auto& spec : effects) {
+      Progress(options,
+               0.65 + 0.33 * static_cast<double>(step++) / static_cast<double>(3 * effects.size()),
+               "pairs");
+      if (first.fit.name == spec.name) continue;
+      // Partners come from the effects that were claimable on their own.
+      const bool claimable = std::any_of(singles.begin(), singles.end(), [&](const Scored& q) {
+        return q.eligible && q.fit.name == spec.name;
+      });
+      if (!claimable) continue;
+      auto fb = spec.fit(cx, rest);
+      if (!fb) continue;
+      Scored sb = ScoreFit(cx, rest, std::move(*fb), rest_base.hold_sse, options.z_claim);
+      if (!sb.eligible) continue;
+      partners.emplace_back(sb.score, spec.name);
+      partner_fits.emplace_back(partners.back(), std::move(sb.fit));
+      if (partner_fits.size() > kPairPartners) {
+        partner_fits.erase(
+            std::min_element(partner_fits.begin(), partner_fits.end(),
+                             [](const auto& u, const auto& v) { return u.first < v.first; }));
       }
-      std::sort(partners.rbegin(), partners.rend());
-      for (std::size_t y = 0; y < std::min<std::size_t>(3, partners.size()); ++y) {
-        const EffectSpec* sa = FindEffect(first.fit.name);
-        const EffectSpec* sb = FindEffect(partners[y].second);
-        EffectFit fa;
-        EffectFit fb;
-        if (!FitPair(cx, cx.resid, *sa, *sb, first.fit, &fa, &fb)) continue;
-        Mat both = fa.pred + fb.pred;
-        const Sums s = Score(cx, cx.resid, &both);
-        const double delta = base.hold_sse - s.hold_sse;
-        const double score = delta - (fa.n_params + fb.n_params) * HoldPenalty(cx);
-        // The partner must add a significant held-out improvement over the first alone …
-        const Mat diff = both - first.fit.pred;
-        double dd = 0.0;
-        for (int c = 0; c < cx.nc; ++c) {
-          for (int i = 0; i < cx.n; ++i) {
-            if (!cx.train[static_cast<std::size_t>(i)])
-              dd += diff(i, c) * diff(i, c) * cx.weight(c);
-          }
+    }
+    std::sort(partners.rbegin(), partners.rend());
+    for (std::size_t y = 0; y < std::min<std::size_t>(kPairPartners, partners.size()); ++y) {
+      const EffectSpec* sa = FindEffect(first.fit.name);
+      const EffectSpec* sb = FindEffect(partners[y].second);
+      EffectFit* b0 = nullptr;
+      for (auto& pf : partner_fits) {
+        if (pf.first == partners[y]) b0 = &pf.second;
+      }
+      EffectFit fa;
+      EffectFit fb;
+      if (!FitPair(cx, cx.resid, *sa, *sb, first.fit, b0, &fa, &fb)) continue;
+      Mat both = fa.pred + fb.pred;
+      const Sums s = Score(cx, cx.resid, &both);
+      const double delta = base.hold_sse - s.hold_sse;
+      const double score = delta - (fa.n_params + fb.n_params) * HoldPenalty(cx);
+      // The partner must add a significant held-out improvement over the first alone …
+      double dd = 0.0;
+      for (int c = 0; c < cx.nc; ++c) {
+        for (int i = 0; i < cx.n; ++i) {
+          if (cx.train[static_cast<std::size_t>(i)]) continue;
+          const double diff = both(i, c) - first.fit.pred(i, c);
+          dd += diff * diff * cx.weight(c);
         }
-        const double inc = first.hold_sse - s.hold_sse;
-        const double z_inc = dd > 0 ? inc / (2.0 * std::sqrt(dd)) : 0.0;
-        // … and carry a visible share (≥ 0.2 %) of the excess over noise, not a misfit's remainder.
-        const double excess = base.hold_sse - static_cast<double>(cx.n_hold) * cx.nc;
-        if (std::getenv("FTDIAG_DEBUG") != nullptr) {
-          std::fprintf(
-              stderr,
-              "pair %s + %s: score %.1f (best single %.1f) z_inc %.1f inc %.1f excess %.1f\n",
-              fa.name.c_str(), fb.name.c_str(), score, best.score, z_inc, inc, excess);
-        }
-        // … and the pair must beat every model so far on the penalised held-out score.
-        if (z_inc > options.z_claim && inc > 0.002 * excess && score > pair_score) {
-          pair_score = score;
-          pa = std::move(fa);
-          pb = std::move(fb);
-          have_pair = true;
-        }
+      }
+      const double inc = first.hold_sse - s.hold_sse;
+      const double z_inc = dd > 0 ? inc / (2.0 * std::sqrt(dd)) : 0.0;
+      // … and carry a visible share (≥ 0.2 %) of the excess over noise, not a misfit's remainder.
+      const double excess = base.hold_sse - static_cast<double>(cx.n_hold) * cx.nc;
+      if (std::getenv("FTDIAG_DEBUG") != nullptr) {
+        std::fprintf(
+            stderr, "pair %s + %s: score %.1f (best single %.1f) z_inc %.1f inc %.1f excess %.1f\n",
+            fa.name.c_str(), fb.name.c_str(), score, best.score, z_inc, inc, excess);
+      }
+      // … and the pair must beat every model so far on the penalised held-out score.
+      if (z_inc > options.z_claim && inc > 0.002 * excess && score > pair_score) {
+        pair_score = score;
+        *pa = std::move(fa);
+        *pb = std::move(fb);
+        have_pair = true;
       }
     }
   }
-  std::vector<EffectFit> claimed;
-  if (have_pair) {
-    // Stronger first: the one whose removal from the pair costs more on held-out rows.
-    const Sums only_a = Score(cx, cx.resid, &pa.pred);
-    const Sums only_b = Score(cx, cx.resid, &pb.pred);
-    if (only_b.hold_sse < only_a.hold_sse) std::swap(pa, pb);
-    claimed.push_back(std::move(pa));
-    claimed.push_back(std::move(pb));
-  } else {
-    claimed.push_back(best.fit);
-  }
+  return have_pair;
+}
+
+/// Thermal refinement of the claimed effects (see the comment inside).
+void RefineThermal(const Context& cx, std::vector<EffectFit>* claimed_effects) {
+  std::vector<EffectFit>& claimed = *claimed_effects;
   // A claimed thermal_zero_drift is refined with a thermometer lag τ ≥ 0 where the lag pays for
   // itself (effects/thermal_lag.cpp); ranked without it, so a lag never wins a claim on its own.
   // A claimed zero_drift is replaced by a lagged thermal_zero_drift where temperature exists and
@@ -429,8 +457,12 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
     const double cost_new = Score(cx, rest, &lagged->pred).hold_sse + lagged->n_params * log_hold;
     if (thermal || cost_new < cost_old) claimed[k] = std::move(*lagged);
   }
-  const std::vector<Confounding> partner_conf =
-      DropUnidentifiedPartner(cx, options.z_claim, &claimed, &r.dropped);
+}
+
+/// The claimed effects into the report, each with its held-out gain and confounders; the verdict.
+void RecordClaims(Report& r, const DiagnoseOptions& options, std::vector<EffectFit>& claimed,
+                  const std::vector<Confounding>& partner_conf) {
+  const Context& cx = r.cx;
   Mat cum = Mat::Zero(cx.n, cx.nc);
   for (std::size_t k = 0; k < claimed.size(); ++k) {
     EffectFit& f = claimed[k];
@@ -465,70 +497,71 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
                               RobustNoise(rest.data(), static_cast<std::size_t>(cx.n), cx.rate_hz));
   }
   r.hold_rms_after = HoldRms(cx, cx.resid, &cum);
-  Progress(options, 1.0, "done");
+}
+
+}  // namespace
+
+Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
+                    const Eigen::VectorXd* sigma);
+
+Report Diagnose(const DiagData& data, const DiagnoseOptions& options) {
+  Report r = DiagnoseOnce(data, options, nullptr);
+  // A strong broadband effect (skew on fast edges, ringing) lifts the spectrum's median and so the
+  // first noise estimate; when the claimed model reveals a clearly lower noise, diagnose again
+  // with it so that weaker effects are weighed against the true noise.
+  if (!r.effects.empty()) {
+    bool lower = false;
+    for (int c = 0; c < r.noise_rms.size(); ++c)
+      lower = lower || r.noise_rms(c) < 0.8 * r.cx.sigma(c);
+    if (lower) {
+      const Eigen::VectorXd sigma = r.noise_rms;
+      r = Report();  // release the first pass (its context and model) before the second
+      r = DiagnoseOnce(data, options, &sigma);
+    }
+  }
   return r;
 }
 
-nlohmann::json ToJson(const Report& r) {
-  auto vec = [](const Vec& v) {
-    auto a = nlohmann::json::array();
-    for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v(i));
-    return a;
-  };
-  nlohmann::json j;
-  j["schema"] = "ftdiag-report/1";
-  j["rate_hz"] = r.rate_hz;
-  j["noise_rms"] = vec(r.noise_rms);
-  j["rms_before"] = vec(r.rms_before);
-  auto windows = nlohmann::json::array();
-  for (const auto& [a, b] : r.windows) windows.push_back({a, b});
-  j["mismatch"] = {{"channels", r.mismatch_channels}, {"windows", windows}};
-  if (!r.load_region.is_null()) j["mismatch"]["load_region"] = r.load_region;
-  if (!r.cx.peak_hz.empty()) {
-    j["mismatch"]["spectral_peaks_hz"] = r.cx.peak_hz;
+Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
+                    const Eigen::VectorXd* sigma) {
+  Report r;
+  Progress(options, 0.0, "noise and hold-out split");
+  r.cx = MakeContext(data, options.block_s, sigma);
+  const Context& cx = r.cx;
+  r.rate_hz = cx.rate_hz;
+  r.noise_rms = cx.sigma;
+  r.rms_before = ChannelRms(cx.resid);
+  r.hold_rms_before = HoldRms(cx, cx.resid, nullptr);
+  r.hold_rms_after = r.hold_rms_before;
+  Locate(r);
+  ReportSpectrum(r);
+  const Sums base = Score(cx, cx.resid, nullptr);
+  const std::vector<Scored> singles = FitSingles(r, options, base);
+  if (singles.empty() || !singles.front().eligible) {
+    r.model = Mat::Zero(cx.n, cx.nc);  // allocated only now: nothing claimed
+    Progress(options, 1.0, "done");
+    return r;
   }
-  j["verdict"] = r.verdict;
-  auto effects = nlohmann::json::array();
-  for (const auto& e : r.effects) {
-    nlohmann::json ej;
-    ej["name"] = e.fit.name;
-    ej["channels"] = e.fit.channels;
-    ej["params"] = e.fit.params;
-    ej["uncertainty"] = e.fit.sigma;
-    ej["evidence"] = e.fit.evidence;
-    ej["rms_after"] = vec(e.rms_after);
-    ej["holdout"] = {{"rms_before", e.hold_rms_before}, {"rms_after", e.hold_rms_after}};
-    ej["model"] = e.fit.variant;
-    ej["n_params"] = e.fit.n_params;
-    ej["identifiable"] = e.confounded_with.empty();
-    if (!e.confounded_with.empty()) {
-      ej["confounded_with"] = e.confounded_with;
-      ej["confounding"] = e.confounding;
-    }
-    effects.push_back(ej);
+  EffectFit pa;
+  EffectFit pb;
+  const bool have_pair = options.pairs && BestPair(cx, options, singles, base, &pa, &pb);
+  std::vector<EffectFit> claimed;
+  if (have_pair) {
+    // Stronger first: the one whose removal from the pair costs more on held-out rows.
+    const Sums only_a = Score(cx, cx.resid, &pa.pred);
+    const Sums only_b = Score(cx, cx.resid, &pb.pred);
+    if (only_b.hold_sse < only_a.hold_sse) std::swap(pa, pb);
+    claimed.push_back(std::move(pa));
+    claimed.push_back(std::move(pb));
+  } else {
+    claimed.push_back(singles.front().fit);
   }
-  j["effects"] = effects;
-  if (!r.dropped.empty()) j["not_claimed"] = r.dropped;
-  j["holdout"] = {{"rms_before", r.hold_rms_before},
-                  {"rms_after", r.hold_rms_after},
-                  {"rows", r.cx.n_hold},
-                  {"block_s", r.cx.block_s},
-                  {"scheme",
-                   "every third block of block_s held out; fits use the other rows; blocks "
-                   "restart at every segment"},
-                  {"segments", r.cx.segments}};
-  auto cands = nlohmann::json::array();
-  for (const auto& c : r.candidates) {
-    cands.push_back({{"name", c.name},
-                     {"model", c.variant},
-                     {"n_params", c.n_params},
-                     {"holdout_rms_after", c.hold_rms_after},
-                     {"z", c.z},
-                     {"score", c.score},
-                     {"eligible", c.eligible}});
-  }
-  j["candidates"] = cands;
-  return j;
+  RefineThermal(cx, &claimed);
+  const std::vector<Confounding> partner_conf =
+      DropUnidentifiedPartner(cx, options.z_claim, &claimed, &r.dropped);
+  RecordClaims(r, options, claimed, partner_conf);
+  Progress(options, 1.0, "done");
+  return r;
 }
 
 }  // namespace ftstack::diag

@@ -184,7 +184,7 @@ Confounding CheckConfounders(const Context& cx, const Mat& target, const EffectF
     *z_rest = 0.0;
     if (score_conf < score_effect) return true;
     Mat eff = fit.pred;
-    Mat conf = alone;
+    Mat conf;  // assigned in the first iteration
     for (int iter = 0; iter < 3; ++iter) {
       conf = confounder(target - eff);
       const auto refit = spec->fit(cx, target - conf);
@@ -197,8 +197,17 @@ Confounding CheckConfounders(const Context& cx, const Mat& target, const EffectF
     const Mat joint = conf + eff;
     const Sums s_alone = Score(cx, target, &alone);
     const Sums s_joint = Score(cx, target, &joint);
-    const Mat diff = joint - alone;
-    const double spread = Score(cx, target, &diff).hold_pp;
+    // Score(cx, target, &(joint − alone)).hold_pp without the n × N difference matrix.
+    double spread = 0.0;
+    for (int c = 0; c < cx.nc; ++c) {
+      double pp = 0.0;
+      for (int i = 0; i < cx.n; ++i) {
+        if (cx.train[static_cast<std::size_t>(i)]) continue;
+        const double p = joint(i, c) - alone(i, c);
+        pp += p * p;
+      }
+      spread += pp * cx.weight(c);
+    }
     const double delta = s_alone.hold_sse - s_joint.hold_sse;
     *z_rest = delta / (2.0 * std::sqrt(std::max(spread, 1e-300)));
     return *z_rest > z_claim && delta > 0.0;

@@ -257,6 +257,11 @@ void PlayOperator(const double* x, std::size_t n, double width, double* z) {
 }
 
 double InterpolateAt(const double* t, const double* x, std::size_t n, double tq, bool uniform) {
+  return InterpolateNear(t, x, n, tq, uniform, n);
+}
+
+double InterpolateNear(const double* t, const double* x, std::size_t n, double tq, bool uniform,
+                       std::size_t guess) {
   if (n == 0) return 0.0;
   if (tq <= t[0]) return x[0];
   if (tq >= t[n - 1]) return x[n - 1];
@@ -265,6 +270,12 @@ double InterpolateAt(const double* t, const double* x, std::size_t n, double tq,
     const double h = (t[n - 1] - t[0]) / static_cast<double>(n - 1);
     i = static_cast<std::size_t>((tq - t[0]) / h);
     if (i >= n - 1) i = n - 2;
+    while (i > 0 && t[i] > tq) --i;
+    while (i + 2 < n && t[i + 1] <= tq) ++i;
+  } else if (guess < n) {
+    // The same interval as the binary search below (t strictly increasing, t[0] < tq < t[n−1]):
+    // the last i with t[i] ≤ tq, walked to from the guess.
+    i = std::min(guess, n - 2);
     while (i > 0 && t[i] > tq) --i;
     while (i + 2 < n && t[i + 1] <= tq) ++i;
   } else {

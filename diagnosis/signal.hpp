@@ -81,6 +81,10 @@ void PlayOperator(const double* x, std::size_t n, double width, double* z);
 /// at the ends). t must be increasing.
 [[nodiscard]] double InterpolateAt(const double* t, const double* x, std::size_t n, double tq,
                                    bool uniform);
+/// The same, with a guess of the row at or just below tq (guess ≥ n: none): on a non-uniform
+/// clock the interval is walked to from the guess instead of searched, for queries near a row.
+[[nodiscard]] double InterpolateNear(const double* t, const double* x, std::size_t n, double tq,
+                                     bool uniform, std::size_t guess);
 
 /// Minimises f over a grid, then refines with golden-section search between the best point's
 /// neighbours. Returns the argument; *fmin receives the value.

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <system_error>
@@ -205,9 +206,30 @@ Recording ParseRecording(const std::string& text, const std::string& path,
 Recording ReadRecording(const std::string& path, const ReadOptions& options) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw RecordingError(path + ": cannot open: " + std::generic_category().message(errno));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ParseRecording(ss.str(), path, options);
+  // One copy of the text (a stringstream and its str() would hold two).
+  std::error_code ec;
+  const bool regular = std::filesystem::is_regular_file(path, ec);
+  std::streamoff size = -1;
+  if (regular) {
+    in.seekg(0, std::ios::end);
+    size = in.tellg();
+  }
+  if (size < 0) {  // not a seekable regular file (a pipe, a directory): read it as a stream
+    in.clear();
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ParseRecording(ss.str(), path, options);
+  }
+  in.seekg(0, std::ios::beg);
+  std::string text;
+  if (size > 0) {
+    text.resize(static_cast<std::size_t>(size));
+    in.read(text.data(), size);
+    if (in.gcount() != size) {
+      throw RecordingError(path + ": read failed: " + std::generic_category().message(errno));
+    }
+  }
+  return ParseRecording(text, path, options);
 }
 
 void CheckAligned(const Recording& sim, const Recording& real) {

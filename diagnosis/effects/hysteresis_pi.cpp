@@ -23,11 +23,33 @@ struct RelayGrid {
   std::array<double, kRelays> up{};
   std::array<double, kRelays> down{};
   std::array<double, kRelays> state{};
+  std::array<double, kLevels> level{};  ///< the thresholds, ascending
+  int band = -1;  ///< band of the last input (levels ≤ x, levels < x); −1: none since a reset
   void Step(double x) {
     for (int j = 0; j < kRelays; ++j) {
       if (x >= up[static_cast<std::size_t>(j)]) state[static_cast<std::size_t>(j)] = 1.0;
       if (x <= down[static_cast<std::size_t>(j)]) state[static_cast<std::size_t>(j)] = -1.0;
     }
+  }
+  /// Step, skipped while the input stays in the band of the last step: every comparison of Step
+  /// depends on x only through its band, and repeating the last assignments changes nothing.
+  /// Returns whether Step ran.
+  bool StepBand(double x) {
+    int at_or_below = 0;
+    int below = 0;
+    for (const double l : level) {
+      at_or_below += l <= x ? 1 : 0;
+      below += l < x ? 1 : 0;
+    }
+    const int b = at_or_below * (kLevels + 1) + below;
+    if (b == band) return false;
+    band = b;
+    Step(x);
+    return true;
+  }
+  void Reset() {
+    state.fill(0.0);
+    band = -1;
   }
 };
 
@@ -41,6 +63,7 @@ RelayGrid MakeGrid(const double* x, std::size_t n) {
         sorted[static_cast<std::size_t>(q * static_cast<double>(n - 1))];
   }
   RelayGrid g;
+  g.level = level;
   int j = 0;
   for (int lo = 0; lo < kLevels; ++lo) {
     for (int hi = lo + 1; hi < kLevels; ++hi, ++j) {
@@ -94,8 +117,8 @@ std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Eigen::M
     double x[p];
     RelayGrid g = start;
     for (std::size_t i = 0; i < n; ++i) {  // streamed: no n × relays matrix is held
-      if (!cx.restart.empty() && cx.restart[i] != 0) g.state.fill(0.0);
-      g.Step(load[i]);
+      if (!cx.restart.empty() && cx.restart[i] != 0) g.Reset();
+      g.StepBand(load[i]);
       // Weights from every k-th training row on long records (k = the search stride, ~12 000
       // rows): the relay states change only at threshold crossings, so little is lost.
       if (cx.train[i] == 0 || i % static_cast<std::size_t>(cx.search_stride) != 0) continue;
@@ -113,11 +136,13 @@ std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Eigen::M
     weights.push_back(w);
     sigmas.push_back(sw);
     g = start;
+    double v = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
-      if (!cx.restart.empty() && cx.restart[i] != 0) g.state.fill(0.0);
-      g.Step(load[i]);
-      double v = 0.0;
-      for (int j = 0; j < kRelays; ++j) v += r.beta(j) * g.state[static_cast<std::size_t>(j)];
+      if (!cx.restart.empty() && cx.restart[i] != 0) g.Reset();
+      if (g.StepBand(load[i])) {  // else the states, and so v, are those of the last row
+        v = 0.0;
+        for (int j = 0; j < kRelays; ++j) v += r.beta(j) * g.state[static_cast<std::size_t>(j)];
+      }
       e.pred(static_cast<Eigen::Index>(i), c) = v;
     }
     sse_w += r.sse * cx.weight(c) * cx.search_stride;

@@ -248,41 +248,10 @@ std::string SvgPlot(const PlotSpec& spec, const std::vector<Series>& series) {
   return o;
 }
 
-std::string HtmlReport(const DiagData& data, const Report& r) {
+/// The channel table and the load region carrying the excess.
+std::string HtmlChannels(const Report& r) {
   const Context& cx = r.cx;
   std::string h;
-  h += "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>ftdiag report</title><style>"
-       "body{font-family:sans-serif;margin:20px;max-width:1060px}table{border-collapse:collapse}"
-       "td,th{border:1px solid #bbb;padding:3px 8px;font-size:13px}th{background:#eee}"
-       "code{word-break:break-all}.verdict{font-size:22px;font-weight:bold}.ev{background:#eef6ee;"
-       "padding:6px;border-left:"
-       "4px solid #4a4}.conf{background:#fbeeee;padding:6px;border-left:4px solid #c44}"
-       "</style></head><body>";
-  h += "<h1>ftdiag: sim vs real</h1>";
-  h += "<p>Real: <code>" + Esc(data.real_name) + "</code>, sim: <code>" + Esc(data.sim_name) +
-       "</code>, " + std::to_string(data.rows()) + " rows × " + std::to_string(data.channels()) +
-       " bridges at " + Num(r.rate_hz) + " Hz.</p>";
-  if (data.segment.size() == data.rows() && r.cx.segments > 1) {
-    h += "<p>" + std::to_string(r.cx.segments) +
-         " joined recordings (segments): stateful models restart at each, hold-out blocks never "
-         "straddle one.</p>";
-  }
-  h += "<p class=\"verdict\">Verdict: " + Esc(r.verdict);
-  for (std::size_t i = 1; i < r.effects.size(); ++i) h += " + " + Esc(r.effects[i].fit.name);
-  h += "</p>";
-  h += "<p>Held-out RMS (rows not used for fitting, all channels): <b>" + Num(r.hold_rms_before) +
-       "</b> → <b>" + Num(r.hold_rms_after) + "</b> mV/V.</p>";
-  for (const auto& e : r.effects) {
-    h += "<h2>" + Esc(e.fit.name) + "</h2><p class=\"ev\">" + Esc(e.fit.evidence) +
-         "</p><p>Model: " + Esc(e.fit.variant) + " (" + std::to_string(e.fit.n_params) +
-         " parameters). Held-out RMS " + Num(e.hold_rms_before) + " → " + Num(e.hold_rms_after) +
-         " mV/V.</p>" + ParamTable(e.fit);
-    if (!e.confounded_with.empty()) {
-      h += "<p class=\"conf\"><b>Not identified.</b> " + Esc(e.confounding) +
-           " The verdict does not name it.</p>";
-    }
-  }
-  // Channel table.
   h += "<h2>Channels</h2><table><tr><th>channel</th><th>noise RMS</th><th>RMS before</th><th>RMS "
        "after</th><th>mismatch</th></tr>";
   for (int c = 0; c < cx.nc; ++c) {
@@ -301,7 +270,14 @@ std::string HtmlReport(const DiagData& data, const Report& r) {
          Num(r.load_region["range"][1].get<double>()) + " (mean squared residual there " +
          Num(r.load_region["excess_ratio"].get<double>()) + " × noise²).</p>";
   }
-  // Plots: the channel with most residual energy.
+  return h;
+}
+
+/// Plots of the channel with most residual energy: against time, before/after, against load; the
+/// residual spectrum.
+std::string HtmlPlots(const DiagData& data, const Report& r) {
+  const Context& cx = r.cx;
+  std::string h;
   int c = 0;
   double be = -1;
   const std::vector<int> pick =
@@ -367,6 +343,12 @@ std::string HtmlReport(const DiagData& data, const Report& r) {
     p4.log_y = true;
     h += "<h2>Spectrum</h2>" + SvgPlot(p4, {sp});
   }
+  return h;
+}
+
+/// Every single effect tried, in held-out ranking order.
+std::string HtmlCandidates(const Report& r) {
+  std::string h;
   h += "<h2>All candidates (held-out "
        "ranking)</h2><table><tr><th>effect</th><th>model</th><th>params</th>"
        "<th>held-out RMS after</th><th>z</th><th>score</th><th>claimable</th></tr>";
@@ -376,9 +358,59 @@ std::string HtmlReport(const DiagData& data, const Report& r) {
          Num(cand.z, "%.1f") + "</td><td>" + Num(cand.score, "%.1f") + "</td><td>" +
          (cand.eligible ? "yes" : "") + "</td></tr>";
   }
-  h += "</table><p>Held-out rows: every third block of " + Num(cx.block_s) +
+  h += "</table><p>Held-out rows: every third block of " + Num(r.cx.block_s) +
        " s. Score = held-out Δχ² − parameters × ln(held-out samples); an effect is claimed when "
        "its held-out z &gt; 6 and score &gt; 0.</p>";
+  return h;
+}
+
+std::string HtmlReport(const DiagData& data, const Report& r) {
+  std::string h;
+  h += "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>ftdiag report</title><style>"
+       "body{font-family:sans-serif;margin:20px;max-width:1060px}table{border-collapse:collapse}"
+       "td,th{border:1px solid #bbb;padding:3px 8px;font-size:13px}th{background:#eee}"
+       "code{word-break:break-all}.verdict{font-size:22px;font-weight:bold}.ev{background:#eef6ee;"
+       "padding:6px;border-left:"
+       "4px solid #4a4}.conf{background:#fbeeee;padding:6px;border-left:4px solid #c44}"
+       "</style></head><body>";
+  h += "<h1>ftdiag: sim vs real</h1>";
+  h += "<p>Real: <code>" + Esc(data.real_name) + "</code>, sim: <code>" + Esc(data.sim_name) +
+       "</code>, " + std::to_string(data.rows()) + " rows × " + std::to_string(data.channels()) +
+       " bridges at " + Num(r.rate_hz) + " Hz.</p>";
+  if (data.segment.size() == data.rows() && r.cx.segments > 1) {
+    h += "<p>" + std::to_string(r.cx.segments) +
+         " joined recordings (segments): stateful models restart at each, hold-out blocks never "
+         "straddle one.</p>";
+  }
+  h += "<p class=\"verdict\">Verdict: " + Esc(r.verdict);
+  for (std::size_t i = 1; i < r.effects.size(); ++i) h += " + " + Esc(r.effects[i].fit.name);
+  h += "</p>";
+  h += "<p>Held-out RMS (rows not used for fitting, all channels): <b>" + Num(r.hold_rms_before) +
+       "</b> → <b>" + Num(r.hold_rms_after) + "</b> mV/V.</p>";
+  for (const auto& e : r.effects) {
+    h += "<h2>" + Esc(e.fit.name) + "</h2><p class=\"ev\">" + Esc(e.fit.evidence) +
+         "</p><p>Model: " + Esc(e.fit.variant) + " (" + std::to_string(e.fit.n_params) +
+         " parameters). Held-out RMS " + Num(e.hold_rms_before) + " → " + Num(e.hold_rms_after) +
+         " mV/V.</p>" + ParamTable(e.fit);
+    if (!e.confounded_with.empty()) {
+      h += "<p class=\"conf\"><b>Not identified.</b> " + Esc(e.confounding) +
+           " The verdict does not name it.</p>";
+    }
+  }
+  // Partners of a pair left unclaimed (JSON "not_claimed": "name: reason"), in words.
+  for (const auto& d : r.dropped) {
+    const std::size_t colon = d.find(": ");
+    const std::string name = colon == std::string::npos ? d : d.substr(0, colon);
+    const std::string why = colon == std::string::npos ? "" : d.substr(colon + 2);
+    h += "<h2>" + Esc(name) + " (not claimed)</h2><p class=\"conf\"><b>Not claimed.</b> " +
+         Esc(name) +
+         " improved the held-out rows beside the claimed effect, but one offset per load hold "
+         "explains that improvement as well, so it is left out of the effects and the verdict. " +
+         Esc(why) + "</p>";
+  }
+  h += HtmlChannels(r);
+  h += HtmlPlots(data, r);
+  h += HtmlCandidates(r);
   h += "</body></html>\n";
   return h;
 }

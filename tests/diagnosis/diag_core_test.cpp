@@ -5,6 +5,7 @@
 #include <random>
 
 #include "diagnosis/diagnose.hpp"
+#include "diagnosis/report/html_report.hpp"
 #include "diagnosis/signal.hpp"
 #include "tests/diagnosis/diag_fixture.hpp"
 
@@ -206,6 +207,21 @@ TEST(DiagFixturePairs, OffsetAndCreepAreBothNamed) {
   std::sort(names.begin(), names.end());
   EXPECT_EQ(names, (std::vector<std::string>{"creep", "zero_offset"}));
   EXPECT_GE(ExcessRemoved(r), 0.7);
+}
+
+TEST(DiagReportHtml, NotClaimedPartnersAreSaidInWords) {
+  // A pair partner left unclaimed (Report::dropped, JSON "not_claimed": "name: reason") is named
+  // in the HTML apart from the claimed effects, with its reason, in words.
+  const auto fx = testing::MakeFixture({{"zero_offset", 5}}, 3, 200.0, kNoise, 4.0);
+  Report r = Diagnose(fx.data);
+  ASSERT_FALSE(r.effects.empty());
+  r.dropped.push_back("zero_drift: one offset per load hold explains it as well");
+  const std::string html = HtmlReport(fx.data, r);
+  EXPECT_NE(html.find("<h2>zero_drift (not claimed)</h2>"), std::string::npos);
+  EXPECT_NE(html.find("<b>Not claimed.</b> zero_drift improved the held-out rows"),
+            std::string::npos);
+  EXPECT_NE(html.find("one offset per load hold explains it as well</p>"), std::string::npos);
+  EXPECT_EQ(ToJson(r)["not_claimed"][0], r.dropped[0]);
 }
 
 TEST(DiagFixtureSubtle, WithoutTemperatureThermalDriftIsNotClaimed) {

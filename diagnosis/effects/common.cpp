@@ -1,0 +1,158 @@
+// Private helpers shared by the effect models (see common.hpp).
+#include "diagnosis/effects/common.hpp"
+
+#include <cstdarg>
+#include <cstdio>
+#include <limits>
+
+namespace ftstack::diag::fx {
+
+std::string Fmt(const char* f, ...) {
+  char buf[512];
+  va_list ap;
+  va_start(ap, f);
+  std::vsnprintf(buf, sizeof buf, f, ap);
+  va_end(ap);
+  return buf;
+}
+
+/// σ of parameter j of channel c from its unit covariance and the channel's residual variance.
+double ParamSigma(const Context& cx, const ChannelFit& f, int c, int j) {
+  const double dof =
+      std::max(1.0, static_cast<double>(cx.n_train) - static_cast<double>(f.beta.rows()));
+  return std::sqrt(std::max(0.0, f.cov[static_cast<std::size_t>(c)](j, j) * f.sse(c) / dof));
+}
+
+/// Uncertainty of a nonlinear parameter from the curvature of the profile SSE (whitened, so
+/// Δχ² = 1 at one σ): σ = sqrt(2 / f'').
+double CurvatureSigma(const std::function<double(double)>& f, double x, double h) {
+  const double f0 = f(x);
+  const double fp = f(x + h);
+  const double fm = f(x - h);
+  const double d2 = (fp - 2.0 * f0 + fm) / (h * h);
+  return d2 > 0 ? std::sqrt(2.0 / d2) : std::numeric_limits<double>::quiet_NaN();
+}
+
+nlohmann::json JsonNum(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+nlohmann::json VecJson(const Vec& v) {
+  auto a = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(JsonNum(v(i)));
+  return a;
+}
+
+/// Puts coefficient j of every channel and its σ into e.params[key] / e.sigma[key]; returns it.
+Vec PutChannelCoef(const Context& cx, const ChannelFit& f, int j, const char* key, EffectFit* e) {
+  Vec v = f.beta.row(j).transpose();
+  Vec sg(cx.nc);
+  for (int c = 0; c < cx.nc; ++c) sg(c) = ParamSigma(cx, f, c, j);
+  e->params[key] = VecJson(v);
+  e->sigma[key] = VecJson(sg);
+  return v;
+}
+
+/// Whitened training SSE of a one-coefficient-per-channel fit of `feature` (n × N), on every
+/// search_stride-th row and scaled back to the full count: the objective of parameter searches.
+double SearchSse(const Context& cx, const Mat& target, const Mat& feature) {
+  // FitChannels with one feature, unrolled: the sums of NormalEq::Add with unit weight and the
+  // arithmetic of NormalEq::Solve for p = 1 (Jacobi scaling, 1e-12 on the scaled diagonal), so the
+  // value is the same to the last bit, without a per-row call or a covariance per channel.
+  const int st = cx.search_stride;
+  double sse_w = 0.0;
+  for (int c = 0; c < cx.nc; ++c) {
+    const double* x = feature.col(c).data();
+    const double* y = target.col(c).data();
+    double sxx = 0.0;
+    double sxy = 0.0;
+    double syy = 0.0;
+    for (int i = 0; i < cx.n; i += st) {
+      if (!cx.train[static_cast<std::size_t>(i)]) continue;
+      sxy += x[i] * y[i];
+      sxx += x[i] * x[i];
+      syy += y[i] * y[i];
+    }
+    const double d = sxx > 0 ? 1.0 / std::sqrt(sxx) : 1.0;
+    const double scaled = d * sxx * d + 1e-12;
+    const double bs = d * sxy / scaled;
+    const double beta = d * bs;
+    sse_w += std::max(0.0, syy - beta * sxy) * cx.weight(c);
+  }
+  return sse_w * st;
+}
+
+/// Channel whose prediction carries the largest whitened energy.
+int DominantChannel(const Context& cx, const Mat& pred) {
+  int best = 0;
+  double be = -1.0;
+  for (int c = 0; c < cx.nc; ++c) {
+    const double e = pred.col(c).squaredNorm() * cx.weight(c);
+    if (e > be) {
+      be = e;
+      best = c;
+    }
+  }
+  return best;
+}
+
+/// Channels carrying at least `share` of the prediction's whitened energy.
+std::vector<int> ActiveChannels(const Context& cx, const Mat& pred, double share) {
+  Vec e(cx.nc);
+  for (int c = 0; c < cx.nc; ++c) e(c) = pred.col(c).squaredNorm() * cx.weight(c);
+  std::vector<int> out;
+  const double tot = e.sum();
+  for (int c = 0; c < cx.nc; ++c) {
+    if (tot > 0 && e(c) >= share * tot) out.push_back(c);
+  }
+  return out;
+}
+
+/// Channels whose single coefficient is significant (|β|/σ > 5) and carries ≥ 5 % of the energy
+/// explained across channels.
+std::vector<int> SignificantChannels(const Context& cx, const ChannelFit& f, const Mat& pred,
+                                     int j) {
+  std::vector<int> out;
+  Vec e(cx.nc);
+  for (int c = 0; c < cx.nc; ++c) e(c) = pred.col(c).squaredNorm() * cx.weight(c);
+  const double tot = e.sum();
+  for (int c = 0; c < cx.nc; ++c) {
+    const double s = ParamSigma(cx, f, c, j);
+    if (s > 0 && std::fabs(f.beta(j, c)) > 5.0 * s && e(c) >= 0.05 * tot) out.push_back(c);
+  }
+  return out;
+}
+
+std::string ChannelList(const std::vector<int>& ch) {
+  std::string s;
+  for (std::size_t i = 0; i < ch.size(); ++i) {
+    if (i) s += ", ";
+    s += "b" + std::to_string(ch[i]);
+  }
+  return s;
+}
+
+nlohmann::json IntList(const std::vector<int>& ch) {
+  auto a = nlohmann::json::array();
+  for (int c : ch) a.push_back(c);
+  return a;
+}
+
+double RowCorr(const Context& cx, const Mat& target, const Mat& pred, int c) {
+  return Correlation(target.col(c).data(), pred.col(c).data(), static_cast<std::size_t>(cx.n));
+}
+
+HatBasis MakeHat(const Context& cx, int k) {
+  HatBasis b;
+  b.t0 = cx.data->t_s.front();
+  b.k = k;
+  b.h = (cx.data->t_s.back() - b.t0) / k;
+  return b;
+}
+
+/// Restart flags of the context's segments for the filters (nullptr for one recording).
+const std::uint8_t* Restarts(const Context& cx) {
+  return cx.restart.empty() ? nullptr : cx.restart.data();
+}
+
+}  // namespace ftstack::diag::fx

@@ -1,0 +1,146 @@
+// Private helpers shared by the effect models of diagnosis/effects/ (not part of the engine's API).
+#pragma once
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "diagnosis/effects.hpp"
+#include "diagnosis/signal.hpp"
+
+namespace ftstack::diag::fx {
+
+inline constexpr const char* kWrenchNames[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
+
+/// printf-style formatting into a std::string (up to 511 characters).
+std::string Fmt(const char* f, ...) __attribute__((format(printf, 1, 2)));
+
+using Mat = Eigen::MatrixXd;
+using Vec = Eigen::VectorXd;
+
+inline double Ln(double x) { return std::log(std::max(x, 1.0)); }
+
+/// BIC-like penalty per parameter for hyper-parameter choices on training data.
+inline double Penalty(const Context& cx) { return Ln(static_cast<double>(cx.n_train) * cx.nc); }
+
+struct ChannelFit {
+  Mat beta;              // p × N
+  std::vector<Mat> cov;  // per channel, unit
+  Vec sse;               // per channel, unweighted
+  double sse_w = 0.0;
+};
+
+/// Per-channel least squares target_c ≈ Σ_j beta_jc · feat(i, c)_j on training rows; fills pred.
+template <class F>
+ChannelFit FitChannels(const Context& cx, const Mat& target, int p, F feat, Mat* pred,
+                       const std::vector<int>* only = nullptr, int stride = 1) {
+  ChannelFit out;
+  out.beta = Mat::Zero(p, cx.nc);
+  out.cov.assign(static_cast<std::size_t>(cx.nc), Mat::Zero(p, p));
+  out.sse = Vec::Zero(cx.nc);
+  std::vector<double> x(static_cast<std::size_t>(p));
+  if (pred != nullptr) pred->setZero(cx.n, cx.nc);
+  for (int c = 0; c < cx.nc; ++c) {
+    const bool active = only == nullptr || std::find(only->begin(), only->end(), c) != only->end();
+    if (!active) {
+      if (stride > 1) continue;  // searches only compare the active channels
+      double s = 0.0;
+      for (int i = 0; i < cx.n; ++i) {
+        if (cx.train[static_cast<std::size_t>(i)]) s += target(i, c) * target(i, c);
+      }
+      out.sse(c) = s;
+      out.sse_w += s * cx.weight(c);
+      continue;
+    }
+    NormalEq ne(p);
+    for (int i = 0; i < cx.n; i += stride) {
+      if (!cx.train[static_cast<std::size_t>(i)]) continue;
+      feat(i, c, x.data());
+      ne.Add(x.data(), target(i, c));
+    }
+    const auto r = ne.Solve();
+    out.beta.col(c) = r.beta;
+    out.cov[static_cast<std::size_t>(c)] = r.cov_unit;
+    out.sse(c) = r.sse;
+    out.sse_w += r.sse * cx.weight(c);
+    if (pred != nullptr) {
+      for (int i = 0; i < cx.n; ++i) {
+        feat(i, c, x.data());
+        double v = 0.0;
+        for (int j = 0; j < p; ++j) v += r.beta(j) * x[static_cast<std::size_t>(j)];
+        (*pred)(i, c) = v;
+      }
+    }
+  }
+  return out;
+}
+
+/// σ of parameter j of channel c from its unit covariance and the channel's residual variance.
+double ParamSigma(const Context& cx, const ChannelFit& f, int c, int j);
+/// Uncertainty of a nonlinear parameter from the curvature of the profile SSE (whitened, so
+/// Δχ² = 1 at one σ): σ = sqrt(2 / f'').
+double CurvatureSigma(const std::function<double(double)>& f, double x, double h);
+nlohmann::json JsonNum(double v);
+nlohmann::json VecJson(const Vec& v);
+/// Puts coefficient j of every channel and its σ into e.params[key] / e.sigma[key]; returns it.
+Vec PutChannelCoef(const Context& cx, const ChannelFit& f, int j, const char* key, EffectFit* e);
+/// Whitened training SSE of a one-coefficient-per-channel fit of `feature` (n × N), on every
+/// search_stride-th row and scaled back to the full count: the objective of parameter searches.
+double SearchSse(const Context& cx, const Mat& target, const Mat& feature);
+/// Channel whose prediction carries the largest whitened energy.
+int DominantChannel(const Context& cx, const Mat& pred);
+/// Channels carrying at least `share` of the prediction's whitened energy.
+std::vector<int> ActiveChannels(const Context& cx, const Mat& pred, double share = 0.02);
+/// Channels whose single coefficient is significant (|β|/σ > 5) and carries ≥ 5 % of the energy
+/// explained across channels.
+std::vector<int> SignificantChannels(const Context& cx, const ChannelFit& f, const Mat& pred,
+                                     int j);
+std::string ChannelList(const std::vector<int>& ch);
+nlohmann::json IntList(const std::vector<int>& ch);
+double RowCorr(const Context& cx, const Mat& target, const Mat& pred, int c);
+
+// Hat (linear B-spline) basis in time with k intervals: row i → (index, fraction).
+struct HatBasis {
+  double t0 = 0.0;
+  double h = 1.0;
+  int k = 1;
+  void At(double t, int* idx, double* frac) const {
+    double u = (t - t0) / h;
+    int j = static_cast<int>(std::floor(u));
+    if (j < 0) j = 0;
+    if (j >= k) j = k - 1;
+    *idx = j;
+    *frac = std::clamp(u - j, 0.0, 1.0);
+  }
+};
+
+HatBasis MakeHat(const Context& cx, int k);
+
+/// Restart flags of the context's segments for the filters (nullptr for one recording).
+const std::uint8_t* Restarts(const Context& cx);
+
+// The effect models (one family per file of diagnosis/effects/).
+std::optional<EffectFit> FitZeroOffset(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitZeroDrift(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitThermalZeroPlain(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitThermalSpan(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitExcitation(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitGainError(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitBridgeNonlinearity(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitGeometric(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitLoadStiffening(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitMisalignment(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitTimeSkew(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitSaturation(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitOverloadShift(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitMains(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target);
+
+}  // namespace ftstack::diag::fx

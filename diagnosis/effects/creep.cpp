@@ -1,0 +1,93 @@
+// creep: a first-order lag of each bridge's load, τ searched.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <vector>
+
+#include "diagnosis/effects/common.hpp"
+#include "diagnosis/signal.hpp"
+
+namespace ftstack::diag::fx {
+
+std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
+  const auto& d = *cx.data;
+  const double duration = d.t_s.back() - d.t_s.front();
+  Mat lp(cx.n, cx.nc);
+  std::vector<const double*> in_cols;
+  std::vector<double*> out_cols;
+  for (int c = 0; c < cx.nc; ++c) {
+    in_cols.push_back(cx.load.col(c).data());
+    out_cols.push_back(lp.col(c).data());
+  }
+  auto build = [&](double tau) {
+    FirstOrderLowPassColumns(d.t_s.data(), static_cast<std::size_t>(cx.n), tau, in_cols.data(),
+                             out_cols.data(), in_cols.size(), Restarts(cx));
+  };
+  auto sse_for = [&](double log_tau, bool gamma) {
+    build(std::exp(log_tau));
+    const int st = cx.search_stride;
+    if (gamma) {
+      return FitChannels(
+                 cx, target, 2,
+                 [&](int i, int c, double* x) {
+                   x[0] = lp(i, c);
+                   x[1] = cx.load(i, c);
+                 },
+                 nullptr, nullptr, st)
+                 .sse_w *
+             st;
+    }
+    return SearchSse(cx, target, lp);
+  };
+  std::vector<double> grid;
+  const double lo = std::log(std::max(3.0 * cx.dt, 0.2));
+  const double hi = std::log(std::max(duration, 1.0));
+  for (int j = 0; j <= 12; ++j) grid.push_back(lo + (hi - lo) * j / 12.0);
+  EffectFit best;
+  double best_bic = std::numeric_limits<double>::infinity();
+  // τ is searched with the plain model; the variant with a gain term reuses it.
+  const double lt = MinimizeOnGrid([&](double v) { return sse_for(v, false); }, grid, 12, nullptr);
+  for (bool gamma : {false, true}) {
+    const int p = cx.nc * (gamma ? 2 : 1) + 1;
+    EffectFit e;
+    e.name = "creep";
+    e.variant = gamma ? "first-order creep with a gain term" : "first-order creep";
+    e.n_params = p;
+    const double tau = std::exp(lt);
+    const double sl = CurvatureSigma([&](double v) { return sse_for(v, gamma); }, lt, 0.02);
+    build(tau);
+    ChannelFit f;
+    if (gamma) {
+      f = FitChannels(
+          cx, target, 2,
+          [&](int i, int c, double* x) {
+            x[0] = lp(i, c);
+            x[1] = cx.load(i, c);
+          },
+          &e.pred);
+    } else {
+      f = FitChannels(
+          cx, target, 1, [&](int i, int c, double* x) { x[0] = lp(i, c); }, &e.pred);
+    }
+    e.train_sse_w = f.sse_w;
+    const double bic = f.sse_w + p * Penalty(cx);
+    if (bic >= best_bic) continue;
+    best_bic = bic;
+    e.params["tau_s"] = tau;
+    e.sigma["tau_s"] = JsonNum(tau * sl);
+    PutChannelCoef(cx, f, 0, "fraction", &e);
+    best = std::move(e);
+  }
+  best.channels = ActiveChannels(cx, best.pred);
+  const int c = DominantChannel(cx, best.pred);
+  best.evidence =
+      Fmt("during load holds b%d keeps moving toward a new value with τ = %.1f s (%.2f %% of the "
+          "load) and recovers after unloading, r = %.2f",
+          c, best.params["tau_s"].get<double>(),
+          100.0 * best.params["fraction"][static_cast<std::size_t>(c)].get<double>(),
+          RowCorr(cx, target, best.pred, c));
+  return best;
+}
+
+}  // namespace ftstack::diag::fx

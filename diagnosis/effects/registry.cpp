@@ -1,0 +1,45 @@
+// The effect vocabulary: name → fit function, in spec order.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <vector>
+
+#include "diagnosis/effects/common.hpp"
+#include "diagnosis/signal.hpp"
+
+namespace ftstack::diag {
+
+using namespace fx;  // NOLINT(google-build-using-namespace): the effects' private helpers
+
+const std::vector<EffectSpec>& Effects() {
+  static const std::vector<EffectSpec> kEffects = {
+      {"zero_offset", &FitZeroOffset},
+      {"zero_drift", &FitZeroDrift},
+      {"thermal_zero_drift", &FitThermalZeroPlain},
+      {"thermal_span_drift", &FitThermalSpan},
+      {"excitation_drift", &FitExcitation},
+      {"creep", &FitCreep},
+      {"hysteresis", &FitHysteresisFamily},
+      {"bridge_nonlinearity", &FitBridgeNonlinearity},
+      {"geometric_nonlinearity", &FitGeometric},
+      {"load_stiffening", &FitLoadStiffening},
+      {"misalignment", &FitMisalignment},
+      {"gain_error", &FitGainError},
+      {"time_skew", &FitTimeSkew},
+      {"saturation", &FitSaturation},
+      {"overload_shift", &FitOverloadShift},
+      {"mains_interference", &FitMains},
+      {"resonance", &FitResonance},
+  };
+  return kEffects;
+}
+
+const EffectSpec* FindEffect(const std::string& name) {
+  for (const auto& e : Effects()) {
+    if (name == e.name) return &e;
+  }
+  return nullptr;
+}
+
+}  // namespace ftstack::diag
