@@ -8,56 +8,6 @@
 
 namespace ftstack::diag {
 
-std::size_t WelchSegment(std::size_t n) {
-  std::size_t seg = 1024;
-  while (seg > 32 && seg * 8 > n) seg /= 2;
-  return seg;
-}
-
-Spectrum Welch(const double* x, std::size_t n, double rate_hz, std::size_t segment) {
-  Spectrum s;
-  if (segment < 8 || n < segment) return s;
-  const std::size_t half = segment / 2;
-  std::vector<double> win(segment);
-  double wsum2 = 0.0;
-  for (std::size_t j = 0; j < segment; ++j) {
-    win[j] =
-        0.5 - 0.5 * std::cos(2.0 * M_PI * static_cast<double>(j) / static_cast<double>(segment));
-    wsum2 += win[j] * win[j];
-  }
-  s.power.assign(half + 1, 0.0);
-  s.freq_hz.resize(half + 1);
-  for (std::size_t k = 0; k <= half; ++k) {
-    s.freq_hz[k] = static_cast<double>(k) * rate_hz / static_cast<double>(segment);
-  }
-  Eigen::FFT<double> fft;
-  std::vector<double> buf(segment);
-  std::vector<std::complex<double>> out;
-  // Linear-trend removal: least squares line over j = 0…seg-1.
-  const double jm = (static_cast<double>(segment) - 1.0) / 2.0;
-  double sjj = 0.0;
-  for (std::size_t j = 0; j < segment; ++j)
-    sjj += (static_cast<double>(j) - jm) * (static_cast<double>(j) - jm);
-  for (std::size_t start = 0; start + segment <= n; start += half) {
-    double mean = 0.0;
-    double sj = 0.0;
-    for (std::size_t j = 0; j < segment; ++j) {
-      mean += x[start + j];
-      sj += (static_cast<double>(j) - jm) * x[start + j];
-    }
-    mean /= static_cast<double>(segment);
-    const double slope = sj / sjj;
-    for (std::size_t j = 0; j < segment; ++j) {
-      buf[j] = (x[start + j] - mean - slope * (static_cast<double>(j) - jm)) * win[j];
-    }
-    fft.fwd(out, buf);
-    for (std::size_t k = 0; k <= half; ++k) s.power[k] += std::norm(out[k]);
-    ++s.segments;
-  }
-  for (auto& p : s.power) p /= static_cast<double>(s.segments) * wsum2;
-  return s;
-}
-
 double RobustNoise(const double* x, std::size_t n, double rate_hz) {
   const std::size_t seg = WelchSegment(n);
   if (n < seg || seg < 32) {
@@ -246,16 +196,6 @@ void DahlOperator(const double* x, std::size_t n, double width, double* z) {
   }
 }
 
-void PlayOperator(const double* x, std::size_t n, double width, double* z) {
-  if (n == 0) return;
-  double p = x[0];
-  const double h = 0.5 * width;
-  for (std::size_t i = 0; i < n; ++i) {
-    p = std::clamp(p, x[i] - h, x[i] + h);
-    z[i] = (p - x[i]) / h;
-  }
-}
-
 double InterpolateAt(const double* t, const double* x, std::size_t n, double tq, bool uniform) {
   return InterpolateNear(t, x, n, tq, uniform, n);
 }
@@ -291,54 +231,6 @@ double InterpolateNear(const double* t, const double* x, std::size_t n, double t
   return p1 + 0.5 * u *
                   (p2 - p0 +
                    u * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + u * (3.0 * (p1 - p2) + p3 - p0)));
-}
-
-double MinimizeOnGrid(const std::function<double(double)>& f, const std::vector<double>& grid,
-                      int golden_iterations, double* fmin) {
-  double best = std::numeric_limits<double>::infinity();
-  std::size_t bi = 0;
-  for (std::size_t i = 0; i < grid.size(); ++i) {
-    const double v = f(grid[i]);
-    if (v < best) {
-      best = v;
-      bi = i;
-    }
-  }
-  double a = grid[bi > 0 ? bi - 1 : bi];
-  double b = grid[bi + 1 < grid.size() ? bi + 1 : bi];
-  double xbest = grid[bi];
-  if (golden_iterations > 0 && b > a) {
-    const double g = (std::sqrt(5.0) - 1.0) / 2.0;
-    double c = b - g * (b - a);
-    double d = a + g * (b - a);
-    double fc = f(c);
-    double fd = f(d);
-    for (int it = 0; it < golden_iterations; ++it) {
-      if (fc < fd) {
-        b = d;
-        d = c;
-        fd = fc;
-        c = b - g * (b - a);
-        fc = f(c);
-      } else {
-        a = c;
-        c = d;
-        fc = fd;
-        d = a + g * (b - a);
-        fd = f(d);
-      }
-    }
-    if (fc < best) {
-      best = fc;
-      xbest = c;
-    }
-    if (fd < best) {
-      best = fd;
-      xbest = d;
-    }
-  }
-  if (fmin != nullptr) *fmin = best;
-  return xbest;
 }
 
 double Correlation(const double* a, const double* b, std::size_t n) {

@@ -7,19 +7,16 @@
 #include <functional>
 #include <vector>
 
+#include "measurement/numerics.hpp"
+
 namespace ftstack::diag {
 
-/// Welch power spectrum (Hann, 50 % overlap, linear detrend per segment) of x sampled at rate_hz.
-/// power[k] is the mean |X_k|² / Σw² over segments, so white noise of variance σ² gives σ² in
-/// every bin; freq_hz[k] = k·rate/segment for k = 0 … segment/2.
-struct Spectrum {
-  std::vector<double> freq_hz;
-  std::vector<double> power;
-  int segments = 0;
-};
-[[nodiscard]] Spectrum Welch(const double* x, std::size_t n, double rate_hz, std::size_t segment);
-/// The segment length used for a record of n rows: a power of two ≤ 1024 giving ≥ 8 segments.
-[[nodiscard]] std::size_t WelchSegment(std::size_t n);
+// Spectra, the play operator and the 1-D search are the shared numerics (measurement/numerics).
+using numerics::MinimizeOnGrid;
+using numerics::PlayOperator;
+using numerics::Spectrum;
+using numerics::Welch;
+using numerics::WelchSegment;
 
 /// White-noise σ of x from the median Welch level over 5 %…95 % of the Nyquist band (robust to
 /// slow effects and to narrow lines), corrected for the median of the χ² averaging distribution.
@@ -73,10 +70,6 @@ void SecondOrderLowPassColumns(const double* t_s, std::size_t n, double freq_hz,
 /// width: z moves toward sign(dx) by 1 − exp(−|dx|/width) per step; starts at 0. Output in [−1, 1].
 void DahlOperator(const double* x, std::size_t n, double width, double* z);
 
-/// Play (backlash) operator of x with total width `width`, scaled to [−1, 1]: z = 2·(p − x)/width
-/// where p follows x only once x has moved width/2 past it; starts centred.
-void PlayOperator(const double* x, std::size_t n, double width, double* z);
-
 /// Value of a sampled signal at time tq (cubic Catmull-Rom on uniform grids, else linear; clamped
 /// at the ends). t must be increasing.
 [[nodiscard]] double InterpolateAt(const double* t, const double* x, std::size_t n, double tq,
@@ -85,11 +78,6 @@ void PlayOperator(const double* x, std::size_t n, double width, double* z);
 /// clock the interval is walked to from the guess instead of searched, for queries near a row.
 [[nodiscard]] double InterpolateNear(const double* t, const double* x, std::size_t n, double tq,
                                      bool uniform, std::size_t guess);
-
-/// Minimises f over a grid, then refines with golden-section search between the best point's
-/// neighbours. Returns the argument; *fmin receives the value.
-double MinimizeOnGrid(const std::function<double(double)>& f, const std::vector<double>& grid,
-                      int golden_iterations, double* fmin);
 
 /// Pearson correlation of two equally long series.
 [[nodiscard]] double Correlation(const double* a, const double* b, std::size_t n);
