@@ -406,11 +406,13 @@ AtiImport ParseAtiCal(const std::string& text, const std::string& path) {
   if (sensor == nullptr)
     throw CalFileError(path + ":1:1: no <FTSensor> element: not an ATI .cal file");
   if (calib == nullptr) throw CalFileError(Where(path, *sensor) + ": no <Calibration> element");
-  const int n =
-      static_cast<int>(Number(path, *sensor, "NumGages", Attr(path, *sensor, "NumGages")));
-  if (n < 1 || n > static_cast<int>(fw::kMaxChannels)) {
-    throw CalFileError(Where(path, *sensor) + ": NumGages " + std::to_string(n) + " outside 1..8");
+  const std::string& gages = Attr(path, *sensor, "NumGages");
+  const double n_gages = Number(path, *sensor, "NumGages", gages);
+  // Range first: a number beyond int (found by fuzzing) must not reach the conversion.
+  if (!(n_gages >= 1.0 && n_gages < static_cast<double>(fw::kMaxChannels) + 1.0)) {
+    throw CalFileError(Where(path, *sensor) + ": NumGages " + gages + " outside 1..8");
   }
+  const int n = static_cast<int>(n_gages);
   AtiImport imp;
   const auto v = sensor->attrs.find("CalFileVersion");
   imp.version = v != sensor->attrs.end() ? v->second : "1.0";

@@ -347,8 +347,7 @@ std::vector<std::size_t> ArrayElementOffsets(const std::string& text, const std:
   return out;
 }
 
-LoadProfile FromJson(const std::string& path, double duration_s) {
-  const std::string text = ReadText(path);
+LoadProfile KeyframesFromJson(const std::string& text, const std::string& path, double duration_s) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);
@@ -406,6 +405,10 @@ LoadProfile FromJson(const std::string& path, double duration_s) {
   const double t0 = lt.front();
   for (double& t : lt) t -= t0;
   for (double& t : tt) t -= t0;
+  // Finite times can still span more than a double holds (-1e308 … 1e308).
+  if (!std::isfinite(lt.back())) {
+    throw ProfileError(path + ": keyframe times span more than a finite duration");
+  }
   if (tt.empty()) {
     tt.push_back(0.0);
     tc.push_back(20.0);
@@ -516,6 +519,17 @@ void LoadProfile::Splice(double t0_s, double t1_s, const std::vector<double>& t_
   load_ = std::move(nw);
 }
 
+LoadProfile ParseProfileJson(const std::string& text, const std::string& path, double duration_s) {
+  if (!(duration_s >= 0.0) || !std::isfinite(duration_s)) {
+    throw ProfileError("duration must be a finite number >= 0");
+  }
+  try {
+    return KeyframesFromJson(text, path, duration_s);
+  } catch (const nlohmann::json::exception& e) {  // a value of the wrong JSON type anywhere
+    throw ProfileError(path + ": " + e.what());
+  }
+}
+
 LoadProfile MakeProfile(const std::string& spec, const Wrench& rated, std::uint64_t seed,
                         double duration_s) {
   if (!(duration_s >= 0.0) || !std::isfinite(duration_s)) {
@@ -538,11 +552,7 @@ LoadProfile MakeProfile(const std::string& spec, const Wrench& rated, std::uint6
   std::string path = spec;
   if (path.rfind("file:", 0) == 0) path = path.substr(5);
   if (EndsWith(path, ".json")) {
-    try {
-      return FromJson(path, duration_s);
-    } catch (const nlohmann::json::exception& e) {  // a value of the wrong JSON type anywhere
-      throw ProfileError(path + ": " + e.what());
-    }
+    return ParseProfileJson(ReadText(path), path, duration_s);
   }
   if (EndsWith(path, ".csv")) return FromCsv(path, duration_s);
   throw ProfileError("unknown profile '" + spec +

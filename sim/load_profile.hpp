@@ -89,4 +89,9 @@ class LoadProfile {
 [[nodiscard]] LoadProfile MakeProfile(const std::string& spec, const Wrench& rated,
                                       std::uint64_t seed, double duration_s = 0.0);
 
+/// The JSON keyframe form of MakeProfile's PATH from its text; `path` names it in errors
+/// (path:line:column). What MakeProfile does with a .json file after reading it.
+[[nodiscard]] LoadProfile ParseProfileJson(const std::string& text, const std::string& path,
+                                           double duration_s = 0.0);
+
 }  // namespace ftstack::sim

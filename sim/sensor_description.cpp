@@ -19,7 +19,7 @@ using nlohmann::json;
 /// One description text being read: every error names origin:line:column and the JSON pointer.
 class Reader {
  public:
-  Reader(const std::string& text, std::string origin) : origin_(std::move(origin)) {
+  Reader(const std::string& text, std::string origin) : text_(text), origin_(std::move(origin)) {
     try {
       root_ = json::parse(text);
     } catch (const json::parse_error& e) {
@@ -38,11 +38,12 @@ class Reader {
       throw SensorDescriptionError(origin_ + ":" + LineColumnAt(text, at) +
                                    ": number out of range");
     }
-    positions_ = std::make_unique<JsonPositions>(text);
   }
   const json& root() const { return root_; }
 
   [[noreturn]] void Fail(const std::string& ptr, const std::string& msg) const {
+    // Positions are needed only for an error: scanned then, not for every text read.
+    if (!positions_) positions_ = std::make_unique<JsonPositions>(text_);
     throw SensorDescriptionError(origin_ + ":" + positions_->LineColumn(ptr) + ": " + msg +
                                  (ptr.empty() ? "" : " (at " + ptr + ")"));
   }
@@ -119,9 +120,10 @@ class Reader {
   }
 
  private:
+  const std::string& text_;  // outlives the reader (ParseSensorDescription's argument)
   std::string origin_;
   json root_;
-  std::unique_ptr<JsonPositions> positions_;
+  mutable std::unique_ptr<JsonPositions> positions_;
 };
 
 void CheckSchema(const Reader& rd) {

@@ -278,6 +278,17 @@ TEST(AtiImport, MalformedFilesAreRefusedWithPosition) {
   // Found by fuzzing (fuzz/corpus/ati/regression_unclosed_value): a quote swallowed by a
   // malformed attribute name left the next value open; the scanner restarted at 0 forever.
   refused(ReadText(test::TestDataPath("regression/ati_unclosed_value.cal")), "value is not closed");
+  // Found by fuzzing (fuzz/corpus/ati/regression_numgages_beyond_int, 2026-11-25): a NumGages
+  // beyond int reached the conversion to int (undefined behaviour) before its range check.
+  for (const char* big : {"3333333333333333333333333333333333333336", "1e300", "-5e9", "8.9e0"}) {
+    std::string gages = good;
+    gages.replace(gages.find("NumGages=\"6\""), 12, std::string("NumGages=\"") + big + "\"");
+    if (std::string(big) == "8.9e0") {  // the count truncates, as it always did: 8 is in range
+      refused(gages, "values, NumGages says 8");
+    } else {
+      refused(gages, std::string("NumGages ") + big + " outside 1..8");
+    }
+  }
 }
 
 TEST(AtiImport, AppliedToVoltsThroughTheFixedPointCore) {

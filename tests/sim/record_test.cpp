@@ -174,6 +174,22 @@ TEST(RecordProfiles, BadFilesNameTheFaultyPlace) {
   }
   EXPECT_NE(ErrorOf(dir + "/big.json").find("big.json: not valid JSON"), std::string::npos)
       << ErrorOf(dir + "/big.json");
+  // Found by reading the fuzz harness's new check (fuzz/corpus/profile/regression_time_span.json):
+  // finite keyframe times whose span overflows a double were accepted with an infinite duration.
+  const std::string span =
+      R"({"schema": "ftstack-profile/1", "keyframes": [{"t_s": -1e308, "wrench": [0,0,0,0,0,0]},)"
+      R"( {"t_s": 1e308, "wrench": [1,0,0,0,0,0]}]})";
+  { std::ofstream(dir + "/span.json") << span; }
+  EXPECT_NE(ErrorOf(dir + "/span.json").find("span.json: keyframe times span more than a finite"),
+            std::string::npos)
+      << ErrorOf(dir + "/span.json");
+  EXPECT_THROW((void)ftstack::sim::ParseProfileJson(span, "span.json"), ftstack::sim::ProfileError);
+  // The largest span a double holds is still accepted, with that duration.
+  const ftstack::sim::LoadProfile wide = ftstack::sim::ParseProfileJson(
+      R"({"schema": "ftstack-profile/1", "keyframes": [{"t_s": -8e307, "wrench": [0,0,0,0,0,0]},)"
+      R"( {"t_s": 8e307, "wrench": [1,0,0,0,0,0]}]})",
+      "wide.json");
+  EXPECT_DOUBLE_EQ(wide.duration_s(), 1.6e308);
   { std::ofstream(dir + "/type.json") << "{\"schema\": 1, \"keyframes\": []}"; }
   EXPECT_NE(ErrorOf(dir + "/type.json").find("schema is not"), std::string::npos)
       << ErrorOf(dir + "/type.json");
