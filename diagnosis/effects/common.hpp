@@ -153,6 +153,11 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Mat& target);
 std::optional<EffectFit> FitSaturation(const Context& cx, const Mat& target);
 std::optional<EffectFit> FitOverloadShift(const Context& cx, const Mat& target);
 std::optional<EffectFit> FitMains(const Context& cx, const Mat& target);
+/// Adds harmonics 2..5 of the fitted mains fundamental f0 to *e (effects/mains_family.cpp): each
+/// at h·f0 or, above Nyquist, at its alias, kept when it lowers the training SSE by more than the
+/// BIC penalty of its 2 coefficients per channel; refits pred jointly with the fundamental and
+/// puts h<k>_amplitude_mvv (σ) and h<k>_seen_at_hz. Returns a clause for the evidence.
+std::string AddMainsHarmonics(const Context& cx, const Mat& target, double f0, EffectFit* e);
 std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target);
 
 }  // namespace ftstack::diag::fx

@@ -46,6 +46,51 @@ ChannelFit FitTwo(const Context& cx, const Mat& target, const Mat& lp1, const Ma
       pred, nullptr, st);
 }
 
+/// Coarse 2-D search of (log τ1 < log τ2) over pairs of a 13-point log grid on [lo, hi]: every grid
+/// τ filtered once (into buf) and only its strided training rows kept, so every pair costs a 2 × 2
+/// solve per channel on those rows.
+void CoarsePair(const Context& cx, const Mat& target, double lo, double hi, Mat* buf, double* l1,
+                double* l2) {
+  const int st = cx.search_stride;
+  std::vector<double> grid;
+  for (int j = 0; j <= 12; ++j) grid.push_back(lo + (hi - lo) * j / 12.0);
+  std::vector<int> rows;
+  for (int i = 0; i < cx.n; i += st) {
+    if (cx.train[static_cast<std::size_t>(i)]) rows.push_back(i);
+  }
+  const auto m = static_cast<Eigen::Index>(rows.size());
+  std::vector<Mat> g(grid.size(), Mat(m, cx.nc));
+  for (std::size_t j = 0; j < grid.size(); ++j) {
+    LowPassLoad(cx, std::exp(grid[j]), buf);
+    for (Eigen::Index r = 0; r < m; ++r) g[j].row(r) = buf->row(rows[static_cast<std::size_t>(r)]);
+  }
+  Mat y(m, cx.nc);
+  for (Eigen::Index r = 0; r < m; ++r) y.row(r) = target.row(rows[static_cast<std::size_t>(r)]);
+  double coarse = std::numeric_limits<double>::infinity();
+  for (std::size_t j1 = 0; j1 < grid.size(); ++j1) {
+    for (std::size_t j2 = j1 + 1; j2 < grid.size(); ++j2) {
+      double sse = 0.0;
+      for (int c = 0; c < cx.nc; ++c) {
+        Eigen::Matrix2d a;
+        Eigen::Vector2d b;
+        const auto x1 = g[j1].col(c);
+        const auto x2 = g[j2].col(c);
+        const auto yc = y.col(c);
+        a << x1.squaredNorm(), x1.dot(x2), x1.dot(x2), x2.squaredNorm();
+        b << x1.dot(yc), x2.dot(yc);
+        a.diagonal().array() += 1e-12 * (a.trace() + 1e-300);
+        const Eigen::Vector2d beta = a.ldlt().solve(b);
+        sse += std::max(0.0, yc.squaredNorm() - beta.dot(b)) * cx.weight(c);
+      }
+      if (sse < coarse) {
+        coarse = sse;
+        *l1 = grid[j1];
+        *l2 = grid[j2];
+      }
+    }
+  }
+}
+
 }  // namespace
 
 void CreepOimlR60(const Context& cx, const std::vector<double>& tau,
@@ -119,7 +164,10 @@ bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double b
                  ChannelFit* best_f, bool* best_gamma) {
   const double duration = cx.data->t_s.back() - cx.data->t_s.front();
   const double lo = std::log(std::max(3.0 * cx.dt, 0.2));
-  const double hi = std::log(std::max(duration, 1.0));
+  // A second time constant longer than a third of the record cannot be told from a drift or an
+  // offset over the record (seen with zero_offset + creep): the pair search stops there.
+  const double hi = std::log(std::max(duration / 3.0, 1.0));
+  if (hi - lo < 1.0) return false;
   const int st = cx.search_stride;
   Mat lp1(cx.n, cx.nc);
   Mat lp2(cx.n, cx.nc);
@@ -133,46 +181,7 @@ bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double b
     LowPassLoad(cx, std::exp(v), &lp1);
     return FitTwo(cx, target, lp1, lp2, false, nullptr, st).sse_w * st;
   };
-  // Coarse 2-D search over pairs of a 13-point log grid: each grid τ filtered once, only its
-  // strided training rows kept, so every pair costs a 2 × 2 solve per channel on those rows.
-  std::vector<double> grid;
-  for (int j = 0; j <= 12; ++j) grid.push_back(lo + (hi - lo) * j / 12.0);
-  std::vector<int> rows;
-  for (int i = 0; i < cx.n; i += st) {
-    if (cx.train[static_cast<std::size_t>(i)]) rows.push_back(i);
-  }
-  const auto m = static_cast<Eigen::Index>(rows.size());
-  std::vector<Mat> g(grid.size(), Mat(m, cx.nc));
-  for (std::size_t j = 0; j < grid.size(); ++j) {
-    LowPassLoad(cx, std::exp(grid[j]), &lp2);
-    for (Eigen::Index r = 0; r < m; ++r) g[j].row(r) = lp2.row(rows[static_cast<std::size_t>(r)]);
-  }
-  Mat y(m, cx.nc);
-  for (Eigen::Index r = 0; r < m; ++r) y.row(r) = target.row(rows[static_cast<std::size_t>(r)]);
-  double coarse = std::numeric_limits<double>::infinity();
-  for (std::size_t j1 = 0; j1 < grid.size(); ++j1) {
-    for (std::size_t j2 = j1 + 1; j2 < grid.size(); ++j2) {
-      double sse = 0.0;
-      for (int c = 0; c < cx.nc; ++c) {
-        Eigen::Matrix2d a;
-        Eigen::Vector2d b;
-        const auto x1 = g[j1].col(c);
-        const auto x2 = g[j2].col(c);
-        const auto yc = y.col(c);
-        a << x1.squaredNorm(), x1.dot(x2), x1.dot(x2), x2.squaredNorm();
-        b << x1.dot(yc), x2.dot(yc);
-        a.diagonal().array() += 1e-12 * (a.trace() + 1e-300);
-        const Eigen::Vector2d beta = a.ldlt().solve(b);
-        sse += std::max(0.0, yc.squaredNorm() - beta.dot(b)) * cx.weight(c);
-      }
-      if (sse < coarse) {
-        coarse = sse;
-        l1 = grid[j1];
-        l2 = grid[j2];
-      }
-    }
-  }
-  g.clear();
+  CoarsePair(cx, target, lo, hi, &lp2, &l1, &l2);
   // Refinement: τ2 with τ1 held, τ1 with τ2 held, τ2 again (golden section between neighbours).
   const double step = (hi - lo) / 12.0;
   auto around = [&](double v, double other) {

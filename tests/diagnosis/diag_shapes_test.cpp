@@ -375,5 +375,100 @@ TEST(DiagShapes, OneTimeConstantCreepIsNotGivenTwo) {
   ExpectOimlMatches(f, tau, fr);
 }
 
+/// Mains pick-up off its nominal frequency with harmonics (6 bridges, 400 Hz, 150 s): random load
+/// steps every 5 s; every bridge adds Σ_h A_h,c·sin(2π·h·f0·t + φ_h,c) for the harmonics h of
+/// `amp_mvv` (index 0 = fundamental) with per-bridge scale 0.6–1.0 and random phases. Noise
+/// σ = 1e-3 mV/V. At 400 Hz the 5th harmonic of 50.4 Hz (252 Hz) lies above Nyquist.
+DiagData MainsWithHarmonics(double f0, const std::vector<double>& amp_mvv, unsigned seed,
+                            std::vector<std::vector<double>>* true_amp) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const int nc = 6;
+  Eigen::MatrixXd s(nc, 6);
+  for (int c = 0; c < nc; ++c) {
+    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
+  }
+  true_amp->assign(amp_mvv.size(), std::vector<double>(nc));
+  std::vector<std::vector<double>> phase(amp_mvv.size(), std::vector<double>(nc));
+  for (std::size_t h = 0; h < amp_mvv.size(); ++h) {
+    for (int c = 0; c < nc; ++c) {
+      (*true_amp)[h][c] = amp_mvv[h] * (0.8 + 0.2 * u(rng));
+      phase[h][c] = M_PI * u(rng);
+    }
+  }
+  const double dt = 1.0 / 400.0;
+  const Eigen::Index n = 60000;
+  DiagData d;
+  d.sim_name = "independent generator";
+  d.real_name = "mains with harmonics";
+  d.sim_mvv.resize(n, nc);
+  d.real_mvv.resize(n, nc);
+  d.wrench.resize(n, 6);
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(6);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) * dt;
+    if (i % 2000 == 0) {
+      for (int a = 0; a < 6; ++a) w(a) = 40.0 * u(rng);
+    }
+    d.t_s.push_back(t);
+    d.wrench.row(i) = w.transpose();
+    const Eigen::VectorXd b = s * w;
+    for (int c = 0; c < nc; ++c) {
+      double hum = 0.0;
+      for (std::size_t h = 0; h < amp_mvv.size(); ++h) {
+        hum += (*true_amp)[h][c] *
+               std::sin(2.0 * M_PI * static_cast<double>(h + 1) * f0 * t + phase[h][c]);
+      }
+      d.sim_mvv(i, c) = b(c);
+      d.real_mvv(i, c) = b(c) + hum + 1e-3 * g(rng);
+    }
+  }
+  return d;
+}
+
+TEST(DiagShapes, MainsOffNominalWithHarmonicsIncludingAnAliasedOne) {
+  // 50.4 Hz (0.8 % off nominal); harmonics 2 and 5 present, 3 and 4 absent; the 5th (252 Hz) is
+  // seen at 400 − 252 = 148 Hz.
+  const double f0 = 50.4;
+  std::vector<std::vector<double>> amp;
+  const DiagData d = MainsWithHarmonics(f0, {0.01, 0.004, 0.0, 0.0, 0.003}, 5, &amp);
+  const Report r = Diagnose(d);
+  ASSERT_FALSE(r.effects.empty());
+  EXPECT_EQ(r.verdict, "mains_interference") << ToJson(r)["candidates"].dump();
+  const EffectFit& f = r.effects.front().fit;
+  EXPECT_EQ(f.variant, "mains fundamental with harmonics");
+  EXPECT_NEAR(f.params["freq_hz"].get<double>(), f0, 0.05);
+  ASSERT_TRUE(f.params.contains("h2_amplitude_mvv")) << f.params.dump();
+  ASSERT_TRUE(f.params.contains("h5_amplitude_mvv")) << f.params.dump();
+  EXPECT_FALSE(f.params.contains("h3_amplitude_mvv")) << f.params.dump();
+  EXPECT_FALSE(f.params.contains("h4_amplitude_mvv")) << f.params.dump();
+  EXPECT_NEAR(f.params["h5_seen_at_hz"].get<double>(), 400.0 - 5 * f0, 0.25);
+  for (int c = 0; c < 6; ++c) {
+    EXPECT_NEAR(f.params["amplitude_mvv"][c].get<double>(), amp[0][c], 0.1 * amp[0][c]) << c;
+    EXPECT_NEAR(f.params["h2_amplitude_mvv"][c].get<double>(), amp[1][c], 0.1 * amp[1][c]) << c;
+    EXPECT_NEAR(f.params["h5_amplitude_mvv"][c].get<double>(), amp[4][c], 0.1 * amp[4][c]) << c;
+  }
+  EXPECT_NE(f.evidence.find("above Nyquist"), std::string::npos) << f.evidence;
+  std::printf(
+      "mains: %s, f %.4f ± %.2g Hz (true %.2f), b0 h1/h2/h5 %.4g/%.4g/%.4g mV/V (true "
+      "%.4g/%.4g/%.4g); %s\n",
+      f.variant.c_str(), f.params["freq_hz"].get<double>(), f.sigma["freq_hz"].get<double>(), f0,
+      f.params["amplitude_mvv"][0].get<double>(), f.params["h2_amplitude_mvv"][0].get<double>(),
+      f.params["h5_amplitude_mvv"][0].get<double>(), amp[0][0], amp[1][0], amp[4][0],
+      f.evidence.c_str());
+}
+
+TEST(DiagShapes, PureMainsLineIsNotGivenHarmonics) {
+  std::vector<std::vector<double>> amp;
+  const DiagData d = MainsWithHarmonics(59.7, {0.01}, 6, &amp);
+  const Report r = Diagnose(d);
+  ASSERT_FALSE(r.effects.empty());
+  EXPECT_EQ(r.verdict, "mains_interference");
+  const EffectFit& f = r.effects.front().fit;
+  EXPECT_EQ(f.variant, "mains fundamental") << f.params.dump();
+  EXPECT_NEAR(f.params["freq_hz"].get<double>(), 59.7, 0.05);
+}
+
 }  // namespace
 }  // namespace ftstack::diag
