@@ -56,6 +56,8 @@ struct EffectFit {
   nlohmann::json params = nlohmann::json::object();
   nlohmann::json sigma = nlohmann::json::object();  ///< 1-σ uncertainty of params (same keys)
   std::vector<int> channels;                        ///< channels the effect acts on
+  /// Figures in a standard's terms computed from the fitted shape, by standard (e.g. "oiml_r60").
+  nlohmann::json standard = nlohmann::json::object();
   std::string evidence;
   double train_sse_w = 0.0;  ///< whitened training SSE after the fit
 };

@@ -33,6 +33,7 @@ nlohmann::json ToJson(const Report& r) {
     ej["channels"] = e.fit.channels;
     ej["params"] = e.fit.params;
     ej["uncertainty"] = e.fit.sigma;
+    if (!e.fit.standard.empty()) ej["standard"] = e.fit.standard;
     ej["evidence"] = e.fit.evidence;
     ej["rms_after"] = vec(e.rms_after);
     ej["holdout"] = {{"rms_before", e.hold_rms_before}, {"rms_after", e.hold_rms_after}};

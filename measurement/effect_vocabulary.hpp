@@ -90,6 +90,11 @@ inline constexpr std::array kCreep = {
     P{"tau_s", T::kNumber, "s", "first-order creep time constant", kBoth, ""},
     P{"fraction", T::kNumber, "", "share of a load change that creeps in (report: per channel)",
       kBoth, ""},
+    P{"tau1_s", T::kNumber, "s", "shorter time constant (two-time-constant variant)", kReported,
+      ""},
+    P{"tau2_s", T::kNumber, "s", "longer time constant (two-time-constant variant)", kReported, ""},
+    P{"fraction1", T::kNumber, "", "share creeping in with tau1_s, per channel", kReported, ""},
+    P{"fraction2", T::kNumber, "", "share creeping in with tau2_s, per channel", kReported, ""},
     kChannels};
 inline constexpr std::array kHysteresis = {
     P{"amplitude", T::kNumber, "", "loop size as a fraction of rated load", kInjected, ""},

@@ -132,6 +132,18 @@ std::optional<EffectFit> FitThermalZeroPlain(const Context& cx, const Mat& targe
 std::optional<EffectFit> FitThermalSpan(const Context& cx, const Mat& target);
 std::optional<EffectFit> FitExcitation(const Context& cx, const Mat& target);
 std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target);
+/// creep with two time constants τ1 < τ2 (effects/creep_family.cpp): τ2 searched with τ1 at the
+/// one-τ optimum `log_tau1`, then τ1 and τ2 refined in turn; replaces *best (and fills tau,
+/// tau_sigma, the channel fit and whether a gain term is in it) only when its training BIC is
+/// below `best_bic`. Returns whether it did.
+bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double best_bic,
+                 EffectFit* best, std::vector<double>* tau, std::vector<double>* tau_sigma,
+                 ChannelFit* best_f, bool* best_gamma);
+/// The fitted creep model (time constants tau, channel fit f with a_k per τ then γ when `gamma`)
+/// in OIML R 60's terms: e->standard["oiml_r60"] (docs/spec/diagnosis.md).
+void CreepOimlR60(const Context& cx, const std::vector<double>& tau,
+                  const std::vector<double>& tau_sigma, const ChannelFit& f, bool gamma,
+                  EffectFit* e);
 std::optional<EffectFit> FitGainError(const Context& cx, const Mat& target);
 std::optional<EffectFit> FitBridgeNonlinearity(const Context& cx, const Mat& target);
 std::optional<EffectFit> FitGeometric(const Context& cx, const Mat& target);
@@ -141,6 +153,11 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Mat& target);
 std::optional<EffectFit> FitSaturation(const Context& cx, const Mat& target);
 std::optional<EffectFit> FitOverloadShift(const Context& cx, const Mat& target);
 std::optional<EffectFit> FitMains(const Context& cx, const Mat& target);
+/// Adds harmonics 2..5 of the fitted mains fundamental f0 to *e (effects/mains_family.cpp): each
+/// at h·f0 or, above Nyquist, at its alias, kept when it lowers the training SSE by more than the
+/// BIC penalty of its 2 coefficients per channel; refits pred jointly with the fundamental and
+/// puts h<k>_amplitude_mvv (σ) and h<k>_seen_at_hz. Returns a clause for the evidence.
+std::string AddMainsHarmonics(const Context& cx, const Mat& target, double f0, EffectFit* e);
 std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target);
 
 }  // namespace ftstack::diag::fx

@@ -45,6 +45,8 @@ std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
   const double hi = std::log(std::max(duration, 1.0));
   for (int j = 0; j <= 12; ++j) grid.push_back(lo + (hi - lo) * j / 12.0);
   EffectFit best;
+  ChannelFit best_f;
+  bool best_gamma = false;
   double best_bic = std::numeric_limits<double>::infinity();
   // τ is searched with the plain model; the variant with a gain term reuses it.
   const double lt = MinimizeOnGrid([&](double v) { return sse_for(v, false); }, grid, 12, nullptr);
@@ -78,9 +80,27 @@ std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
     e.sigma["tau_s"] = JsonNum(tau * sl);
     PutChannelCoef(cx, f, 0, "fraction", &e);
     best = std::move(e);
+    best_f = f;
+    best_gamma = gamma;
   }
+  std::vector<double> tau{std::exp(lt)};
+  std::vector<double> tau_sigma{best.sigma["tau_s"].is_number() ? best.sigma["tau_s"].get<double>()
+                                                                : 0.0};
+  const bool two =
+      FitCreepTwo(cx, target, lt, best_bic, &best, &tau, &tau_sigma, &best_f, &best_gamma);
+  CreepOimlR60(cx, tau, tau_sigma, best_f, best_gamma, &best);
   best.channels = ActiveChannels(cx, best.pred);
   const int c = DominantChannel(cx, best.pred);
+  if (two) {
+    const auto k = static_cast<std::size_t>(c);
+    best.evidence =
+        Fmt("during load holds b%d keeps moving toward a new value along two exponentials, τ1 = "
+            "%.1f s (%.2f %% of the load) and τ2 = %.1f s (%.2f %%), and recovers after "
+            "unloading, r = %.2f",
+            c, tau[0], 100.0 * best.params["fraction1"][k].get<double>(), tau[1],
+            100.0 * best.params["fraction2"][k].get<double>(), RowCorr(cx, target, best.pred, c));
+    return best;
+  }
   best.evidence =
       Fmt("during load holds b%d keeps moving toward a new value with τ = %.1f s (%.2f %% of the "
           "load) and recovers after unloading, r = %.2f",

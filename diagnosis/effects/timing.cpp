@@ -125,11 +125,14 @@ std::optional<EffectFit> FitMains(const Context& cx, const Mat& target) {
   Vec amp(cx.nc);
   for (int c = 0; c < cx.nc; ++c) amp(c) = std::hypot(cf.beta(0, c), cf.beta(1, c));
   e.params["amplitude_mvv"] = VecJson(amp);
+  e.variant = "mains fundamental";
+  const std::string harmonics = AddMainsHarmonics(cx, target, best_f, &e);
   e.channels = ActiveChannels(cx, e.pred);
   const int c = DominantChannel(cx, e.pred);
-  e.evidence = Fmt(
-      "a steady line at %.3f Hz on %s, %.3g mV/V (%.1f σ) on b%d, present at every load and time",
-      best_f, ChannelList(e.channels).c_str(), amp(c), amp(c) / cx.sigma(c), c);
+  e.evidence = Fmt("a steady line at %.3f Hz on %s, %.3g mV/V (%.1f σ) on b%d, present at every "
+                   "load and time",
+                   best_f, ChannelList(e.channels).c_str(), amp(c), amp(c) / cx.sigma(c), c) +
+               harmonics;
   return e;
 }
 

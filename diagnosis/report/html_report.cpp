@@ -52,6 +52,8 @@ std::string UnitOf(const std::string& key, const std::string& effect) {
   if (ends("_deg")) return "°";
   if (ends("_mvv") || key == "offset" || key == "limit") return "mV/V";
   if (key == "coef_per_K") return effect == "thermal_span_drift" ? "1/K" : "mV/V per K";
+  if (effect == "creep" && (key == "amplitude" || key.rfind("fraction", 0) == 0))
+    return "1 (of the load output)";
   return "";
 }
 
@@ -74,6 +76,30 @@ std::string ParamTable(const EffectFit& f) {
     const std::string sigma = f.sigma.contains(key) ? Cell(f.sigma[key]) : "—";
     h += "<tr><td>" + Esc(key) + "</td><td>" + Cell(value) + "</td><td>" + sigma + "</td><td>" +
          Esc(UnitOf(key, f.name)) + "</td></tr>";
+  }
+  return h + "</table>";
+}
+
+/// Figures in a standard's terms (EffectFit::standard) as a table: figure, value, 1-σ, unit.
+std::string StandardTable(const EffectFit& f) {
+  if (!f.standard.contains("oiml_r60")) return "";
+  const auto& o = f.standard["oiml_r60"];
+  struct Row {
+    const char* key;
+    const char* label;
+  };
+  const Row rows[] = {
+      {"creep_30min_pct", "OIML R 60 creep (30 min)"},
+      {"creep_20_30min_pct", "OIML R 60 creep between 20 and 30 min"},
+      {"dead_load_return_pct", "minimum dead-load output return (30 min after unloading)"}};
+  std::string h = "<p>In OIML R 60's terms (load cells), per bridge, from the fitted model: " +
+                  Esc(o.value("load", "")) +
+                  ".</p><table><tr><th>figure</th><th>value</th><th>± 1σ</th><th>unit</th></tr>";
+  for (const auto& row : rows) {
+    if (!o.contains(row.key)) continue;
+    const auto& u = o["uncertainty"];
+    h += std::string("<tr><td>") + row.label + "</td><td>" + Cell(o[row.key]) + "</td><td>" +
+         (u.contains(row.key) ? Cell(u[row.key]) : "—") + "</td><td>% of the load output</td></tr>";
   }
   return h + "</table>";
 }
@@ -391,7 +417,7 @@ std::string HtmlReport(const DiagData& data, const Report& r) {
     h += "<h2>" + Esc(e.fit.name) + "</h2><p class=\"ev\">" + Esc(e.fit.evidence) +
          "</p><p>Model: " + Esc(e.fit.variant) + " (" + std::to_string(e.fit.n_params) +
          " parameters). Held-out RMS " + Num(e.hold_rms_before) + " → " + Num(e.hold_rms_after) +
-         " mV/V.</p>" + ParamTable(e.fit);
+         " mV/V.</p>" + ParamTable(e.fit) + StandardTable(e.fit);
     if (!e.confounded_with.empty()) {
       h += "<p class=\"conf\"><b>Not identified.</b> " + Esc(e.confounding) +
            " The verdict does not name it.</p>";

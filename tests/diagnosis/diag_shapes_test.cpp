@@ -228,5 +228,247 @@ TEST(DiagShapes, HysteresisInTheLoadPathIsNamedHysteresisAlone) {
               r.hold_rms_after);
 }
 
+/// Creep as a sum of first-order lags of each bridge's load with time constants `tau_s` and
+/// per-bridge fractions `fraction * (0.7 .. 1.0)` (6 bridges, 20 Hz): load holds of 200–600 s,
+/// every other one at zero load so recovery shows (the first too: the diagnosis's creep model,
+/// like a sensor maker's test, starts from a sensor at rest). Each lag state z obeys dz/dt = (load
+/// − z)/τ, integrated with 20 Euler substeps per sample. Noise σ = 1e-3 mV/V. `true_fraction`
+/// receives the fractions per lag and bridge.
+DiagData CreepLags(const std::vector<double>& tau_s, const std::vector<double>& fraction,
+                   double duration_s, unsigned seed,
+                   std::vector<std::vector<double>>* true_fraction) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const int nc = 6;
+  Eigen::MatrixXd s(nc, 6);
+  for (int c = 0; c < nc; ++c) {
+    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
+  }
+  true_fraction->assign(tau_s.size(), std::vector<double>(nc));
+  for (std::size_t k = 0; k < tau_s.size(); ++k) {
+    for (int c = 0; c < nc; ++c) (*true_fraction)[k][c] = fraction[k] * (0.85 + 0.15 * u(rng));
+  }
+  const double dt = 0.05;
+  const auto n = static_cast<Eigen::Index>(duration_s / dt);
+  DiagData d;
+  d.sim_name = "independent generator";
+  d.real_name = "multi-lag creep";
+  d.sim_mvv.resize(n, nc);
+  d.real_mvv.resize(n, nc);
+  d.wrench.resize(n, 6);
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(6);
+  std::vector<std::vector<double>> z(tau_s.size(), std::vector<double>(nc, 0.0));
+  Eigen::Index next = 0;
+  bool loaded = true;  // the first hold is at zero load: the sensor starts at rest
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (i == next) {
+      loaded = !loaded;
+      for (int a = 0; a < 6; ++a) w(a) = loaded ? 40.0 * u(rng) : 0.0;
+      next += static_cast<Eigen::Index>((400.0 + 200.0 * u(rng)) / dt);
+    }
+    const Eigen::VectorXd b = s * w;
+    for (std::size_t k = 0; k < tau_s.size(); ++k) {
+      for (int c = 0; c < nc; ++c) {
+        for (int sub = 0; sub < 20; ++sub) z[k][c] += (b(c) - z[k][c]) * (dt / 20.0) / tau_s[k];
+      }
+    }
+    d.t_s.push_back(static_cast<double>(i) * dt);
+    d.wrench.row(i) = w.transpose();
+    for (int c = 0; c < nc; ++c) {
+      double creep = 0.0;
+      for (std::size_t k = 0; k < tau_s.size(); ++k) creep += (*true_fraction)[k][c] * z[k][c];
+      d.sim_mvv(i, c) = b(c);
+      d.real_mvv(i, c) = b(c) + creep + 1e-3 * g(rng);
+    }
+  }
+  return d;
+}
+
+/// OIML R 60 figures of the generator's true creep on bridge c, in % of the load output: creep
+/// over 30 min after a load step, between 20 and 30 min, and the output 30 min after unloading.
+std::vector<double> TrueOiml(const std::vector<double>& tau_s,
+                             const std::vector<std::vector<double>>& fr, int c) {
+  std::vector<double> v(3, 0.0);
+  for (std::size_t k = 0; k < tau_s.size(); ++k) {
+    const double e30 = std::exp(-1800.0 / tau_s[k]);
+    const double e20 = std::exp(-1200.0 / tau_s[k]);
+    v[0] += 100.0 * fr[k][c] * (1.0 - e30);
+    v[1] += 100.0 * fr[k][c] * (e20 - e30);
+    v[2] += 100.0 * fr[k][c] * (1.0 - e30) * e30;
+  }
+  return v;
+}
+
+/// Checks the report's OIML R 60 figures against the generator's closed form on every bridge:
+/// within 3 σ of the report's own uncertainty or 0.02 percentage points.
+void ExpectOimlMatches(const EffectFit& f, const std::vector<double>& tau_s,
+                       const std::vector<std::vector<double>>& fr) {
+  ASSERT_TRUE(f.standard.contains("oiml_r60")) << f.standard.dump();
+  const auto& o = f.standard["oiml_r60"];
+  const char* keys[3] = {"creep_30min_pct", "creep_20_30min_pct", "dead_load_return_pct"};
+  for (int c = 0; c < 6; ++c) {
+    const auto truth = TrueOiml(tau_s, fr, c);
+    for (int q = 0; q < 3; ++q) {
+      const double got = o[keys[q]][c].get<double>();
+      const double sg = o["uncertainty"][keys[q]][c].get<double>();
+      EXPECT_NEAR(got, truth[q], std::max(3.0 * sg, 0.02)) << keys[q] << " b" << c;
+      if (c == 0) {
+        std::printf("  b0 %s: %.4f ± %.4f %% (true %.4f %%)\n", keys[q], got, sg, truth[q]);
+      }
+    }
+  }
+}
+
+TEST(DiagShapes, TwoTimeConstantCreepIsNamedWithBothTimeConstants) {
+  const std::vector<double> tau{8.0, 400.0};
+  std::vector<std::vector<double>> fr;
+  const DiagData d = CreepLags(tau, {0.02, 0.03}, 3600.0, 3, &fr);
+  const Report r = Diagnose(d);
+  ASSERT_FALSE(r.effects.empty());
+  EXPECT_EQ(r.verdict, "creep") << ToJson(r)["candidates"].dump();
+  const EffectFit& f = r.effects.front().fit;
+  EXPECT_NE(f.variant.find("two-time-constant"), std::string::npos) << f.variant;
+  ASSERT_TRUE(f.params.contains("tau1_s") && f.params.contains("tau2_s")) << f.params.dump();
+  const double t1 = f.params["tau1_s"].get<double>();
+  const double t2 = f.params["tau2_s"].get<double>();
+  EXPECT_NEAR(t1, tau[0], 0.3 * tau[0]);
+  EXPECT_NEAR(t2, tau[1], 0.3 * tau[1]);
+  for (int c = 0; c < 6; ++c) {
+    EXPECT_NEAR(f.params["fraction1"][c].get<double>(), fr[0][c], 0.3 * fr[0][c]) << c;
+    EXPECT_NEAR(f.params["fraction2"][c].get<double>(), fr[1][c], 0.3 * fr[1][c]) << c;
+  }
+  std::printf(
+      "two-τ creep: %s, τ1 %.3g ± %.2g s (true %.3g), τ2 %.4g ± %.2g s (true %.4g), b0 "
+      "fractions %.4f / %.4f (true %.4f / %.4f)\n",
+      f.variant.c_str(), t1, f.sigma["tau1_s"].get<double>(), tau[0], t2,
+      f.sigma["tau2_s"].get<double>(), tau[1], f.params["fraction1"][0].get<double>(),
+      f.params["fraction2"][0].get<double>(), fr[0][0], fr[1][0]);
+  ExpectOimlMatches(f, tau, fr);
+  const std::string html = std::string(FTSTACK_BIN_DIR) + "/../diag_shapes_creep2.html";
+  WriteHtml(html, d, r);
+  std::ifstream in(html);
+  const std::string text((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_NE(text.find("<tr><td>OIML R 60 creep (30 min)</td>"), std::string::npos);
+  EXPECT_NE(text.find("<tr><td>tau2_s</td>"), std::string::npos);
+  EXPECT_TRUE(ToJson(r)["effects"][0].contains("standard"));
+  if (test::HaveChromium()) {
+    EXPECT_TRUE(test::RenderWithChromium(html, html + ".png",
+                                         std::string(FTSTACK_BIN_DIR) + "/../chromium-shapes-creep",
+                                         1000, 1600));
+  }
+}
+
+TEST(DiagShapes, OneTimeConstantCreepIsNotGivenTwo) {
+  const std::vector<double> tau{30.0};
+  std::vector<std::vector<double>> fr;
+  const DiagData d = CreepLags(tau, {0.03}, 3600.0, 4, &fr);
+  const Report r = Diagnose(d);
+  ASSERT_FALSE(r.effects.empty());
+  EXPECT_EQ(r.verdict, "creep") << ToJson(r)["candidates"].dump();
+  const EffectFit& f = r.effects.front().fit;
+  EXPECT_EQ(f.variant.find("two-time-constant"), std::string::npos) << f.params.dump();
+  ASSERT_TRUE(f.params.contains("tau_s")) << f.params.dump();
+  EXPECT_NEAR(f.params["tau_s"].get<double>(), tau[0], 0.1 * tau[0]);
+  std::printf("one-τ creep: %s, τ %.3g ± %.2g s (true %.3g)\n", f.variant.c_str(),
+              f.params["tau_s"].get<double>(), f.sigma["tau_s"].get<double>(), tau[0]);
+  ExpectOimlMatches(f, tau, fr);
+}
+
+/// Mains pick-up off its nominal frequency with harmonics (6 bridges, 400 Hz, 150 s): random load
+/// steps every 5 s; every bridge adds Σ_h A_h,c·sin(2π·h·f0·t + φ_h,c) for the harmonics h of
+/// `amp_mvv` (index 0 = fundamental) with per-bridge scale 0.6–1.0 and random phases. Noise
+/// σ = 1e-3 mV/V. At 400 Hz the 5th harmonic of 50.4 Hz (252 Hz) lies above Nyquist.
+DiagData MainsWithHarmonics(double f0, const std::vector<double>& amp_mvv, unsigned seed,
+                            std::vector<std::vector<double>>* true_amp) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const int nc = 6;
+  Eigen::MatrixXd s(nc, 6);
+  for (int c = 0; c < nc; ++c) {
+    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
+  }
+  true_amp->assign(amp_mvv.size(), std::vector<double>(nc));
+  std::vector<std::vector<double>> phase(amp_mvv.size(), std::vector<double>(nc));
+  for (std::size_t h = 0; h < amp_mvv.size(); ++h) {
+    for (int c = 0; c < nc; ++c) {
+      (*true_amp)[h][c] = amp_mvv[h] * (0.8 + 0.2 * u(rng));
+      phase[h][c] = M_PI * u(rng);
+    }
+  }
+  const double dt = 1.0 / 400.0;
+  const Eigen::Index n = 60000;
+  DiagData d;
+  d.sim_name = "independent generator";
+  d.real_name = "mains with harmonics";
+  d.sim_mvv.resize(n, nc);
+  d.real_mvv.resize(n, nc);
+  d.wrench.resize(n, 6);
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(6);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) * dt;
+    if (i % 2000 == 0) {
+      for (int a = 0; a < 6; ++a) w(a) = 40.0 * u(rng);
+    }
+    d.t_s.push_back(t);
+    d.wrench.row(i) = w.transpose();
+    const Eigen::VectorXd b = s * w;
+    for (int c = 0; c < nc; ++c) {
+      double hum = 0.0;
+      for (std::size_t h = 0; h < amp_mvv.size(); ++h) {
+        hum += (*true_amp)[h][c] *
+               std::sin(2.0 * M_PI * static_cast<double>(h + 1) * f0 * t + phase[h][c]);
+      }
+      d.sim_mvv(i, c) = b(c);
+      d.real_mvv(i, c) = b(c) + hum + 1e-3 * g(rng);
+    }
+  }
+  return d;
+}
+
+TEST(DiagShapes, MainsOffNominalWithHarmonicsIncludingAnAliasedOne) {
+  // 50.4 Hz (0.8 % off nominal); harmonics 2 and 5 present, 3 and 4 absent; the 5th (252 Hz) is
+  // seen at 400 − 252 = 148 Hz.
+  const double f0 = 50.4;
+  std::vector<std::vector<double>> amp;
+  const DiagData d = MainsWithHarmonics(f0, {0.01, 0.004, 0.0, 0.0, 0.003}, 5, &amp);
+  const Report r = Diagnose(d);
+  ASSERT_FALSE(r.effects.empty());
+  EXPECT_EQ(r.verdict, "mains_interference") << ToJson(r)["candidates"].dump();
+  const EffectFit& f = r.effects.front().fit;
+  EXPECT_EQ(f.variant, "mains fundamental with harmonics");
+  EXPECT_NEAR(f.params["freq_hz"].get<double>(), f0, 0.05);
+  ASSERT_TRUE(f.params.contains("h2_amplitude_mvv")) << f.params.dump();
+  ASSERT_TRUE(f.params.contains("h5_amplitude_mvv")) << f.params.dump();
+  EXPECT_FALSE(f.params.contains("h3_amplitude_mvv")) << f.params.dump();
+  EXPECT_FALSE(f.params.contains("h4_amplitude_mvv")) << f.params.dump();
+  EXPECT_NEAR(f.params["h5_seen_at_hz"].get<double>(), 400.0 - 5 * f0, 0.25);
+  for (int c = 0; c < 6; ++c) {
+    EXPECT_NEAR(f.params["amplitude_mvv"][c].get<double>(), amp[0][c], 0.1 * amp[0][c]) << c;
+    EXPECT_NEAR(f.params["h2_amplitude_mvv"][c].get<double>(), amp[1][c], 0.1 * amp[1][c]) << c;
+    EXPECT_NEAR(f.params["h5_amplitude_mvv"][c].get<double>(), amp[4][c], 0.1 * amp[4][c]) << c;
+  }
+  EXPECT_NE(f.evidence.find("above Nyquist"), std::string::npos) << f.evidence;
+  std::printf(
+      "mains: %s, f %.4f ± %.2g Hz (true %.2f), b0 h1/h2/h5 %.4g/%.4g/%.4g mV/V (true "
+      "%.4g/%.4g/%.4g); %s\n",
+      f.variant.c_str(), f.params["freq_hz"].get<double>(), f.sigma["freq_hz"].get<double>(), f0,
+      f.params["amplitude_mvv"][0].get<double>(), f.params["h2_amplitude_mvv"][0].get<double>(),
+      f.params["h5_amplitude_mvv"][0].get<double>(), amp[0][0], amp[1][0], amp[4][0],
+      f.evidence.c_str());
+}
+
+TEST(DiagShapes, PureMainsLineIsNotGivenHarmonics) {
+  std::vector<std::vector<double>> amp;
+  const DiagData d = MainsWithHarmonics(59.7, {0.01}, 6, &amp);
+  const Report r = Diagnose(d);
+  ASSERT_FALSE(r.effects.empty());
+  EXPECT_EQ(r.verdict, "mains_interference");
+  const EffectFit& f = r.effects.front().fit;
+  EXPECT_EQ(f.variant, "mains fundamental") << f.params.dump();
+  EXPECT_NEAR(f.params["freq_hz"].get<double>(), 59.7, 0.05);
+}
+
 }  // namespace
 }  // namespace ftstack::diag

@@ -49,7 +49,7 @@ TEST(EffectVocabulary, ReportedParametersAreTheSpecsColumn) {
       {EffectKind::kZeroOffset, "offset"},
       {EffectKind::kThermalZeroDrift, "coef_per_K"},
       {EffectKind::kThermalSpanDrift, "coef_per_K"},
-      {EffectKind::kCreep, "tau_s, fraction"},
+      {EffectKind::kCreep, "tau_s, fraction, tau1_s, tau2_s, fraction1, fraction2"},
       {EffectKind::kBridgeNonlinearity, "channels"},
       {EffectKind::kMisalignment, "axis, angle_deg"},
       {EffectKind::kGainError, "channels, gain"},
