@@ -159,5 +159,12 @@ std::optional<EffectFit> FitMains(const Context& cx, const Mat& target);
 /// puts h<k>_amplitude_mvv (σ) and h<k>_seen_at_hz. Returns a clause for the evidence.
 std::string AddMainsHarmonics(const Context& cx, const Mat& target, double f0, EffectFit* e);
 std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target);
+/// The two-mode variant of a one-mode resonance fit *e at (f1_hz, zeta1) (effects/
+/// resonance_family.cpp): mode 2 searched at the lines of the residual spectrum, both refined in
+/// turn and fitted jointly (a participation per channel and mode); replaces *e (variant "two
+/// modes", mode 1 the lower frequency) only when the training BIC is lower and the weaker mode
+/// carries ≥ 1 % of the ringing's whitened energy. Returns a clause for the evidence.
+std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz, double zeta1,
+                             EffectFit* e);
 
 }  // namespace ftstack::diag::fx
