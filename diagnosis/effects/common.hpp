@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "diagnosis/effects.hpp"
@@ -121,6 +122,10 @@ struct HatBasis {
 };
 
 HatBasis MakeHat(const Context& cx, int k);
+
+/// Lines of r's Welch spectra, whitened and summed over channels: local maxima (from the 4th bin)
+/// over 4 × the median level, strongest first, as (level / median level, frequency in Hz).
+std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Mat& r);
 
 /// Restart flags of the context's segments for the filters (nullptr for one recording).
 const std::uint8_t* Restarts(const Context& cx);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "diagnosis/effects/common.hpp"
@@ -30,38 +31,11 @@ void Ringing(const Context& cx, double f_hz, double zeta, const std::vector<int>
 /// Whether two modes are far enough apart to be told apart (more than 15 % in frequency).
 bool Apart(double fa_hz, double fb_hz) { return std::fabs(std::log(fa_hz / fb_hz)) > 0.14; }
 
-/// Lines of the residual r (Welch spectra whitened and summed over channels), strongest first:
-/// local maxima over 4 × the median level, at most 3, none within 15 % of f1_hz.
+/// Lines of the residual r (SpectralLines), strongest first, at most 3, none within 15 % of f1_hz.
 std::vector<double> ResidualLines(const Context& cx, const Mat& r, double f1_hz) {
-  const auto rows = static_cast<std::size_t>(cx.n);
-  const std::size_t seg = WelchSegment(rows);
-  if (rows < seg || seg < 32) return {};
-  std::vector<double> total;
-  std::vector<double> freq;
-  for (int c = 0; c < cx.nc; ++c) {
-    const Mat col = r.col(c);
-    const Spectrum s = Welch(col.data(), rows, cx.rate_hz, seg);
-    if (total.empty()) {
-      total.assign(s.power.size(), 0.0);
-      freq = s.freq_hz;
-    }
-    for (std::size_t k = 0; k < s.power.size(); ++k) total[k] += s.power[k] * cx.weight(c);
-  }
-  std::vector<double> band(total.begin() + 1, total.end());
-  std::nth_element(band.begin(), band.begin() + static_cast<std::ptrdiff_t>(band.size() / 2),
-                   band.end());
-  const double floor = std::max(band[band.size() / 2], 1e-300);
-  std::vector<std::pair<double, double>> peaks;
-  for (std::size_t k = 3; k + 1 < total.size(); ++k) {
-    if (total[k] > total[k - 1] && total[k] >= total[k + 1] && total[k] > 4.0 * floor &&
-        Apart(freq[k], f1_hz)) {
-      peaks.emplace_back(total[k], freq[k]);
-    }
-  }
-  std::sort(peaks.rbegin(), peaks.rend());
   std::vector<double> out;
-  for (std::size_t j = 0; j < std::min<std::size_t>(peaks.size(), 3); ++j) {
-    out.push_back(peaks[j].second);
+  for (const auto& [level, f_hz] : SpectralLines(cx, r)) {
+    if (out.size() < 3 && Apart(f_hz, f1_hz)) out.push_back(f_hz);
   }
   return out;
 }
@@ -88,6 +62,29 @@ std::vector<int> StrongestTwo(const Context& cx, const Mat& r) {
   });
   order.resize(static_cast<std::size_t>(std::min(2, cx.nc)));
   return order;
+}
+
+/// Puts both modes' parameters and 1-σ into *e, mode 1 the lower frequency (log f, log ζ and their
+/// σ per fitted mode m; participations from column m of cf). Returns the fitted index of mode 2.
+int PutModes(const Context& cx, const ChannelFit& cf, const double* lf, const double* lz,
+             const double* slf, const double* slz, EffectFit* e) {
+  const int lo = lf[0] <= lf[1] ? 0 : 1;
+  const char* fkey[2] = {"freq_hz", "freq2_hz"};
+  const char* zkey[2] = {"damping_ratio", "damping_ratio2"};
+  const char* pkey[2] = {"participation", "participation2"};
+  for (int k = 0; k < 2; ++k) {
+    const int m = k == 0 ? lo : 1 - lo;
+    const double f_hz = std::exp(lf[m]);
+    const double z = std::exp(lz[m]);
+    e->params[fkey[k]] = f_hz;
+    e->sigma[fkey[k]] = JsonNum(f_hz * slf[m]);
+    e->params[zkey[k]] = z;
+    e->sigma[zkey[k]] = JsonNum(z * slz[m]);
+    PutChannelCoef(cx, cf, m, pkey[k], e);
+  }
+  const double z_lo = std::exp(lz[lo]);
+  e->params["damped_freq_hz"] = std::exp(lf[lo]) * std::sqrt(std::max(0.0, 1.0 - z_lo * z_lo));
+  return 1 - lo;
 }
 
 }  // namespace
@@ -191,27 +188,11 @@ std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz,
         "%% of the ringing)",
         f2_hz, gain, 100.0 * share);
   }
-  const int lo = lf[0] <= lf[1] ? 0 : 1;  // mode 1 is the lower frequency
-  const int hi = 1 - lo;
+  const int hi = PutModes(cx, cf, lf, lz, slf, slz, e);
   e->variant = "two modes";
   e->n_params = p;
   e->train_sse_w = cf.sse_w;
-  e->pred = pred;
-  const char* fkey[2] = {"freq_hz", "freq2_hz"};
-  const char* zkey[2] = {"damping_ratio", "damping_ratio2"};
-  const char* pkey[2] = {"participation", "participation2"};
-  for (int k = 0; k < 2; ++k) {
-    const int m = k == 0 ? lo : hi;
-    const double f_hz = std::exp(lf[m]);
-    const double z = std::exp(lz[m]);
-    e->params[fkey[k]] = f_hz;
-    e->sigma[fkey[k]] = JsonNum(f_hz * slf[m]);
-    e->params[zkey[k]] = z;
-    e->sigma[zkey[k]] = JsonNum(z * slz[m]);
-    PutChannelCoef(cx, cf, m, pkey[k], e);
-  }
-  const double z_lo = std::exp(lz[lo]);
-  e->params["damped_freq_hz"] = std::exp(lf[lo]) * std::sqrt(std::max(0.0, 1.0 - z_lo * z_lo));
+  e->pred = std::move(pred);
   return Fmt(
       "; a second mode at %.2f Hz (damping ratio %.3f) from the residual spectrum, kept: "
       "training BIC lower by %.1f, %.0f %% of the ringing's energy in the weaker mode",
