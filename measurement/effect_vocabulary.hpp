@@ -132,6 +132,12 @@ inline constexpr std::array kResonance = {
     P{"damping_ratio", T::kNumber, "", "damping ratio ζ", kBoth, ""},
     P{"participation", T::kNumber, "", "the mode's share of the output (report: per channel)",
       kBoth, ""},
+    P{"freq2_hz", T::kNumber, "Hz", "undamped natural frequency of mode 2 (two-mode variant)",
+      kReported, ""},
+    P{"damping_ratio2", T::kNumber, "", "damping ratio of mode 2 (two-mode variant)", kReported,
+      ""},
+    P{"participation2", T::kNumber, "",
+      "mode 2's share of the output, per channel (two-mode variant)", kReported, ""},
     kChannels};
 }  // namespace vocabulary_detail
 

@@ -150,6 +150,35 @@ HatBasis MakeHat(const Context& cx, int k) {
   return b;
 }
 
+std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Mat& r) {
+  const auto rows = static_cast<std::size_t>(cx.n);
+  const std::size_t seg = WelchSegment(rows);
+  std::vector<std::pair<double, double>> peaks;
+  if (rows < seg || seg < 32) return peaks;
+  std::vector<double> total;
+  std::vector<double> freq;
+  for (int c = 0; c < cx.nc; ++c) {
+    const Vec col = r.col(c);
+    const Spectrum s = Welch(col.data(), rows, cx.rate_hz, seg);
+    if (total.empty()) {
+      total.assign(s.power.size(), 0.0);
+      freq = s.freq_hz;
+    }
+    for (std::size_t k = 0; k < s.power.size(); ++k) total[k] += s.power[k] * cx.weight(c);
+  }
+  std::vector<double> band(total.begin() + 1, total.end());
+  std::nth_element(band.begin(), band.begin() + static_cast<std::ptrdiff_t>(band.size() / 2),
+                   band.end());
+  const double floor = std::max(band[band.size() / 2], 1e-300);
+  for (std::size_t k = 3; k + 1 < total.size(); ++k) {
+    if (total[k] > total[k - 1] && total[k] >= total[k + 1] && total[k] > 4.0 * floor) {
+      peaks.emplace_back(total[k] / floor, freq[k]);
+    }
+  }
+  std::sort(peaks.rbegin(), peaks.rend());
+  return peaks;
+}
+
 /// Restart flags of the context's segments for the filters (nullptr for one recording).
 const std::uint8_t* Restarts(const Context& cx) {
   return cx.restart.empty() ? nullptr : cx.restart.data();

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "diagnosis/effects.hpp"
@@ -122,6 +123,10 @@ struct HatBasis {
 
 HatBasis MakeHat(const Context& cx, int k);
 
+/// Lines of r's Welch spectra, whitened and summed over channels: local maxima (from the 4th bin)
+/// over 4 × the median level, strongest first, as (level / median level, frequency in Hz).
+std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Mat& r);
+
 /// Restart flags of the context's segments for the filters (nullptr for one recording).
 const std::uint8_t* Restarts(const Context& cx);
 
@@ -159,5 +164,12 @@ std::optional<EffectFit> FitMains(const Context& cx, const Mat& target);
 /// puts h<k>_amplitude_mvv (σ) and h<k>_seen_at_hz. Returns a clause for the evidence.
 std::string AddMainsHarmonics(const Context& cx, const Mat& target, double f0, EffectFit* e);
 std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target);
+/// The two-mode variant of a one-mode resonance fit *e at (f1_hz, zeta1) (effects/
+/// resonance_family.cpp): mode 2 searched at the lines of the residual spectrum, both refined in
+/// turn and fitted jointly (a participation per channel and mode); replaces *e (variant "two
+/// modes", mode 1 the lower frequency) only when the training BIC is lower and the weaker mode
+/// carries ≥ 1 % of the ringing's whitened energy. Returns a clause for the evidence.
+std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz, double zeta1,
+                             EffectFit* e);
 
 }  // namespace ftstack::diag::fx

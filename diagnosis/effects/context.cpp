@@ -18,34 +18,10 @@ namespace {
 /// Spectral lines of the whitened residual, summed over channels: the five strongest peaks over
 /// four times the median level (cx.peak_hz, cx.peak_ratio).
 void FindSpectralLines(Context& cx) {
-  const auto rows = static_cast<std::size_t>(cx.n);
-  const std::size_t seg = WelchSegment(rows);
-  if (rows >= seg && seg >= 32) {
-    std::vector<double> total;
-    std::vector<double> freq;
-    for (int c = 0; c < cx.nc; ++c) {
-      const Spectrum s = Welch(cx.resid.col(c).data(), rows, cx.rate_hz, seg);
-      if (total.empty()) {
-        total.assign(s.power.size(), 0.0);
-        freq = s.freq_hz;
-      }
-      for (std::size_t k = 0; k < s.power.size(); ++k) total[k] += s.power[k] * cx.weight(c);
-    }
-    std::vector<double> band(total.begin() + 1, total.end());
-    std::nth_element(band.begin(), band.begin() + static_cast<std::ptrdiff_t>(band.size() / 2),
-                     band.end());
-    const double floor = std::max(band[band.size() / 2], 1e-300);
-    std::vector<std::pair<double, double>> peaks;
-    for (std::size_t k = 3; k + 1 < total.size(); ++k) {
-      if (total[k] > total[k - 1] && total[k] >= total[k + 1] && total[k] > 4.0 * floor) {
-        peaks.emplace_back(total[k] / floor, freq[k]);
-      }
-    }
-    std::sort(peaks.rbegin(), peaks.rend());
-    for (std::size_t j = 0; j < std::min<std::size_t>(peaks.size(), 5); ++j) {
-      cx.peak_ratio.push_back(peaks[j].first);
-      cx.peak_hz.push_back(peaks[j].second);
-    }
+  const auto lines = SpectralLines(cx, cx.resid);
+  for (std::size_t j = 0; j < std::min<std::size_t>(lines.size(), 5); ++j) {
+    cx.peak_ratio.push_back(lines[j].first);
+    cx.peak_hz.push_back(lines[j].second);
   }
 }
 

@@ -229,8 +229,9 @@ std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target) {
   e.sigma["damping_ratio"] = JsonNum(
       z * CurvatureSigma([&](double v) { return sse_for(f, std::exp(v), all, nullptr, nullptr); },
                          lz, 0.02));
-  Vec gain = cf.beta.row(0).transpose();
-  e.params["participation"] = VecJson(gain);
+  PutChannelCoef(cx, cf, 0, "participation", &e);
+  e.variant = "one mode";
+  const std::string second = AddResonanceMode(cx, target, f, z, &e);
   e.channels = ActiveChannels(cx, e.pred);
   // Count fast load changes: steps where |Δsim| per sample exceeds 20 σ on the dominant channel.
   const int c = DominantChannel(cx, e.pred);
@@ -244,7 +245,9 @@ std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target) {
   e.evidence =
       Fmt("ringing at %.2f Hz (damping ratio %.3f) after the %d fast load changes on b%d, quiet "
           "during slow ramps and holds, r = %.2f",
-          e.params["damped_freq_hz"].get<double>(), z, fast, c, RowCorr(cx, target, e.pred, c));
+          e.params["damped_freq_hz"].get<double>(), e.params["damping_ratio"].get<double>(), fast,
+          c, RowCorr(cx, target, e.pred, c)) +
+      second;
   return e;
 }
 

@@ -54,6 +54,7 @@ std::string UnitOf(const std::string& key, const std::string& effect) {
   if (key == "coef_per_K") return effect == "thermal_span_drift" ? "1/K" : "mV/V per K";
   if (effect == "creep" && (key == "amplitude" || key.rfind("fraction", 0) == 0))
     return "1 (of the load output)";
+  if (effect == "resonance" && key.rfind("participation", 0) == 0) return "1 (of the output)";
   return "";
 }
 

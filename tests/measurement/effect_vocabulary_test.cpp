@@ -57,7 +57,8 @@ TEST(EffectVocabulary, ReportedParametersAreTheSpecsColumn) {
       {EffectKind::kSaturation, "limit"},
       {EffectKind::kOverloadShift, "onset_s"},
       {EffectKind::kMainsInterference, "freq_hz, amplitude_mvv (alias amplitude)"},
-      {EffectKind::kResonance, "freq_hz, damping_ratio, participation"},
+      {EffectKind::kResonance,
+       "freq_hz, damping_ratio, participation, freq2_hz, damping_ratio2, participation2"},
       {EffectKind::kHysteresis, "none"},
   };
   for (const auto& [kind, keys] : want) {
