@@ -49,6 +49,7 @@ void WrenchCore::ClearTare() {
 
 void WrenchCore::BuildPlan() {
   plan_ = Plan{};
+  narrow_linear_ = nullptr;
   eff_dt_ = 0;
   const std::size_t n = cal_.channel_count;
   if (!cal_.valid || n > kMaxChannels || cal_.extra_count > kMaxFeatures - kMaxChannels) return;
@@ -97,12 +98,23 @@ void WrenchCore::BuildPlan() {
     // 2^k < 2^s); checked here because ApplyNarrow relies on it.
     if (cal_.narrow_shift[r] > cal_.shift[r]) plan_.narrow = false;
     plan_.final_shift[r] = static_cast<std::uint8_t>(cal_.shift[r] - cal_.narrow_shift[r]);
+    plan_.final.shift[r] = plan_.final_shift[r];
+    plan_.final.offset[r] =
+        (std::uint64_t{1} << 31) - (std::uint64_t{1} << (63 - plan_.final_shift[r]));
   }
   plan_.narrow_shift = cal_.narrow_shift;
   plan_.narrow_product_shift = cal_.narrow_product_shift;
   for (std::size_t r = 0; r < kAxes; ++r) {
     const std::uint8_t k = plan_.narrow_shift[r];
     plan_.narrow_half[r] = k > 0 ? std::int64_t{1} << (k - 1) : 0;  // RoundShift's half
+  }
+  if (plan_.narrow && p == 0 && n >= 1) {
+    static constexpr std::array<LinearFn, kMaxChannels> kLinear = {
+        &WrenchCore::ApplyNarrowLinear<1>, &WrenchCore::ApplyNarrowLinear<2>,
+        &WrenchCore::ApplyNarrowLinear<3>, &WrenchCore::ApplyNarrowLinear<4>,
+        &WrenchCore::ApplyNarrowLinear<5>, &WrenchCore::ApplyNarrowLinear<6>,
+        &WrenchCore::ApplyNarrowLinear<7>, &WrenchCore::ApplyNarrowLinear<8>};
+    narrow_linear_ = kLinear[n - 1];
   }
   for (std::size_t r = 0; r < kAxes && plan_.narrow; ++r) {
     std::uint64_t sum = 0;
@@ -187,6 +199,22 @@ void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
 
 // Inlined into Apply: the narrow form (see Plan::narrow and narrow::Table). The counts sum runs
 // in 32x32→64-bit lanes; the second-order features, when present, in a second group of lanes.
+template <std::size_t N>
+void WrenchCore::ApplyNarrowLinear(const std::array<std::int32_t, kMaxChannels>& counts,
+                                   WrenchLsb& y, bool* saturated) const {
+  // Clamped counts (unused here) and t = floor(acc/2^k) exactly (its true value is bounded by
+  // the loader): one more shift.
+  std::array<std::int32_t, kMaxChannels> v;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+  std::array<std::uint64_t, kAxes> t;        // NOLINT(cppcoreguidelines-pro-type-member-init)
+  bool sat = narrow::CountsSum<N>(counts, cal_.min_counts, cal_.max_counts, narrow_tab_, v, t);
+  if (!narrow::ShiftToI32(t, plan_.final, y)) {  // some axis beyond int32: saturate
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      y[r] = SatToI32(static_cast<std::int64_t>(t[r]) >> plan_.final_shift[r], &sat);
+    }
+  }
+  if (sat) *saturated = true;
+}
+
 [[gnu::always_inline]] inline void WrenchCore::ApplyNarrow(
     const std::array<std::int32_t, kMaxChannels>& counts, std::array<std::int64_t, kAxes>& q,
     bool& clamped) const {
@@ -195,13 +223,6 @@ void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
   std::array<std::uint64_t, kAxes> t;        // NOLINT(cppcoreguidelines-pro-type-member-init)
   clamped |= narrow::CountsSumN(plan_.channels, counts, cal_.min_counts, cal_.max_counts,
                                 narrow_tab_, v, t);
-  if (plan_.products == 0) {
-    // t = floor(acc/2^k) exactly (its true value is bounded by the loader): one more shift.
-    for (std::size_t r = 0; r < kAxes; ++r) {
-      q[r] = static_cast<std::int64_t>(t[r]) >> plan_.final_shift[r];
-    }
-    return;
-  }
   std::array<std::int64_t, kMaxChannels> x;  // NOLINT: x̃ = v − zero, [0, n) written and read
   for (std::size_t c = 0; c < plan_.channels; ++c) x[c] = std::int64_t{v[c]} - plan_.zero[c];
   std::uint64_t psum = 0;  // Σ p'_u
@@ -270,6 +291,10 @@ void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts,
   if (plan_.temperature) {
     const std::int32_t dt = DeltaT(temperature_mdegc, has_temperature, temp_range);
     if (dt != eff_dt_) UpdateEffective(dt);
+  }
+  if (narrow_linear_ != nullptr) {  // narrow, no second-order features: one instance per N
+    (this->*narrow_linear_)(counts, y, saturated);
+    return;
   }
   // The loader guarantees every partial sum stays within ±2^62 (EvaluationFits). konst_ holds
   // the rounding half. An axis the calibration does not determine has all-zero rows in the plan:

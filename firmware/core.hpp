@@ -112,10 +112,19 @@ class WrenchCore {
   void Accumulate(const std::array<std::int32_t, kMaxChannels>& v, const Columns& eff,
                   std::array<std::int64_t, kAxes>& acc) const;
   /// The same model in the narrow form (FixedCalibration::narrow) with the cached narrow_tab_, for
-  /// raw counts that it clamps to the rails (clamped set when it had to): q = the sum shifted
-  /// right by each row's binary point (before the int32 saturation).
+  /// raw counts that it clamps to the rails (clamped set when it had to), with second-order
+  /// features: q = the sum shifted right by each row's binary point (before the saturation).
   void ApplyNarrow(const std::array<std::int32_t, kMaxChannels>& counts,
                    std::array<std::int64_t, kAxes>& q, bool& clamped) const;
+  /// The narrow form without second-order features for N channels, whole (clamp, sum, shift,
+  /// int32 saturation, *saturated set when clamped or saturated): BuildPlan points
+  /// narrow_linear_ at the instance for the calibration's N.
+  template <std::size_t N>
+  void ApplyNarrowLinear(const std::array<std::int32_t, kMaxChannels>& counts, WrenchLsb& y,
+                         bool* saturated) const;
+  using LinearFn = void (WrenchCore::*)(const std::array<std::int32_t, kMaxChannels>&, WrenchLsb&,
+                                        bool*) const;
+  LinearFn narrow_linear_ = nullptr;
 
   /// The calibration as the per-sample path reads it. Temperature terms never reach the
   /// per-sample sum: the ΔT feature, and each ΔT product C_c·round(x̃_c·ΔT/2^h) evaluated as
@@ -153,6 +162,7 @@ class WrenchCore {
     /// s_r − k_r: the counts sum T_r = floor(acc_r / 2^k_r) needs only this shift without
     /// products (floor(floor(a/2^k)/2^(s−k)) = floor(a/2^s); the plan is narrow only if k ≤ s).
     std::array<std::uint8_t, kAxes> final_shift{};
+    narrow::Final final{};  ///< the same shifts for narrow::ShiftToI32
   };
 
   FixedCalibration cal_{};

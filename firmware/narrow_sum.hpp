@@ -140,6 +140,52 @@ template <std::size_t N>
 #endif
 }
 
+/// The last step of the narrow form without second-order features: y_r = floor(T_r / 2^shift_r)
+/// for T_r = t_r modulo 2^64 with |T_r| < 2^63 − 2^62 (the loader's bound on the sums). With
+/// u = T + 2^63 ≥ 0, floor(u / 2^shift) = floor(T / 2^shift) + 2^(63 − shift) (a logical shift),
+/// and offset_r = 2^31 − 2^(63 − shift_r) turns it into y + 2^31, in [0, 2^32) iff y fits int32.
+struct Final {
+  alignas(16) std::array<std::uint64_t, kRows> shift{};   ///< s_r − k_r ≤ 62
+  alignas(16) std::array<std::uint64_t, kRows> offset{};  ///< 2^31 − 2^(63 − shift_r) mod 2^64
+};
+
+/// Writes y and returns true when every y_r fits int32; false (y partly written) otherwise.
+[[gnu::always_inline]] inline bool ShiftToI32(const std::array<std::uint64_t, kRows>& t,
+                                              const Final& f, std::array<std::int32_t, kRows>& y) {
+#if defined(__SSE2__)
+  const __m128i bias = _mm_set1_epi64x(static_cast<long long>(std::uint64_t{1} << 63));
+  const auto* tv = reinterpret_cast<const __m128i*>(t.data());          // NOLINT
+  const auto* off = reinterpret_cast<const __m128i*>(f.offset.data());  // NOLINT
+  __m128i w[3];  // NOLINT: y_r + 2^31 in each 64-bit lane
+  for (std::size_t i = 0; i < 3; ++i) {
+    const __m128i u = _mm_add_epi64(_mm_loadu_si128(tv + i), bias);
+    // psrlq shifts both lanes by one count: shift twice and keep one lane of each.
+    const auto* sh = reinterpret_cast<const __m128i*>(f.shift.data() + 2 * i);  // NOLINT
+    const __m128i a = _mm_srl_epi64(u, _mm_loadl_epi64(sh));
+    const __m128i b = _mm_srl_epi64(u, _mm_srli_si128(_mm_load_si128(sh), 8));
+    const __m128i lanes = _mm_castpd_si128(_mm_move_sd(_mm_castsi128_pd(b), _mm_castsi128_pd(a)));
+    w[i] = _mm_add_epi64(lanes, _mm_load_si128(off + i));
+  }
+  const __m128i any = _mm_or_si128(_mm_or_si128(w[0], w[1]), w[2]);
+  const int high_zero = _mm_movemask_epi8(_mm_cmpeq_epi32(any, _mm_setzero_si128()));
+  const __m128i flip = _mm_set1_epi32(static_cast<int>(0x80000000u));
+  const __m128i y03 = _mm_castps_si128(
+      _mm_shuffle_ps(_mm_castsi128_ps(w[0]), _mm_castsi128_ps(w[1]), 0x88));         // low dwords
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(y.data()), _mm_xor_si128(y03, flip));  // NOLINT
+  _mm_storel_epi64(reinterpret_cast<__m128i*>(y.data() + 4),                         // NOLINT
+                   _mm_xor_si128(_mm_shuffle_epi32(w[2], 0x08), flip));
+  return (high_zero & 0xF0F0) == 0xF0F0;
+#else
+  std::uint64_t outside = 0;
+  for (std::size_t r = 0; r < kRows; ++r) {
+    const std::uint64_t w = ((t[r] + (std::uint64_t{1} << 63)) >> f.shift[r]) + f.offset[r];
+    outside |= w;
+    y[r] = static_cast<std::int32_t>(static_cast<std::uint32_t>(w) ^ 0x80000000u);
+  }
+  return (outside >> 32) == 0;
+#endif
+}
+
 /// Six unsigned 64-bit sums of 32x32-bit products (the low halves of col's lanes times x < 2^32):
 /// the second-order features' group of the narrow form.
 class Sums6 {
