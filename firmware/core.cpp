@@ -108,6 +108,10 @@ void WrenchCore::BuildPlan() {
     const std::uint8_t k = plan_.narrow_shift[r];
     plan_.narrow_half[r] = k > 0 ? std::int64_t{1} << (k - 1) : 0;  // RoundShift's half
   }
+  for (std::size_t c = 0; c < n; ++c) {
+    plan_.lo_minus_zero[c] =
+        static_cast<std::uint64_t>(std::int64_t{cal_.min_counts} - plan_.zero[c]);
+  }
   if (plan_.narrow && p == 0 && n >= 1) {
     static constexpr std::array<LinearFn, kMaxChannels> kLinear = {
         &WrenchCore::ApplyNarrowLinear<1>, &WrenchCore::ApplyNarrowLinear<2>,
@@ -153,28 +157,37 @@ void WrenchCore::Effective(std::int32_t dt_mdegc, Columns& eff,
 }
 
 void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
-  std::array<std::int64_t, kAxes> k{};
-  Effective(dt_mdegc, eff_, k);
-  // With the final rounding half: Apply shifts acc right without adding it (the loader's bound
-  // covers every partial sum plus the half, in any order).
-  for (std::size_t r = 0; r < kAxes; ++r) konst_[r] = k[r] - tare_acc_[r] + plan_.round_half[r];
   eff_dt_ = dt_mdegc;
-  if (!plan_.narrow) return;
-  const std::size_t n = plan_.channels;
-  for (std::size_t r = 0; r < kAxes; ++r) {
-    const std::uint8_t ks = plan_.narrow_shift[r];
-    // floor(K/2^k) + Σ_c c'·(lo − zero_c), modulo 2^64 (narrow::Table), and K mod 2^k.
-    auto base = static_cast<std::uint64_t>(konst_[r] >> ks);
-    narrow_low_[r] = konst_[r] & ((std::int64_t{1} << ks) - 1);
-    for (std::size_t c = 0; c < n; ++c) {
+  if (!plan_.narrow) {
+    std::array<std::int64_t, kAxes> k{};
+    Effective(dt_mdegc, eff_, k);
+    // With the final rounding half: Apply shifts acc right without adding it (the loader's bound
+    // covers every partial sum plus the half, in any order).
+    for (std::size_t r = 0; r < kAxes; ++r) konst_[r] = k[r] - tare_acc_[r] + plan_.round_half[r];
+    return;
+  }
+  // The narrow form reads only narrow_tab_ and narrow_low_: Effective's values, rounded to the
+  // narrow coefficients as they are made (eff_ is not kept).
+  const std::int64_t dt = dt_mdegc;
+  std::array<std::uint64_t, kAxes> base{};  // Σ_c c'·(lo − zero_c), modulo 2^64
+  for (std::size_t c = 0; c < plan_.channels; ++c) {
+    const std::uint8_t h = plan_.drift_shift[c];
+    const std::uint64_t lz = plan_.lo_minus_zero[c];
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      const std::int64_t d = (plan_.drift[c][r] * dt + plan_.drift_half[c]) >> h;
       // |eff'| ≤ 2^31 − 1 at every ΔT in range (NarrowRow): eff' + 2^31 fits 32 bits.
-      const std::int64_t e = (eff_[c][r] + plan_.narrow_half[r]) >> ks;
+      const std::int64_t e = (plan_.coef[c][r] + d + plan_.narrow_half[r]) >> plan_.narrow_shift[r];
       narrow_tab_.coef_u[c][r] = static_cast<std::uint64_t>(e + kHalf32);
       narrow_tab_.coef_u32[c][r] = static_cast<std::uint32_t>(e + kHalf32);
-      base += static_cast<std::uint64_t>(e) *
-              static_cast<std::uint64_t>(std::int64_t{cal_.min_counts} - plan_.zero[c]);
+      base[r] += static_cast<std::uint64_t>(e) * lz;
     }
-    narrow_tab_.konst[r] = base;
+  }
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    // K with the final rounding half (see above); floor(K/2^k) + base and K mod 2^k.
+    konst_[r] = plan_.bias[r] + plan_.temp_coef[r] * dt - tare_acc_[r] + plan_.round_half[r];
+    const std::uint8_t ks = plan_.narrow_shift[r];
+    narrow_tab_.konst[r] = static_cast<std::uint64_t>(konst_[r] >> ks) + base[r];
+    narrow_low_[r] = konst_[r] & ((std::int64_t{1} << ks) - 1);
   }
 }
 

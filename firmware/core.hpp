@@ -163,13 +163,14 @@ class WrenchCore {
     /// products (floor(floor(a/2^k)/2^(s−k)) = floor(a/2^s); the plan is narrow only if k ≤ s).
     std::array<std::uint8_t, kAxes> final_shift{};
     narrow::Final final{};  ///< the same shifts for narrow::ShiftToI32
+    std::array<std::uint64_t, kMaxChannels> lo_minus_zero{};  ///< lower rail − zero_c, mod 2^64
   };
 
   FixedCalibration cal_{};
   Plan plan_{};
   // A cache of values derived from the calibration, the tare and the last ΔT (mutable: Apply is
   // const; WrenchCore is single-threaded by contract).
-  mutable Columns eff_{};                            ///< counts coefficients at eff_dt_
+  mutable Columns eff_{};  ///< counts coefficients at eff_dt_ (64-bit form only)
   mutable std::array<std::int64_t, kAxes> konst_{};  ///< constant at eff_dt_ minus tare_acc_
   mutable std::int32_t eff_dt_ = 0;
   mutable narrow::Table narrow_tab_{};                    ///< narrow eff_ at eff_dt_

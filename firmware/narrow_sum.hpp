@@ -8,9 +8,9 @@
 
 #include "hal/adc.hpp"
 
-#if defined(__SSE2__)
+#ifdef __SSE2__
 #include <emmintrin.h>
-#elif defined(__aarch64__)
+#elif defined __aarch64__
 #include <arm_neon.h>
 #endif
 
