@@ -124,7 +124,6 @@ class WrenchCore {
                          bool* saturated) const;
   using LinearFn = void (WrenchCore::*)(const std::array<std::int32_t, kMaxChannels>&, WrenchLsb&,
                                         bool*) const;
-  LinearFn narrow_linear_ = nullptr;
 
   /// The calibration as the per-sample path reads it. Temperature terms never reach the
   /// per-sample sum: the ΔT feature, and each ΔT product C_c·round(x̃_c·ΔT/2^h) evaluated as
@@ -166,14 +165,16 @@ class WrenchCore {
     std::array<std::uint64_t, kMaxChannels> lo_minus_zero{};  ///< lower rail − zero_c, mod 2^64
   };
 
-  FixedCalibration cal_{};
+  // The 16-byte aligned members first (SIMD loads), then the rest.
+  mutable narrow::Table narrow_tab_{};  ///< the narrow coefficients at eff_dt_
   Plan plan_{};
+  LinearFn narrow_linear_ = nullptr;
+  FixedCalibration cal_{};
   // A cache of values derived from the calibration, the tare and the last ΔT (mutable: Apply is
   // const; WrenchCore is single-threaded by contract).
   mutable Columns eff_{};  ///< counts coefficients at eff_dt_ (64-bit form only)
   mutable std::array<std::int64_t, kAxes> konst_{};  ///< constant at eff_dt_ minus tare_acc_
   mutable std::int32_t eff_dt_ = 0;
-  mutable narrow::Table narrow_tab_{};                    ///< narrow eff_ at eff_dt_
   mutable std::array<std::int64_t, kAxes> narrow_low_{};  ///< konst_ mod 2^k_r
   /// The untared sum at the tare (zero without one): subtracting it makes every feature relative
   /// to its value at the tare and drops the bias.

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "hal/adc.hpp"
 
@@ -141,7 +142,7 @@ template <std::size_t N>
 }
 
 /// The last step of the narrow form without second-order features: y_r = floor(T_r / 2^shift_r)
-/// for T_r = t_r modulo 2^64 with |T_r| < 2^63 − 2^62 (the loader's bound on the sums). With
+/// for T_r = t_r modulo 2^64 with −2^63 ≤ T_r < 2^63 (the loader bounds the sums). With
 /// u = T + 2^63 ≥ 0, floor(u / 2^shift) = floor(T / 2^shift) + 2^(63 − shift) (a logical shift),
 /// and offset_r = 2^31 − 2^(63 − shift_r) turns it into y + 2^31, in [0, 2^32) iff y fits int32.
 struct Final {
@@ -153,9 +154,9 @@ struct Final {
 [[gnu::always_inline]] inline bool ShiftToI32(const std::array<std::uint64_t, kRows>& t,
                                               const Final& f, std::array<std::int32_t, kRows>& y) {
 #if defined(__SSE2__)
-  const __m128i bias = _mm_set1_epi64x(static_cast<long long>(std::uint64_t{1} << 63));
-  const auto* tv = reinterpret_cast<const __m128i*>(t.data());          // NOLINT
-  const auto* off = reinterpret_cast<const __m128i*>(f.offset.data());  // NOLINT
+  const __m128i bias = _mm_set1_epi64x(std::numeric_limits<long long>::min());  // 2^63
+  const auto* tv = reinterpret_cast<const __m128i*>(t.data());                  // NOLINT
+  const auto* off = reinterpret_cast<const __m128i*>(f.offset.data());          // NOLINT
   __m128i w[3];  // NOLINT: y_r + 2^31 in each 64-bit lane
   for (std::size_t i = 0; i < 3; ++i) {
     const __m128i u = _mm_add_epi64(_mm_loadu_si128(tv + i), bias);
