@@ -176,12 +176,35 @@ class DoubleCore {
     t_ref_ = cal.temp_ref_c;
     t_min_ = cal.temp_min_c;
     t_max_ = cal.temp_max_c;
+    m_dt_ = m_;
+    bias_dt_ = bias_;
   }
 
-  void Apply(const hal::AdcSample& s, Eigen::Matrix<double, 6, 1>& y) {
-    // Bridge values on the stack, products from them, then the N bridge features (temperature
-    // folded in) written straight into the feature vector: plain loops for the O(N + P) steps,
-    // Eigen's matrix-vector product for the O(6·(N + P)) one.
+  /// Bridge values on the stack, products from them, then the N bridge features (temperature
+  /// folded in) written straight into the feature vector: plain loops for the O(N + P) steps,
+  /// Eigen's matrix-vector product for the O(6·(N + P)) one.
+  void Apply(const hal::AdcSample& s, Eigen::Matrix<double, 6, 1>& y) { Run<false>(s, y); }
+
+  /// The same model with the temperature folded into the matrix and the bias once per new
+  /// reading, as the fixed-point core caches it: wrench = M(ΔT)·[x; x_a·x_b] + b(ΔT) with
+  /// M(ΔT)_rc = M_rc·(1 − γ_c·ΔT) and b(ΔT) = bias − Σ_c M_rc·α_c·ΔT.
+  void ApplyCached(const hal::AdcSample& s, Eigen::Matrix<double, 6, 1>& y) { Run<true>(s, y); }
+
+ private:
+  template <bool kCached>
+  void Run(const hal::AdcSample& s, Eigen::Matrix<double, 6, 1>& y) {
+    if constexpr (kCached) {
+      if (temp_ && (!cached_ || s.temperature_mdegc != cached_mdegc_)) {
+        const double dt = std::clamp(s.temperature_mdegc * 1e-3, t_min_, t_max_) - t_ref_;
+        bias_dt_ = bias_;
+        for (int c = 0; c < n_; ++c) {
+          m_dt_.col(c) = m_.col(c) * (1.0 - gamma_(c) * dt);
+          bias_dt_ -= m_.col(c) * (alpha_(c) * dt);
+        }
+        cached_ = true;
+        cached_mdegc_ = s.temperature_mdegc;
+      }
+    }
     std::array<double, fw::kMaxChannels> x;  // NOLINT(cppcoreguidelines-pro-type-member-init)
     for (int c = 0; c < n_; ++c) {
       const double xc = s.counts[static_cast<std::size_t>(c)] * mvv_per_count_ - offset_(c);
@@ -192,23 +215,31 @@ class DoubleCore {
       const auto ku = static_cast<std::size_t>(k);
       f_(n_ + k) = x[a_[ku]] * x[b_[ku]];
     }
-    if (temp_) {
-      const double dt = std::clamp(s.temperature_mdegc * 1e-3, t_min_, t_max_) - t_ref_;
-      for (int c = 0; c < n_; ++c) {
-        const double xc = x[static_cast<std::size_t>(c)];
-        f_(c) = xc - dt * (alpha_(c) + gamma_(c) * xc);
+    if constexpr (kCached) {
+      y.noalias() = m_dt_ * f_;
+      y += bias_dt_;
+    } else {
+      if (temp_) {
+        const double dt = std::clamp(s.temperature_mdegc * 1e-3, t_min_, t_max_) - t_ref_;
+        for (int c = 0; c < n_; ++c) {
+          const double xc = x[static_cast<std::size_t>(c)];
+          f_(c) = xc - dt * (alpha_(c) + gamma_(c) * xc);
+        }
       }
+      y.noalias() = m_ * f_;
+      y += bias_;
     }
-    y.noalias() = m_ * f_;
-    y += bias_;
   }
 
- private:
   int n_;
   int products_;
   bool temp_;
   double mvv_per_count_ = 0;
   Matrix m_;
+  Matrix m_dt_;  ///< ApplyCached: m_ at cached_mdegc_
+  Eigen::Matrix<double, 6, 1> bias_dt_;
+  bool cached_ = false;
+  std::int32_t cached_mdegc_ = 0;
   Features f_;
   Eigen::Matrix<double, 6, 1> bias_;
   Eigen::Matrix<double, fw::kMaxChannels, 1> offset_, alpha_, gamma_;
@@ -216,7 +247,9 @@ class DoubleCore {
   double t_ref_ = 20, t_min_ = -20, t_max_ = 80;
 };
 
-void BM_EigenDouble(benchmark::State& state) {
+/// The double model per sample (kCached: with the per-temperature cache, DoubleCore::ApplyCached).
+template <bool kCached>
+void EigenDouble(benchmark::State& state) {
   const auto n = static_cast<std::uint8_t>(state.range(0));
   const auto terms = static_cast<int>(state.range(1));
   std::mt19937_64 rng(1);
@@ -225,12 +258,17 @@ void BM_EigenDouble(benchmark::State& state) {
   Eigen::Matrix<double, 6, 1> y;
   std::size_t i = 0;
   for (auto _ : state) {
-    core.Apply(samples[i], y);
+    if constexpr (kCached) {
+      core.ApplyCached(samples[i], y);
+    } else {
+      core.Apply(samples[i], y);
+    }
     benchmark::DoNotOptimize(y);
     i = (i + 1) & (kSamples - 1);
   }
   state.SetItemsProcessed(state.iterations());
 }
+void BM_EigenDouble(benchmark::State& state) { EigenDouble<false>(state); }
 
 // Every configuration (N, terms, temperature every 64 samples) for fixed point and for double,
 // measured in the same run; with temperature terms also a new temperature every sample.
@@ -244,6 +282,11 @@ void Configurations(benchmark::internal::Benchmark* b) {
 }
 BENCHMARK(BM_FixedMatrix)->Apply(Configurations);
 BENCHMARK(BM_EigenDouble)->Apply(Configurations);
+
+// The double model with the fixed-point core's per-temperature cache (temperature terms only):
+// like with like for the temperature configurations.
+void BM_EigenDoubleCached(benchmark::State& state) { EigenDouble<true>(state); }
+BENCHMARK(BM_EigenDoubleCached)->Args({6, 2, 0})->Args({6, 3, 0})->Args({8, 2, 0})->Args({8, 3, 0});
 
 }  // namespace
 

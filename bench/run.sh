@@ -12,10 +12,9 @@ section() { printf '\n== %s ==\n' "$*"; }
 # 0 linear, 1 second order, 2 temperature, 3 both) on the same inputs; every = 0: a new
 # temperature reading every 64 samples (thermistor slower than the bridges), 1: every sample.
 # The ratio fixed/double is printed per configuration.
-if [ -x "$B/bench_core" ]; then
-  section "fixed-point core vs double-precision Eigen (CPU ns per sample, one run)"
-  "$B/bench_core" --benchmark_min_time="$MIN_TIME" --benchmark_format=csv 2>/dev/null |
-    awk -F, 'NR>1 && $1 ~ /BM_/ { gsub(/"/,"",$1); t[$1]=$4 }
+# core_table: the table from bench_core's CSV on stdin.
+core_table() {
+  awk -F, 'NR>1 && $1 ~ /BM_/ { gsub(/"/,"",$1); t[$1]=$4 }
       function row(n, k, e, label,   f, d) {
         f = t["BM_FixedMatrix/" n "/" k "/" e]; d = t["BM_EigenDouble/" n "/" k "/" e]
         if (f > 0 && d > 0) { printf "  %-4d %-40s %10.1f %10.1f %8.2f\n", n, label, f, d, f / d
@@ -27,11 +26,36 @@ if [ -x "$B/bench_core" ]; then
         worst = 0
         for (n = 6; n <= 8; n += 2) for (k = 0; k <= 3; ++k) row(n, k, 0, name[k+1])
         printf "  worst fixed/double = %.2f (target <= 1.00)\n", worst
+        for (n = 6; n <= 8; n += 2) for (k = 2; k <= 3; ++k) {
+          f = t["BM_FixedMatrix/" n "/" k "/0"]; d = t["BM_EigenDoubleCached/" n "/" k "/0"]
+          if (f > 0 && d > 0) printf "  %-4d %-40s %10.1f %10.1f %8.2f\n", n, name[k+1] " (double caching per T)", f, d, f / d
+        }
         printf "  worst case, a new temperature every sample (the cached coefficients recomputed each time):\n"
         for (n = 6; n <= 8; n += 2) for (k = 2; k <= 3; ++k) row(n, k, 1, name[k+1] " (T every sample)")
-        for (n = 6; n <= 8; n += 2) printf "  whole core N=%d (faults, tare, filter 1 / 16): %.1f / %.1f ns\n", n,
+        for (n = 6; n <= 8; n += 2) if (t["BM_FixedCore/" n "/1"] > 0) printf "  whole core N=%d (faults, tare, filter 1 / 16): %.1f / %.1f ns\n", n,
           t["BM_FixedCore/" n "/1"], t["BM_FixedCore/" n "/16"]
       }'
+}
+if [ -x "$B/bench_core" ]; then
+  section "fixed-point core vs double-precision Eigen (CPU ns per sample, one run)"
+  "$B/bench_core" --benchmark_min_time="$MIN_TIME" --benchmark_format=csv 2>/dev/null | core_table
+fi
+
+# --- the same on aarch64 under qemu-user (issue 15), when a cross build of bench_core exists ------
+# cmake --preset cross-aarch64 -DFTSTACK_BUILD_BENCH=ON && cmake --build build-aarch64 --target
+# bench_core (sysroot: cmake/make-sysroot.sh arm64). qemu translates each instruction, so the
+# absolute ns mean little; the ratio to the same double implementation is the figure.
+A64=${FTSTACK_AARCH64_BUILD:-build-aarch64}
+A64_LIB="$(dirname "$0")/../out/sysroot-arm64/usr/lib/aarch64-linux-gnu"
+if [ -x "$A64/bench/bench_core" ] && command -v qemu-aarch64 >/dev/null 2>&1; then
+  section "aarch64 under qemu-aarch64: fixed-point core vs double-precision Eigen (same run)"
+  if ! qemu-aarch64 -L /usr/aarch64-linux-gnu -E "LD_LIBRARY_PATH=/usr/aarch64-linux-gnu/lib:$A64_LIB" \
+    "$A64/bench/bench_core" --benchmark_filter='Matrix|Eigen' --benchmark_min_time="$MIN_TIME" \
+    --benchmark_format=csv 2>/dev/null | core_table; then
+    echo "  (bench_core for aarch64 did not run under qemu-aarch64)"
+  fi
+else
+  section "aarch64 under qemu-aarch64: skipped (no $A64/bench/bench_core or no qemu-aarch64)"
 fi
 
 # --- Modbus TCP (issue 5): ftd vs a plain libmodbus server, same registers, same run -------

@@ -5,10 +5,6 @@
 #include <algorithm>
 #include <limits>
 
-#ifdef __SSE2__
-#include <emmintrin.h>
-#endif
-
 namespace ftstack::fw {
 
 namespace {
@@ -53,6 +49,7 @@ void WrenchCore::ClearTare() {
 
 void WrenchCore::BuildPlan() {
   plan_ = Plan{};
+  narrow_linear_ = nullptr;
   eff_dt_ = 0;
   const std::size_t n = cal_.channel_count;
   if (!cal_.valid || n > kMaxChannels || cal_.extra_count > kMaxFeatures - kMaxChannels) return;
@@ -96,11 +93,32 @@ void WrenchCore::BuildPlan() {
     plan_.temp_coef[r] = 0;
   }
   plan_.narrow = cal_.narrow;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    // k ≤ s always holds where the loader chose the narrow form (its rounding ≤ 1/16 LSB needs
+    // 2^k < 2^s); checked here because ApplyNarrow relies on it.
+    if (cal_.narrow_shift[r] > cal_.shift[r]) plan_.narrow = false;
+    plan_.final_shift[r] = static_cast<std::uint8_t>(cal_.shift[r] - cal_.narrow_shift[r]);
+    plan_.final.shift[r] = plan_.final_shift[r];
+    plan_.final.offset[r] =
+        (std::uint64_t{1} << 31) - (std::uint64_t{1} << (63 - plan_.final_shift[r]));
+  }
   plan_.narrow_shift = cal_.narrow_shift;
   plan_.narrow_product_shift = cal_.narrow_product_shift;
   for (std::size_t r = 0; r < kAxes; ++r) {
     const std::uint8_t k = plan_.narrow_shift[r];
     plan_.narrow_half[r] = k > 0 ? std::int64_t{1} << (k - 1) : 0;  // RoundShift's half
+  }
+  for (std::size_t c = 0; c < n; ++c) {
+    plan_.lo_minus_zero[c] =
+        static_cast<std::uint64_t>(std::int64_t{cal_.min_counts} - plan_.zero[c]);
+  }
+  if (plan_.narrow && p == 0 && n >= 1) {
+    static constexpr std::array<LinearFn, kMaxChannels> kLinear = {
+        &WrenchCore::ApplyNarrowLinear<1>, &WrenchCore::ApplyNarrowLinear<2>,
+        &WrenchCore::ApplyNarrowLinear<3>, &WrenchCore::ApplyNarrowLinear<4>,
+        &WrenchCore::ApplyNarrowLinear<5>, &WrenchCore::ApplyNarrowLinear<6>,
+        &WrenchCore::ApplyNarrowLinear<7>, &WrenchCore::ApplyNarrowLinear<8>};
+    narrow_linear_ = kLinear[n - 1];
   }
   for (std::size_t r = 0; r < kAxes && plan_.narrow; ++r) {
     std::uint64_t sum = 0;
@@ -139,25 +157,37 @@ void WrenchCore::Effective(std::int32_t dt_mdegc, Columns& eff,
 }
 
 void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
-  std::array<std::int64_t, kAxes> k{};
-  Effective(dt_mdegc, eff_, k);
-  // With the final rounding half: Apply shifts acc right without adding it (the loader's bound
-  // covers every partial sum plus the half, in any order).
-  for (std::size_t r = 0; r < kAxes; ++r) konst_[r] = k[r] - tare_acc_[r] + plan_.round_half[r];
   eff_dt_ = dt_mdegc;
-  if (!plan_.narrow) return;
-  const std::size_t n = plan_.channels;
-  std::array<std::uint64_t, kAxes> sum{};
-  for (std::size_t c = 0; c < n; ++c) {
+  if (!plan_.narrow) {
+    std::array<std::int64_t, kAxes> k{};
+    Effective(dt_mdegc, eff_, k);
+    // With the final rounding half: Apply shifts acc right without adding it (the loader's bound
+    // covers every partial sum plus the half, in any order).
+    for (std::size_t r = 0; r < kAxes; ++r) konst_[r] = k[r] - tare_acc_[r] + plan_.round_half[r];
+    return;
+  }
+  // The narrow form reads only narrow_tab_ and narrow_low_: Effective's values, rounded to the
+  // narrow coefficients as they are made (eff_ is not kept).
+  const std::int64_t dt = dt_mdegc;
+  std::array<std::uint64_t, kAxes> base{};  // Σ_c c'·(lo − zero_c), modulo 2^64
+  for (std::size_t c = 0; c < plan_.channels; ++c) {
+    const std::uint8_t h = plan_.drift_shift[c];
+    const std::uint64_t lz = plan_.lo_minus_zero[c];
     for (std::size_t r = 0; r < kAxes; ++r) {
+      const std::int64_t d = (plan_.drift[c][r] * dt + plan_.drift_half[c]) >> h;
       // |eff'| ≤ 2^31 − 1 at every ΔT in range (NarrowRow): eff' + 2^31 fits 32 bits.
-      const std::int64_t e = (eff_[c][r] + plan_.narrow_half[r]) >> plan_.narrow_shift[r];
-      eff_u_[c][r] = static_cast<std::uint64_t>(e + kHalf32);
-      sum[r] += eff_u_[c][r];
+      const std::int64_t e = (plan_.coef[c][r] + d + plan_.narrow_half[r]) >> plan_.narrow_shift[r];
+      narrow_tab_.coef_u[c][r] = static_cast<std::uint64_t>(e + kHalf32);
+      narrow_tab_.coef_u32[c][r] = static_cast<std::uint32_t>(e + kHalf32);
+      base[r] += static_cast<std::uint64_t>(e) * lz;
     }
   }
   for (std::size_t r = 0; r < kAxes; ++r) {
-    narrow_k_[r] = (sum[r] << 31) - (std::uint64_t{n} << 62);  // modulo 2^64
+    // K with the final rounding half (see above); floor(K/2^k) + base and K mod 2^k.
+    konst_[r] = plan_.bias[r] + plan_.temp_coef[r] * dt - tare_acc_[r] + plan_.round_half[r];
+    const std::uint8_t ks = plan_.narrow_shift[r];
+    narrow_tab_.konst[r] = static_cast<std::uint64_t>(konst_[r] >> ks) + base[r];
+    narrow_low_[r] = konst_[r] & ((std::int64_t{1} << ks) - 1);
   }
 }
 
@@ -180,64 +210,52 @@ void WrenchCore::UpdateEffective(std::int32_t dt_mdegc) const {
   }
 }
 
-// Inlined into Apply: the narrow form of Accumulate (see Plan::narrow): one 64-bit sum of
-// unsigned 32-bit products per axis for the counts and one for the second-order features.
-[[gnu::always_inline]] inline void WrenchCore::AccumulateNarrow(
-    const std::array<std::int32_t, kMaxChannels>& counts, std::array<std::int64_t, kAxes>& acc,
-    bool& clamped) const {
-  const std::size_t n = plan_.channels;
-  // x̃ = counts − zero, |x̃| < 2^31 (NarrowRow); only [0, n) is written and read.
-  std::array<std::int64_t, kMaxChannels> x;  // NOLINT(cppcoreguidelines-pro-type-member-init)
-  std::array<std::uint64_t, 2> xsum{};       // Σ x'_u: counts, products
-#ifdef __SSE2__
-  // Every lane is stored from the vector sums below.
-  // NOLINTNEXTLINE(cppcoreguidelines-pro-type-member-init)
-  std::array<std::array<std::uint64_t, kAxes>, 2> sum;
-  // pmuludq multiplies the low 32 bits of each 64-bit lane: two axes per instruction.
-  __m128i s[2][3] = {};  // NOLINT: vector registers (std::array drops their attributes)
-  auto madd = [&](std::size_t g, const std::array<std::uint64_t, kAxes>& col, std::uint64_t xu) {
-    const __m128i xb = _mm_set1_epi64x(static_cast<long long>(xu));
-    const auto* p = reinterpret_cast<const __m128i*>(col.data());  // NOLINT
-    s[g][0] = _mm_add_epi64(s[g][0], _mm_mul_epu32(_mm_loadu_si128(p), xb));
-    s[g][1] = _mm_add_epi64(s[g][1], _mm_mul_epu32(_mm_loadu_si128(p + 1), xb));
-    s[g][2] = _mm_add_epi64(s[g][2], _mm_mul_epu32(_mm_loadu_si128(p + 2), xb));
-  };
-#else
-  std::array<std::array<std::uint64_t, kAxes>, 2> sum{};
-  auto madd = [&](std::size_t g, const std::array<std::uint64_t, kAxes>& col, std::uint64_t xu) {
-    for (std::size_t r = 0; r < kAxes; ++r) sum[g][r] += col[r] * xu;
-  };
-#endif
-  for (std::size_t c = 0; c < n; ++c) {
-    const std::int32_t v = std::min(std::max(counts[c], cal_.min_counts), cal_.max_counts);
-    clamped |= v != counts[c];
-    x[c] = std::int64_t{v} - plan_.zero[c];
-    const auto xu = static_cast<std::uint64_t>(x[c] + kHalf32);
-    xsum[0] += xu;
-    madd(0, eff_u_[c], xu);
+// Inlined into Apply: the narrow form (see Plan::narrow and narrow::Table). The counts sum runs
+// in 32x32→64-bit lanes; the second-order features, when present, in a second group of lanes.
+template <std::size_t N>
+void WrenchCore::ApplyNarrowLinear(const std::array<std::int32_t, kMaxChannels>& counts,
+                                   WrenchLsb& y, bool* saturated) const {
+  // Clamped counts (unused here) and t = floor(acc/2^k) exactly (its true value is bounded by
+  // the loader): one more shift.
+  std::array<std::int32_t, kMaxChannels> v;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+  std::array<std::uint64_t, kAxes> t;        // NOLINT(cppcoreguidelines-pro-type-member-init)
+  bool sat = narrow::CountsSum<N>(counts, cal_.min_counts, cal_.max_counts, narrow_tab_, v, t);
+  if (!narrow::ShiftToI32(t, plan_.final, y)) {  // some axis beyond int32: saturate
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      y[r] = SatToI32(static_cast<std::int64_t>(t[r]) >> plan_.final_shift[r], &sat);
+    }
   }
+  if (sat) *saturated = true;
+}
+
+[[gnu::always_inline]] inline void WrenchCore::ApplyNarrow(
+    const std::array<std::int32_t, kMaxChannels>& counts, std::array<std::int64_t, kAxes>& q,
+    bool& clamped) const {
+  // Clamped counts: only [0, n) is written and read.
+  std::array<std::int32_t, kMaxChannels> v;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+  std::array<std::uint64_t, kAxes> t;        // NOLINT(cppcoreguidelines-pro-type-member-init)
+  clamped |= narrow::CountsSumN(plan_.channels, counts, cal_.min_counts, cal_.max_counts,
+                                narrow_tab_, v, t);
+  std::array<std::int64_t, kMaxChannels> x;  // NOLINT: x̃ = v − zero, [0, n) written and read
+  for (std::size_t c = 0; c < plan_.channels; ++c) x[c] = std::int64_t{v[c]} - plan_.zero[c];
+  std::uint64_t psum = 0;  // Σ p'_u
+  narrow::Sums6 sums;
   for (std::size_t j = 0; j < plan_.products; ++j) {
+    // The loader checked |x̃_a·x̃_b| + half ≤ 2^63 − 1 (kFeatureOverflow) and sized the shifts.
     const std::int64_t p = (x[plan_.a[j]] * x[plan_.b[j]] + plan_.half[j]) >> plan_.shift[j];
     const auto pu = static_cast<std::uint64_t>(p + kHalf32);  // |p| < 2^31 (NarrowRow)
-    xsum[1] += pu;
-    madd(1, plan_.quad_u[j], pu);
+    psum += pu;
+    sums.Add(plan_.quad_u[j], pu);
   }
-#ifdef __SSE2__
-  for (std::size_t g = 0; g < 2; ++g) {
-    auto* out = reinterpret_cast<__m128i*>(sum[g].data());  // NOLINT
-    for (std::size_t i = 0; i < 3; ++i) _mm_storeu_si128(out + i, s[g][i]);
-  }
-#endif
-  // The true Σ c'·x of each group (|·|·2^k bounded by the loader), scaled back by 2^k, modulo
-  // 2^64.
+  std::array<std::uint64_t, kAxes> sum;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+  sums.Store(sum);
   for (std::size_t r = 0; r < kAxes; ++r) {
-    const std::uint64_t lin = sum[0][r] - narrow_k_[r] - (xsum[0] << 31);
-    acc[r] += static_cast<std::int64_t>(lin << plan_.narrow_shift[r]);
-  }
-  if (plan_.products == 0) return;
-  for (std::size_t r = 0; r < kAxes; ++r) {
-    const std::uint64_t quad = sum[1][r] - plan_.quad_k[r] - (xsum[1] << 31);
-    acc[r] += static_cast<std::int64_t>(quad << plan_.narrow_product_shift[r]);
+    // acc = T·2^k + (K mod 2^k) + (Σ q'·p)·2^k2, modulo 2^64 (the true acc is bounded).
+    const std::uint64_t quad = sum[r] - plan_.quad_k[r] - (psum << 31);
+    const std::uint64_t acc = (t[r] << plan_.narrow_shift[r]) +
+                              static_cast<std::uint64_t>(narrow_low_[r]) +
+                              (quad << plan_.narrow_product_shift[r]);
+    q[r] = static_cast<std::int64_t>(acc) >> cal_.shift[r];
   }
 }
 
@@ -287,24 +305,28 @@ void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts,
     const std::int32_t dt = DeltaT(temperature_mdegc, has_temperature, temp_range);
     if (dt != eff_dt_) UpdateEffective(dt);
   }
-  // The loader guarantees every partial sum stays within ±2^62 (EvaluationFits).
-  std::array<std::int64_t, kAxes> acc = konst_;
+  if (narrow_linear_ != nullptr) {  // narrow, no second-order features: one instance per N
+    (this->*narrow_linear_)(counts, y, saturated);
+    return;
+  }
+  // The loader guarantees every partial sum stays within ±2^62 (EvaluationFits). konst_ holds
+  // the rounding half. An axis the calibration does not determine has all-zero rows in the plan:
+  // it reads 0.
+  std::array<std::int64_t, kAxes> q;  // NOLINT(cppcoreguidelines-pro-type-member-init)
   if (plan_.narrow) {
-    AccumulateNarrow(counts, acc, clamped);  // clamps the counts itself
+    ApplyNarrow(counts, q, clamped);  // clamps the counts itself
   } else {
     std::array<std::int32_t, kMaxChannels> v{};
     for (std::size_t c = 0; c < n; ++c) {
       v[c] = std::min(std::max(counts[c], cal_.min_counts), cal_.max_counts);  // branch-free
       clamped |= v[c] != counts[c];
     }
+    std::array<std::int64_t, kAxes> acc = konst_;
     Accumulate(v, eff_, acc);
+    for (std::size_t r = 0; r < kAxes; ++r) q[r] = acc[r] >> cal_.shift[r];
   }
-  // konst_ holds the rounding half. An axis the calibration does not determine has all-zero rows
-  // in the plan: it reads 0.
-  std::array<std::int64_t, kAxes> q{};
   std::uint64_t outside = 0;  // bits ≥ 32 set when some q is outside int32
   for (std::size_t r = 0; r < kAxes; ++r) {
-    q[r] = acc[r] >> cal_.shift[r];
     outside |= static_cast<std::uint64_t>(q[r]) + (std::uint64_t{1} << 31);
     y[r] = static_cast<std::int32_t>(q[r]);
   }

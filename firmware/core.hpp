@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "firmware/fixed_calibration.hpp"
+#include "firmware/narrow_sum.hpp"
 #include "firmware/status_bits.hpp"
 #include "firmware/wrench.hpp"
 #include "hal/adc.hpp"
@@ -110,12 +111,19 @@ class WrenchCore {
   /// Σ eff·v + Σ q·p (+ acc's start value) for clamped counts v: the per-sample sum.
   void Accumulate(const std::array<std::int32_t, kMaxChannels>& v, const Columns& eff,
                   std::array<std::int64_t, kAxes>& acc) const;
-  /// The same sum in the narrow form (FixedCalibration::narrow) with the cached eff_u_, for raw
-  /// counts that it clamps to the rails (clamped set when it had to).
-  void AccumulateNarrow(const std::array<std::int32_t, kMaxChannels>& counts,
-                        std::array<std::int64_t, kAxes>& acc, bool& clamped) const;
-  /// Unsigned 32-bit lanes (c + 2^31 in uint64): [channel or product][axis].
-  using ColumnsU = std::array<std::array<std::uint64_t, kAxes>, kMaxChannels>;
+  /// The same model in the narrow form (FixedCalibration::narrow) with the cached narrow_tab_, for
+  /// raw counts that it clamps to the rails (clamped set when it had to), with second-order
+  /// features: q = the sum shifted right by each row's binary point (before the saturation).
+  void ApplyNarrow(const std::array<std::int32_t, kMaxChannels>& counts,
+                   std::array<std::int64_t, kAxes>& q, bool& clamped) const;
+  /// The narrow form without second-order features for N channels, whole (clamp, sum, shift,
+  /// int32 saturation, *saturated set when clamped or saturated): BuildPlan points
+  /// narrow_linear_ at the instance for the calibration's N.
+  template <std::size_t N>
+  void ApplyNarrowLinear(const std::array<std::int32_t, kMaxChannels>& counts, WrenchLsb& y,
+                         bool* saturated) const;
+  using LinearFn = void (WrenchCore::*)(const std::array<std::int32_t, kMaxChannels>&, WrenchLsb&,
+                                        bool*) const;
 
   /// The calibration as the per-sample path reads it. Temperature terms never reach the
   /// per-sample sum: the ΔT feature, and each ΔT product C_c·round(x̃_c·ΔT/2^h) evaluated as
@@ -150,17 +158,24 @@ class WrenchCore {
     std::array<std::int64_t, kAxes> narrow_half{};           ///< rounding half of the counts' k
     std::array<std::array<std::uint64_t, kAxes>, kMaxProducts> quad_u{};  ///< q' + 2^31
     std::array<std::uint64_t, kAxes> quad_k{};  ///< 2^31·Σ_j q'_u − P·2^62 mod 2^64
+    /// s_r − k_r: the counts sum T_r = floor(acc_r / 2^k_r) needs only this shift without
+    /// products (floor(floor(a/2^k)/2^(s−k)) = floor(a/2^s); the plan is narrow only if k ≤ s).
+    std::array<std::uint8_t, kAxes> final_shift{};
+    narrow::Final final{};  ///< the same shifts for narrow::ShiftToI32
+    std::array<std::uint64_t, kMaxChannels> lo_minus_zero{};  ///< lower rail − zero_c, mod 2^64
   };
 
-  FixedCalibration cal_{};
+  // The 16-byte aligned members first (SIMD loads), then the rest.
+  mutable narrow::Table narrow_tab_{};  ///< the narrow coefficients at eff_dt_
   Plan plan_{};
+  LinearFn narrow_linear_ = nullptr;
+  FixedCalibration cal_{};
   // A cache of values derived from the calibration, the tare and the last ΔT (mutable: Apply is
   // const; WrenchCore is single-threaded by contract).
-  mutable Columns eff_{};                            ///< counts coefficients at eff_dt_
+  mutable Columns eff_{};  ///< counts coefficients at eff_dt_ (64-bit form only)
   mutable std::array<std::int64_t, kAxes> konst_{};  ///< constant at eff_dt_ minus tare_acc_
   mutable std::int32_t eff_dt_ = 0;
-  mutable ColumnsU eff_u_{};                             ///< narrow eff_ (+ 2^31)
-  mutable std::array<std::uint64_t, kAxes> narrow_k_{};  ///< 2^31·Σ c'_u − N·2^62 mod 2^64
+  mutable std::array<std::int64_t, kAxes> narrow_low_{};  ///< konst_ mod 2^k_r
   /// The untared sum at the tare (zero without one): subtracting it makes every feature relative
   /// to its value at the tare and drops the bias.
   std::array<std::int64_t, kAxes> tare_acc_{};

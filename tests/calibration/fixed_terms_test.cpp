@@ -24,11 +24,11 @@ struct Case {
 
 /// A random calibration shaped like a real one: about rated output at 0.6 mV/V per bridge,
 /// second-order terms worth ~1 % of rated at that level, drift of ~0.03 %/°C.
-Case RandomCase(std::mt19937_64& rng, bool products, bool temperature) {
+Case RandomCase(std::mt19937_64& rng, bool products, bool temperature, int channels = 0) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::uniform_int_distribution<int> nch(1, 8);
   Case c;
-  const int n = nch(rng);
+  const int n = channels > 0 ? channels : nch(rng);
   c.adc = cal::DefaultAdc(static_cast<std::uint8_t>(n));
   c.cal.channel_count = static_cast<std::uint8_t>(n);
   for (std::size_t r = 0; r < 6; ++r) {
@@ -410,6 +410,69 @@ TEST(FixedTerms, NarrowFormOnlyWhereProvenAndWithinTheBound) {
   for (std::size_t r = 0; r < 6; ++r) EXPECT_LE(rep.worst_case_error_lsb[r], 1.0);
   ExpectWithinBound(
       big, core, rep, rng, 300, [&](int) { return temp(rng); }, {}, nullptr);
+}
+
+/// The narrow form's per-channel-count kernels (SSE2 / NEON / scalar, one instance per N): for
+/// every N = 1 … 8 and every combination of terms, counts beyond the rails (up to the int32
+/// limits) are clamped and flagged, channels beyond N (filled with extreme values) are ignored,
+/// and the result stays within the loader's bound of the reference at the clamped counts, and
+/// within 1 LSB of the 64-bit form.
+TEST(FixedTerms, NarrowKernelsForEveryChannelCountClampBeyondTheRails) {
+  std::mt19937_64 rng(21);
+  std::uniform_int_distribution<std::int32_t> temp(-15000, 65000);
+  std::uniform_int_distribution<int> pick(0, 5);
+  for (int n = 1; n <= 8; ++n) {
+    for (int terms = 0; terms < 4; ++terms) {
+      const Case c = RandomCase(rng, (terms & 1) != 0, (terms & 2) != 0, n);
+      fw::FixedCalibration fixed{};
+      fw::LoadReport rep{};
+      ASSERT_EQ(fw::LoadCalibration(c.cal, c.adc, &fixed, &rep), fw::LoadStatus::kOk);
+      ASSERT_TRUE(fixed.narrow) << "N " << n << " terms " << terms;
+      fw::FixedCalibration wide = fixed;
+      wide.narrow = false;
+      fw::WrenchCore narrow_core;
+      fw::WrenchCore wide_core;
+      narrow_core.SetCalibration(fixed);
+      wide_core.SetCalibration(wide);
+      for (int s = 0; s < 200; ++s) {
+        auto x = RandomCounts(rng, c.adc);
+        auto inside = x;
+        bool beyond = false;
+        for (std::size_t ch = 0; ch < hal::kMaxChannels; ++ch) {
+          const int p = pick(rng);
+          std::int32_t v = x[ch];
+          if (p == 0) v = std::numeric_limits<std::int32_t>::max();
+          if (p == 1) v = std::numeric_limits<std::int32_t>::min();
+          if (p == 2) v = c.adc.max_counts + 1;
+          if (p == 3) v = c.adc.min_counts - 1;
+          if (ch >= static_cast<std::size_t>(n)) {
+            x[ch] = v;  // not a channel of this calibration: never read
+            continue;
+          }
+          if (s % 2 == 0) continue;  // every other sample stays between the rails
+          x[ch] = v;
+          inside[ch] = std::clamp(v, c.adc.min_counts, c.adc.max_counts);
+          beyond = beyond || v != inside[ch];
+        }
+        const std::int32_t t = temp(rng);
+        fw::WrenchLsb yn{};
+        fw::WrenchLsb yw{};
+        bool sat_n = false;
+        bool sat_w = false;
+        bool range = false;
+        narrow_core.Apply(x, t, true, yn, &sat_n, &range);
+        wide_core.Apply(x, t, true, yw, &sat_w, &range);
+        EXPECT_EQ(sat_n, beyond) << "N " << n << " sample " << s;
+        EXPECT_EQ(sat_w, beyond);
+        const auto ref = Reference(c, inside, t);
+        for (std::size_t r = 0; r < 6; ++r) {
+          ASSERT_LE(std::fabs(yn[r] - ref[r]), rep.worst_case_error_lsb[r])
+              << "N " << n << " terms " << terms << " axis " << r;
+          ASSERT_LE(std::abs(yn[r] - yw[r]), 1);
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
