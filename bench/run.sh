@@ -135,7 +135,8 @@ if [ -x "$B/bench_diag" ]; then
             u=c["BM_DiagnoseClock1M/1000000/0/iterations:1"]; j=c["BM_DiagnoseClock1M/1000000/1/iterations:1"];
             if (u > 0) printf "  1e6 rows: jittered / uniform CPU = %.2f\n", j / u }'
   [ -s "$B/diag_clock_rss" ] && echo "  peak resident memory of the run (largest case): $(( $(cat "$B/diag_clock_rss") / 1024 )) MB"
-  # The real command on the same data written as CSV: wall time (reading included) and peak memory.
+  # The real command on the same data written as CSV: wall and user CPU time (reading included; the
+  # CPU time is the steadier figure on a loaded machine) and peak memory.
   if [ -x "$B/bench_diag_data" ] && [ -x "$BUILD/bin/ftdiag" ]; then
     section "ftdiag diagnose (the command, CSV in, JSON out), 8 channels: wall time and peak memory (GNU time)"
     tmp=$(mktemp -d)
@@ -143,11 +144,12 @@ if [ -x "$B/bench_diag" ]; then
       for jit in 0 1; do
         label=$([ "$jit" = 1 ] && echo jittered || echo uniform)
         "$B/bench_diag_data" "$rows" "$jit" "$tmp/sim.csv" "$tmp/real.csv"
-        if /usr/bin/time -f "%e %M" -o "$tmp/tv" "$BUILD/bin/ftdiag" diagnose --sim "$tmp/sim.csv" \
+        if /usr/bin/time -f "%e %U %M" -o "$tmp/tv" "$BUILD/bin/ftdiag" diagnose --sim "$tmp/sim.csv" \
             --real "$tmp/real.csv" --json "$tmp/out.json" >/dev/null 2>&1; then
-          read -r wall kb < "$tmp/tv"
-          printf "  %8d rows %-9s %7.1f s wall %6d MB peak  verdict %s\n" "$rows" "$label" "$wall" \
-            $((kb / 1024)) "$(sed -n 's/.*"verdict": *"\([^"]*\)".*/\1/p' "$tmp/out.json" | head -1)"
+          read -r wall user kb < "$tmp/tv"
+          printf "  %8d rows %-9s %7.1f s wall %7.1f s CPU %6d MB peak  verdict %s\n" "$rows" \
+            "$label" "$wall" "$user" $((kb / 1024)) \
+            "$(sed -n 's/.*"verdict": *"\([^"]*\)".*/\1/p' "$tmp/out.json" | head -1)"
         else
           echo "  $rows rows $label: ftdiag diagnose failed"
         fi

@@ -243,9 +243,11 @@ bool FitPair(const Context& cx, const Mat& target, const EffectSpec& a, const Ef
     if (it == 0 && b0 != nullptr) {
       *fb = std::move(*b0);
     } else {
+      fb->pred = Mat();  // memory: the previous B is replaced; only `first` is used now
       auto nb = b.fit(cx, target - first->pred);
       if (!nb) return false;
       *fb = std::move(*nb);
+      if (first == fa) fa->pred = Mat();  // the previous A is replaced below
     }
     auto na = a.fit(cx, target - fb->pred);
     if (!na) return false;
@@ -299,6 +301,7 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
   const Context& cx = r.cx;
   std::vector<Scored> singles;
   const auto& effects = Effects();
+  singles.reserve(effects.size());  // no reallocation (it would copy the kept predictions)
   for (std::size_t j = 0; j < effects.size(); ++j) {
     Progress(options, 0.05 + 0.6 * static_cast<double>(j) / static_cast<double>(effects.size()),
              effects[j].name);
@@ -342,7 +345,7 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
 
 /// Pairs: the best single with each other eligible candidate among the top six, backfitted.
 /// True with *pa, *pb set when a pair beats every model so far.
-bool BestPair(const Context& cx, const DiagnoseOptions& options, const std::vector<Scored>& singles,
+bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Scored>& singles,
               const Sums& base, EffectFit* pa, EffectFit* pb) {
   const Scored& best = singles.front();
   const auto& effects = Effects();
@@ -400,8 +403,7 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, const std::vect
       EffectFit fa;
       EffectFit fb;
       if (!FitPair(cx, cx.resid, *sa, *sb, first.fit, b0, &fa, &fb)) continue;
-      Mat both = fa.pred + fb.pred;
-      const Sums s = Score(cx, cx.resid, &both);
+      const Sums s = ScoreSum(cx, cx.resid, fa.pred, fb.pred);
       const double delta = base.hold_sse - s.hold_sse;
       const double score = delta - (fa.n_params + fb.n_params) * HoldPenalty(cx);
       // The partner must add a significant held-out improvement over the first alone …
@@ -409,7 +411,7 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, const std::vect
       for (int c = 0; c < cx.nc; ++c) {
         for (int i = 0; i < cx.n; ++i) {
           if (cx.train[static_cast<std::size_t>(i)]) continue;
-          const double diff = both(i, c) - first.fit.pred(i, c);
+          const double diff = (fa.pred(i, c) + fb.pred(i, c)) - first.fit.pred(i, c);
           dd += diff * diff * cx.weight(c);
         }
       }
@@ -430,6 +432,8 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, const std::vect
         have_pair = true;
       }
     }
+    // Memory: a start other than the best single is not used again.
+    if (x != 0) singles[x].fit.pred = Mat();
   }
   return have_pair;
 }
@@ -536,7 +540,7 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
   Locate(r);
   ReportSpectrum(r);
   const Sums base = Score(cx, cx.resid, nullptr);
-  const std::vector<Scored> singles = FitSingles(r, options, base);
+  std::vector<Scored> singles = FitSingles(r, options, base);
   if (singles.empty() || !singles.front().eligible) {
     r.model = Mat::Zero(cx.n, cx.nc);  // allocated only now: nothing claimed
     Progress(options, 1.0, "done");
@@ -554,8 +558,10 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
     claimed.push_back(std::move(pa));
     claimed.push_back(std::move(pb));
   } else {
-    claimed.push_back(singles.front().fit);
+    claimed.push_back(std::move(singles.front().fit));
   }
+  singles.clear();  // memory: the kept single predictions are not used again
+  singles.shrink_to_fit();
   RefineThermal(cx, &claimed);
   const std::vector<Confounding> partner_conf =
       DropUnidentifiedPartner(cx, options.z_claim, &claimed, &r.dropped);

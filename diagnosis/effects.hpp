@@ -108,5 +108,8 @@ struct Sums {
 };
 [[nodiscard]] Sums Score(const Context& cx, const Eigen::MatrixXd& target,
                          const Eigen::MatrixXd* pred);
+/// Score(cx, target, &(a + b)) without the n × N sum (the same sums, element by element).
+[[nodiscard]] Sums ScoreSum(const Context& cx, const Eigen::MatrixXd& target,
+                            const Eigen::MatrixXd& a, const Eigen::MatrixXd& b);
 
 }  // namespace ftstack::diag

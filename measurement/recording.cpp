@@ -90,69 +90,75 @@ std::vector<std::string> BridgeColumns(std::size_t n) {
   return v;
 }
 
-Recording ParseRecording(const std::string& text, const std::string& path,
-                         const ReadOptions& options) {
-  Recording rec;
-  rec.path = path;
-  std::size_t pos = 0;
-  std::size_t line_no = 0;
-  bool have_header = false;
-  int t_col = -1;
-  std::size_t next_progress = 1 << 20;
-  const char* const base = text.data();
-  while (pos < text.size()) {
-    std::size_t end = text.find('\n', pos);
-    if (end == std::string::npos) end = text.size();
-    std::string_view line(base + pos, end - pos);
-    const std::size_t line_start = pos;
-    pos = end + 1;
-    ++line_no;
+namespace {
+
+/// The line-by-line reader behind ParseRecording and ReadRecording: metadata, header, then one
+/// row per line (lines are given without their '\n').
+class LineParser {
+ public:
+  LineParser(const std::string& path, const ReadOptions& options) : options_(options) {
+    rec_.path = path;
+  }
+
+  void Line(std::string_view line) {
+    ++line_no_;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    if (options.progress != nullptr && line_start >= next_progress) {
-      options.progress(line_start, text.size(), options.progress_user);
-      next_progress = line_start + (1 << 20);
+    if (!have_header_) {
+      Header(line);
+      return;
     }
-    if (!have_header) {
-      if (line.empty()) continue;
-      if (line[0] == '#') {
-        std::string m = Trim(line.substr(1));
-        rec.metadata.push_back(m);
-        continue;
-      }
-      std::size_t a = 0;
-      while (true) {
-        const std::size_t b = line.find(',', a);
-        const std::string name = Trim(line.substr(a, b == std::string_view::npos ? b : b - a));
-        if (name.empty()) Fail(path, line_no, a + 1, "empty column name in header");
-        if (rec.Find(name) >= 0) Fail(path, line_no, a + 1, "duplicate column '" + name + "'");
-        rec.names.push_back(name);
-        if (b == std::string_view::npos) break;
-        a = b + 1;
-      }
-      rec.columns.resize(rec.names.size());
-      have_header = true;
-      auto require = [&](const std::string& col) {
-        if (rec.Find(col) < 0) {
-          Fail(path, line_no, line.size() + 1, "header lacks required column '" + col + "'");
-        }
-      };
-      for (const auto& r : options.required) require(r);
-      if (options.require_wrench) {
-        for (const auto& r : WrenchColumns()) require(r);
-      }
-      if (options.require_bridges) require("b0");
-      t_col = rec.Find("t");
-      continue;
+    if (line.empty()) return;  // tolerate blank lines (e.g. a trailing one)
+    Row(line);
+  }
+
+  Recording Finish() {
+    if (!have_header_) throw RecordingError(rec_.path + ": no header line");
+    return std::move(rec_);
+  }
+
+ private:
+  void Header(std::string_view line) {
+    const std::string& path = rec_.path;
+    if (line.empty()) return;
+    if (line[0] == '#') {
+      rec_.metadata.push_back(Trim(line.substr(1)));
+      return;
     }
-    if (line.empty()) continue;  // tolerate blank lines (e.g. a trailing one)
+    std::size_t a = 0;
+    while (true) {
+      const std::size_t b = line.find(',', a);
+      const std::string name = Trim(line.substr(a, b == std::string_view::npos ? b : b - a));
+      if (name.empty()) Fail(path, line_no_, a + 1, "empty column name in header");
+      if (rec_.Find(name) >= 0) Fail(path, line_no_, a + 1, "duplicate column '" + name + "'");
+      rec_.names.push_back(name);
+      if (b == std::string_view::npos) break;
+      a = b + 1;
+    }
+    rec_.columns.resize(rec_.names.size());
+    have_header_ = true;
+    auto require = [&](const std::string& col) {
+      if (rec_.Find(col) < 0) {
+        Fail(path, line_no_, line.size() + 1, "header lacks required column '" + col + "'");
+      }
+    };
+    for (const auto& r : options_.required) require(r);
+    if (options_.require_wrench) {
+      for (const auto& r : WrenchColumns()) require(r);
+    }
+    if (options_.require_bridges) require("b0");
+    t_col_ = rec_.Find("t");
+  }
+
+  void Row(std::string_view line) {
+    const std::string& path = rec_.path;
     std::size_t a = 0;
     std::size_t field = 0;
     while (true) {
       const std::size_t b = line.find(',', a);
       const std::size_t stop = b == std::string_view::npos ? line.size() : b;
-      if (field >= rec.names.size()) {
-        Fail(path, line_no, a + 1,
-             "more fields than the header's " + std::to_string(rec.names.size()) + " columns");
+      if (field >= rec_.names.size()) {
+        Fail(path, line_no_, a + 1,
+             "more fields than the header's " + std::to_string(rec_.names.size()) + " columns");
       }
       std::size_t s = a;
       std::size_t e = stop;
@@ -164,49 +170,89 @@ Recording ParseRecording(const std::string& text, const std::string& path,
       if (s < e && *first == '+') ++first;
       const auto res = std::from_chars(first, last, v);
       if (s == e || res.ec != std::errc() || res.ptr != last) {
-        Fail(path, line_no, s + 1,
-             "column '" + rec.names[field] + "': '" + std::string(line.substr(s, e - s)) +
+        Fail(path, line_no_, s + 1,
+             "column '" + rec_.names[field] + "': '" + std::string(line.substr(s, e - s)) +
                  "' is not a number");
       }
       if (!std::isfinite(v)) {
-        Fail(path, line_no, s + 1,
-             "column '" + rec.names[field] + "': NaN/infinity is not allowed");
+        Fail(path, line_no_, s + 1,
+             "column '" + rec_.names[field] + "': NaN/infinity is not allowed");
       }
-      rec.columns[field].push_back(v);
+      rec_.columns[field].push_back(v);
       ++field;
       if (b == std::string_view::npos) break;
       a = b + 1;
     }
-    if (field != rec.names.size()) {
-      Fail(path, line_no, line.size() + 1,
+    if (field != rec_.names.size()) {
+      Fail(path, line_no_, line.size() + 1,
            "row has " + std::to_string(field) + " fields, header has " +
-               std::to_string(rec.names.size()));
+               std::to_string(rec_.names.size()));
     }
-    rec.data_lines.push_back(line_no);
-    if (t_col >= 0) {
-      const auto& t = rec.columns[static_cast<std::size_t>(t_col)];
-      if (t.size() >= 2 && !(t[t.size() - 1] > t[t.size() - 2])) {
-        // Column of the t field within this line.
-        std::size_t col = 1;
-        std::size_t k = 0;
-        for (std::size_t i = 0; i < line.size() && k < static_cast<std::size_t>(t_col); ++i) {
-          if (line[i] == ',') {
-            ++k;
-            col = i + 2;
-          }
+    rec_.data_lines.push_back(line_no_);
+    if (t_col_ >= 0) CheckTime(line);
+  }
+
+  void CheckTime(std::string_view line) const {
+    const auto& t = rec_.columns[static_cast<std::size_t>(t_col_)];
+    if (t.size() >= 2 && !(t[t.size() - 1] > t[t.size() - 2])) {
+      // Column of the t field within this line.
+      std::size_t col = 1;
+      std::size_t k = 0;
+      for (std::size_t i = 0; i < line.size() && k < static_cast<std::size_t>(t_col_); ++i) {
+        if (line[i] == ',') {
+          ++k;
+          col = i + 2;
         }
-        Fail(path, line_no, col, "t is not strictly increasing");
       }
+      Fail(rec_.path, line_no_, col, "t is not strictly increasing");
     }
   }
-  if (!have_header) throw RecordingError(path + ": no header line");
-  return rec;
+
+  const ReadOptions& options_;
+  Recording rec_;
+  std::size_t line_no_ = 0;
+  bool have_header_ = false;
+  int t_col_ = -1;
+};
+
+/// Calls options.progress every ~1 MB of input (`done` = offset of the line being read).
+class ProgressTicker {
+ public:
+  ProgressTicker(const ReadOptions& options, std::size_t total)
+      : options_(options), total_(total) {}
+  void At(std::size_t done) {
+    if (options_.progress != nullptr && done >= next_) {
+      options_.progress(done, total_, options_.progress_user);
+      next_ = done + (1 << 20);
+    }
+  }
+
+ private:
+  const ReadOptions& options_;
+  std::size_t total_;
+  std::size_t next_ = 1 << 20;
+};
+
+}  // namespace
+
+Recording ParseRecording(const std::string& text, const std::string& path,
+                         const ReadOptions& options) {
+  LineParser parser(path, options);
+  ProgressTicker ticker(options, text.size());
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string::npos) end = text.size();
+    ticker.At(pos);
+    parser.Line(std::string_view(text.data() + pos, end - pos));
+    pos = end + 1;
+  }
+  return parser.Finish();
 }
 
 Recording ReadRecording(const std::string& path, const ReadOptions& options) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw RecordingError(path + ": cannot open: " + std::generic_category().message(errno));
-  // One copy of the text (a stringstream and its str() would hold two).
   std::error_code ec;
   const bool regular = std::filesystem::is_regular_file(path, ec);
   std::streamoff size = -1;
@@ -221,15 +267,39 @@ Recording ReadRecording(const std::string& path, const ReadOptions& options) {
     return ParseRecording(ss.str(), path, options);
   }
   in.seekg(0, std::ios::beg);
-  std::string text;
-  if (size > 0) {
-    text.resize(static_cast<std::size_t>(size));
-    in.read(text.data(), size);
-    if (in.gcount() != size) {
+  // Streamed in chunks (memory: the columns, not the text): lines are cut at '\n'; a line that
+  // runs past the chunk's end is carried to the front of the next one.
+  LineParser parser(path, options);
+  ProgressTicker ticker(options, static_cast<std::size_t>(size));
+  std::vector<char> buf(std::size_t{1} << 20);
+  std::size_t kept = 0;    // bytes of an unfinished line at the front of buf
+  std::size_t offset = 0;  // file offset of buf[0]
+  while (true) {
+    if (kept == buf.size()) buf.resize(buf.size() * 2);  // a line longer than the buffer
+    in.read(buf.data() + kept, static_cast<std::streamsize>(buf.size() - kept));
+    const auto got = static_cast<std::size_t>(in.gcount());
+    if (got == 0 && in.bad()) {
       throw RecordingError(path + ": read failed: " + std::generic_category().message(errno));
     }
+    const std::size_t have = kept + got;
+    const bool eof = got == 0;
+    std::size_t pos = 0;
+    while (pos < have) {
+      const void* nl = std::memchr(buf.data() + pos, '\n', have - pos);
+      if (nl == nullptr && !eof) break;
+      const std::size_t end =
+          nl == nullptr ? have
+                        : static_cast<std::size_t>(static_cast<const char*>(nl) - buf.data());
+      ticker.At(offset + pos);
+      parser.Line(std::string_view(buf.data() + pos, end - pos));
+      pos = end + 1;
+    }
+    if (eof) break;
+    kept = have - pos;
+    std::memmove(buf.data(), buf.data() + pos, kept);
+    offset += pos;
   }
-  return ParseRecording(text, path, options);
+  return parser.Finish();
 }
 
 void CheckAligned(const Recording& sim, const Recording& real) {

@@ -82,6 +82,22 @@ ChannelFit FitChannels(const Context& cx, const Mat& target, int p, F feat, Mat*
   return out;
 }
 
+/// pred(i, c) = Σ_j f.beta(j, c) · feat(i, c)_j on every row and channel: the prediction
+/// FitChannels fills (same sums in the same order), made only once a fit is kept (memory: n × N).
+template <class F>
+void PredictChannels(const Context& cx, const ChannelFit& f, int p, F feat, Mat* pred) {
+  std::vector<double> x(static_cast<std::size_t>(p));
+  pred->setZero(cx.n, cx.nc);
+  for (int c = 0; c < cx.nc; ++c) {
+    for (int i = 0; i < cx.n; ++i) {
+      feat(i, c, x.data());
+      double v = 0.0;
+      for (int j = 0; j < p; ++j) v += f.beta(j, c) * x[static_cast<std::size_t>(j)];
+      (*pred)(i, c) = v;
+    }
+  }
+}
+
 /// σ of parameter j of channel c from its unit covariance and the channel's residual variance.
 double ParamSigma(const Context& cx, const ChannelFit& f, int c, int j);
 /// Uncertainty of a nonlinear parameter from the curvature of the profile SSE (whitened, so

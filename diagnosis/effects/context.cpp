@@ -121,14 +121,18 @@ Context MakeContext(const DiagData& d, double block_s, const Eigen::VectorXd* si
   return cx;
 }
 
-Sums Score(const Context& cx, const Eigen::MatrixXd& target, const Eigen::MatrixXd* pred) {
+namespace {
+
+/// The whitened sums with prediction pred(i, c).
+template <class P>
+Sums ScoreWith(const Context& cx, const Eigen::MatrixXd& target, P pred) {
   Sums s;
   for (int c = 0; c < cx.nc; ++c) {
     double tr = 0.0;
     double ho = 0.0;
     double pp = 0.0;
     for (int i = 0; i < cx.n; ++i) {
-      const double p = pred != nullptr ? (*pred)(i, c) : 0.0;
+      const double p = pred(i, c);
       const double e = target(i, c) - p;
       if (cx.train[static_cast<std::size_t>(i)]) {
         tr += e * e;
@@ -142,6 +146,18 @@ Sums Score(const Context& cx, const Eigen::MatrixXd& target, const Eigen::Matrix
     s.hold_pp += pp * cx.weight(c);
   }
   return s;
+}
+
+}  // namespace
+
+Sums Score(const Context& cx, const Eigen::MatrixXd& target, const Eigen::MatrixXd* pred) {
+  if (pred == nullptr) return ScoreWith(cx, target, [](int, int) { return 0.0; });
+  return ScoreWith(cx, target, [pred](int i, int c) { return (*pred)(i, c); });
+}
+
+Sums ScoreSum(const Context& cx, const Eigen::MatrixXd& target, const Eigen::MatrixXd& a,
+              const Eigen::MatrixXd& b) {
+  return ScoreWith(cx, target, [&](int i, int c) { return a(i, c) + b(i, c); });
 }
 
 }  // namespace ftstack::diag

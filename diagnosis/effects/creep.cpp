@@ -59,22 +59,23 @@ std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
     const double tau = std::exp(lt);
     const double sl = CurvatureSigma([&](double v) { return sse_for(v, gamma); }, lt, 0.02);
     build(tau);
-    ChannelFit f;
-    if (gamma) {
-      f = FitChannels(
-          cx, target, 2,
-          [&](int i, int c, double* x) {
-            x[0] = lp(i, c);
-            x[1] = cx.load(i, c);
-          },
-          &e.pred);
-    } else {
-      f = FitChannels(
-          cx, target, 1, [&](int i, int c, double* x) { x[0] = lp(i, c); }, &e.pred);
-    }
+    const auto feat_gamma = [&](int i, int c, double* x) {
+      x[0] = lp(i, c);
+      x[1] = cx.load(i, c);
+    };
+    const auto feat_plain = [&](int i, int c, double* x) { x[0] = lp(i, c); };
+    // The prediction only for the variant kept (memory: one n × N prediction at a time).
+    const ChannelFit f = gamma ? FitChannels(cx, target, 2, feat_gamma, nullptr)
+                               : FitChannels(cx, target, 1, feat_plain, nullptr);
     e.train_sse_w = f.sse_w;
     const double bic = f.sse_w + p * Penalty(cx);
     if (bic >= best_bic) continue;
+    best.pred = Mat();
+    if (gamma) {
+      PredictChannels(cx, f, 2, feat_gamma, &e.pred);
+    } else {
+      PredictChannels(cx, f, 1, feat_plain, &e.pred);
+    }
     best_bic = bic;
     e.params["tau_s"] = tau;
     e.sigma["tau_s"] = JsonNum(tau * sl);
@@ -83,6 +84,7 @@ std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
     best_f = f;
     best_gamma = gamma;
   }
+  lp = Mat();  // the two-τ search filters into buffers of its own
   std::vector<double> tau{std::exp(lt)};
   std::vector<double> tau_sigma{best.sigma["tau_s"].is_number() ? best.sigma["tau_s"].get<double>()
                                                                 : 0.0};

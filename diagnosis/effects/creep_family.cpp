@@ -46,6 +46,19 @@ ChannelFit FitTwo(const Context& cx, const Mat& target, const Mat& lp1, const Ma
       pred, nullptr, st);
 }
 
+/// The prediction of a FitTwo fit (the same sums FitChannels would have filled in).
+void PredictTwo(const Context& cx, const ChannelFit& f, const Mat& lp1, const Mat& lp2, bool gamma,
+                Mat* pred) {
+  PredictChannels(
+      cx, f, gamma ? 3 : 2,
+      [&](int i, int c, double* x) {
+        x[0] = lp1(i, c);
+        x[1] = lp2(i, c);
+        if (gamma) x[2] = cx.load(i, c);
+      },
+      pred);
+}
+
 /// Coarse 2-D search of (log τ1 < log τ2) over pairs of a 13-point log grid on [lo, hi]: every grid
 /// τ filtered once (into buf) and only its strided training rows kept (at most ~20 000), so every
 /// pair costs a 2 × 2 solve per channel on those rows.
@@ -218,7 +231,7 @@ bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double b
     e.name = "creep";
     e.variant = gamma ? "two-time-constant creep with a gain term" : "two-time-constant creep";
     e.n_params = p;
-    const ChannelFit f = FitTwo(cx, target, lp1, lp2, gamma, &e.pred, 1);
+    const ChannelFit f = FitTwo(cx, target, lp1, lp2, gamma, nullptr, 1);
     e.train_sse_w = f.sse_w;
     const double bic = f.sse_w + p * Penalty(cx);
     if (bic >= best_bic) continue;
@@ -233,6 +246,8 @@ bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double b
     }
     if (std::min(amp[0], amp[1]) < 0.01 * std::max(amp[0], amp[1])) continue;
     best_bic = bic;
+    best->pred = Mat();  // replaced below: one n × N prediction at a time
+    PredictTwo(cx, f, lp1, lp2, gamma, &e.pred);
     const double t1 = std::exp(l1);
     const double t2 = std::exp(l2);
     e.params["tau1_s"] = t1;

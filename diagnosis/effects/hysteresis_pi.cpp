@@ -80,7 +80,9 @@ std::optional<EffectFit> LowerBic(const Context& cx, std::optional<EffectFit> a,
   if (!a) return b;
   if (!b) return a;
   const double log_n = std::log(std::max<double>(2.0, static_cast<double>(cx.n_train)));
-  return a->train_sse_w + a->n_params * log_n <= b->train_sse_w + b->n_params * log_n ? a : b;
+  // Two returns, not a conditional expression: each moves its fit (a ?: would copy n × N).
+  if (a->train_sse_w + a->n_params * log_n <= b->train_sse_w + b->n_params * log_n) return a;
+  return b;
 }
 
 std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Eigen::MatrixXd& target);

@@ -213,6 +213,7 @@ std::optional<EffectFit> FitExcitation(const Context& cx, const Mat& target) {
       e.name = "excitation_drift";
       e.n_params = p;
       e.train_sse_w = r.sse;
+      best.pred = Mat();  // replaced by e below: one n × N prediction at a time
       e.pred.resize(cx.n, cx.nc);
       Vec factor(cx.n);
       for (int i = 0; i < cx.n; ++i) {

@@ -109,5 +109,52 @@ TEST(Recording, StreamingWriterRefusesWrongWidth) {
   EXPECT_EQ(back.rows(), 1u);
 }
 
+TEST(Recording, FileIsReadInChunksAcrossLineBoundaries) {
+  // ReadRecording streams the file in 1 MiB chunks: rows cut by a chunk's end, a metadata line
+  // longer than a chunk, CRLF endings and a last line without '\n' must read as the text does.
+  const test::TempDir tmp("rec");
+  const std::string path = tmp / "big.csv";
+  std::string text = "# note: " + std::string(1500000, 'x') + "\r\nt,b0,b1\r\n";
+  const std::size_t rows = 120000;  // ~3 MB: several chunk boundaries inside rows
+  char line[96];
+  for (std::size_t i = 0; i < rows; ++i) {
+    const int n = std::snprintf(line, sizeof line, "%zu.5,%zu,-%zu.25%s", i, 3 * i, i,
+                                i + 1 == rows ? "" : "\r\n");
+    text.append(line, static_cast<std::size_t>(n));
+  }
+  {
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    ASSERT_EQ(std::fwrite(text.data(), 1, text.size(), f), text.size());
+    std::fclose(f);
+  }
+  const Recording r = ReadRecording(path);
+  ASSERT_EQ(r.rows(), rows);
+  EXPECT_EQ(r.Meta("note").size(), 1500000u);
+  for (std::size_t i = 0; i < rows; ++i) {
+    const auto k = static_cast<double>(i);
+    ASSERT_EQ(r.Column("t")[i], k + 0.5) << i;
+    ASSERT_EQ(r.Column("b0")[i], 3.0 * k) << i;
+    ASSERT_EQ(r.Column("b1")[i], -(k + 0.25)) << i;
+    ASSERT_EQ(r.data_lines[i], i + 3) << i;
+  }
+  // An error deep in the file names its line (the line number counts across chunks).
+  const std::size_t bad = text.rfind("\r\n") + 2;  // start of the last row
+  text.replace(bad, 1, "z");
+  {
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    ASSERT_EQ(std::fwrite(text.data(), 1, text.size(), f), text.size());
+    std::fclose(f);
+  }
+  try {
+    (void)ReadRecording(path);
+    FAIL() << "a bad number was accepted";
+  } catch (const RecordingError& e) {
+    const std::string want = path + ":" + std::to_string(rows + 2) + ":1: column 't'";
+    EXPECT_EQ(std::string(e.what()).substr(0, want.size()), want) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace ftstack::sim
