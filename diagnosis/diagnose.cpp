@@ -3,6 +3,7 @@
 #include "diagnosis/identifiability.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -230,6 +231,15 @@ void Locate(Report& r) {
   LocateLoadRegion(r);
 }
 
+/// FTDIAG_DEBUG: the time one fit took, on stderr.
+void DebugTime(const char* stage, const char* what, std::chrono::steady_clock::time_point t0) {
+  static const bool on = std::getenv("FTDIAG_DEBUG") != nullptr;
+  if (!on) return;
+  const double s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::fprintf(stderr, "time %-8s %-40s %7.3f s\n", stage, what, s);
+}
+
 void Progress(const DiagnoseOptions& o, double f, const char* what) {
   if (o.progress != nullptr) o.progress(f, what, o.progress_user);
 }
@@ -305,7 +315,9 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
   for (std::size_t j = 0; j < effects.size(); ++j) {
     Progress(options, 0.05 + 0.6 * static_cast<double>(j) / static_cast<double>(effects.size()),
              effects[j].name);
+    const auto t0 = std::chrono::steady_clock::now();
     auto fit = effects[j].fit(cx, cx.resid);
+    DebugTime("single", effects[j].name, t0);
     if (!fit) continue;
     singles.push_back(ScoreFit(cx, cx.resid, std::move(*fit), base.hold_sse, options.z_claim));
     Scored& s = singles.back();
@@ -380,7 +392,9 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Sco
         return q.eligible && q.fit.name == spec.name;
       });
       if (!claimable) continue;
+      const auto t0 = std::chrono::steady_clock::now();
       auto fb = spec.fit(cx, rest);
+      DebugTime("partner", spec.name, t0);
       if (!fb) continue;
       Scored sb = ScoreFit(cx, rest, std::move(*fb), rest_base.hold_sse, options.z_claim);
       if (!sb.eligible) continue;
@@ -402,7 +416,10 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Sco
       }
       EffectFit fa;
       EffectFit fb;
-      if (!FitPair(cx, cx.resid, *sa, *sb, first.fit, b0, &fa, &fb)) continue;
+      const auto t0 = std::chrono::steady_clock::now();
+      const bool ok = FitPair(cx, cx.resid, *sa, *sb, first.fit, b0, &fa, &fb);
+      DebugTime("backfit", (std::string(sa->name) + "+" + sb->name).c_str(), t0);
+      if (!ok) continue;
       const Sums s = ScoreSum(cx, cx.resid, fa.pred, fb.pred);
       const double delta = base.hold_sse - s.hold_sse;
       const double score = delta - (fa.n_params + fb.n_params) * HoldPenalty(cx);
@@ -530,7 +547,9 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
                     const Eigen::VectorXd* sigma) {
   Report r;
   Progress(options, 0.0, "noise and hold-out split");
+  auto t0 = std::chrono::steady_clock::now();
   r.cx = MakeContext(data, options.block_s, sigma);
+  DebugTime("context", "", t0);
   const Context& cx = r.cx;
   r.rate_hz = cx.rate_hz;
   r.noise_rms = cx.sigma;
