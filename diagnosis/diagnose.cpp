@@ -1,9 +1,9 @@
 #include "diagnosis/diagnose.hpp"
 
 #include "diagnosis/identifiability.hpp"
+#include "diagnosis/ranking.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -26,55 +26,11 @@ double ChiSquareZ(double x, double nu) {
   return (std::cbrt(x / nu) - (1.0 - a)) / std::sqrt(a);
 }
 
-double HoldRms(const Context& cx, const Mat& target, const Mat* pred) {
-  double s = 0.0;
-  for (int c = 0; c < cx.nc; ++c) {
-    for (int i = 0; i < cx.n; ++i) {
-      if (cx.train[static_cast<std::size_t>(i)]) continue;
-      const double e = target(i, c) - (pred != nullptr ? (*pred)(i, c) : 0.0);
-      s += e * e;
-    }
-  }
-  return std::sqrt(s / std::max(1.0, static_cast<double>(cx.n_hold) * cx.nc));
-}
-
 Vec ChannelRms(const Mat& m) {
   Vec v(m.cols());
   for (Eigen::Index c = 0; c < m.cols(); ++c)
     v(c) = std::sqrt(m.col(c).squaredNorm() / static_cast<double>(m.rows()));
   return v;
-}
-
-double HoldPenalty(const Context& cx) {
-  return std::log(std::max(2.0, static_cast<double>(cx.n_hold) * cx.nc));
-}
-
-struct Scored {
-  EffectFit fit;
-  double hold_sse = 0.0;
-  double delta = 0.0;
-  double z = 0.0;
-  double score = 0.0;
-  bool eligible = false;
-  double hold_rms_after = 0.0;  ///< held-out RMS after removing the prediction
-};
-
-/// Pairs start from at most this many of the best eligible singles (BestPair).
-constexpr std::size_t kPairStarts = 3;
-/// Partners tried with each start (the best by their score on what the start leaves).
-constexpr std::size_t kPairPartners = 3;
-
-Scored ScoreFit(const Context& cx, const Mat& target, EffectFit fit, double base_hold,
-                double z_claim) {
-  Scored s;
-  const Sums sums = Score(cx, target, &fit.pred);
-  s.hold_sse = sums.hold_sse;
-  s.delta = base_hold - sums.hold_sse;
-  s.z = sums.hold_pp > 0 ? s.delta / (2.0 * std::sqrt(sums.hold_pp)) : 0.0;
-  s.score = s.delta - fit.n_params * HoldPenalty(cx);
-  s.eligible = s.z > z_claim && s.score > 0;
-  s.fit = std::move(fit);
-  return s;
 }
 
 /// Channels: slow (window means of m rows) and fast (mean square) χ² tests.
@@ -231,42 +187,6 @@ void Locate(Report& r) {
   LocateLoadRegion(r);
 }
 
-/// FTDIAG_DEBUG: the time one fit took, on stderr.
-void DebugTime(const char* stage, const char* what, std::chrono::steady_clock::time_point t0) {
-  static const bool on = std::getenv("FTDIAG_DEBUG") != nullptr;
-  if (!on) return;
-  const double s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::fprintf(stderr, "time %-8s %-40s %7.3f s\n", stage, what, s);
-}
-
-void Progress(const DiagnoseOptions& o, double f, const char* what) {
-  if (o.progress != nullptr) o.progress(f, what, o.progress_user);
-}
-
-/// Backfits two effects, twice: B on target − A (A first fitted alone), then A on target − B.
-/// b0, when given, is B already fitted to target − A0 (the same fit the first step would make).
-bool FitPair(const Context& cx, const Mat& target, const EffectSpec& a, const EffectSpec& b,
-             const EffectFit& a0, EffectFit* b0, EffectFit* fa, EffectFit* fb) {
-  const EffectFit* first = &a0;
-  for (int it = 0; it < 2; ++it) {
-    if (it == 0 && b0 != nullptr) {
-      *fb = std::move(*b0);
-    } else {
-      fb->pred = Mat();  // memory: the previous B is replaced; only `first` is used now
-      auto nb = b.fit(cx, target - first->pred);
-      if (!nb) return false;
-      *fb = std::move(*nb);
-      if (first == fa) fa->pred = Mat();  // the previous A is replaced below
-    }
-    auto na = a.fit(cx, target - fb->pred);
-    if (!na) return false;
-    *fa = std::move(*na);
-    first = fa;
-  }
-  return true;
-}
-
 /// A time-based partner of a load effect that one offset per load hold explains as well (a misfit
 /// of the first effect's shape left from hold to hold, which a time curve follows) is not
 /// claimed: the data cannot tell it from the first effect's remainder. Returns the partner's
@@ -303,156 +223,6 @@ void ReportSpectrum(Report& r) {
         r.spectrum_power[k] += s.power[k] * cx.weight(c) / cx.nc;
     }
   }
-}
-
-/// Every effect fitted alone to the residual and scored on the held-out rows, best first; each is
-/// listed among the report's candidates.
-std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const Sums& base) {
-  const Context& cx = r.cx;
-  std::vector<Scored> singles;
-  const auto& effects = Effects();
-  singles.reserve(effects.size());  // no reallocation (it would copy the kept predictions)
-  for (std::size_t j = 0; j < effects.size(); ++j) {
-    Progress(options, 0.05 + 0.6 * static_cast<double>(j) / static_cast<double>(effects.size()),
-             effects[j].name);
-    const auto t0 = std::chrono::steady_clock::now();
-    auto fit = effects[j].fit(cx, cx.resid);
-    DebugTime("single", effects[j].name, t0);
-    if (!fit) continue;
-    singles.push_back(ScoreFit(cx, cx.resid, std::move(*fit), base.hold_sse, options.z_claim));
-    Scored& s = singles.back();
-    s.hold_rms_after = HoldRms(cx, cx.resid, &s.fit.pred);
-    // Memory (n × N per prediction): only the kPairStarts best eligible singles are used again
-    // (the claim and the pair starts); every other prediction is released at once.
-    if (!s.eligible) {
-      s.fit.pred = Mat();
-      continue;
-    }
-    std::vector<Scored*> kept;
-    for (auto& q : singles) {
-      if (q.eligible && q.fit.pred.size() > 0) kept.push_back(&q);
-    }
-    if (kept.size() > kPairStarts) {
-      auto lowest =
-          std::min_element(kept.begin(), kept.end(),
-                           [](const Scored* a, const Scored* b) { return a->score < b->score; });
-      (*lowest)->fit.pred = Mat();
-    }
-  }
-  std::sort(singles.begin(), singles.end(),
-            [](const Scored& a, const Scored& b) { return a.score > b.score; });
-  for (const auto& s : singles) {
-    CandidateScore c;
-    c.name = s.fit.name;
-    c.variant = s.fit.variant;
-    c.n_params = s.fit.n_params;
-    c.hold_rms_after = s.hold_rms_after;
-    c.z = s.z;
-    c.score = s.score;
-    c.eligible = s.eligible;
-    r.candidates.push_back(c);
-  }
-  return singles;
-}
-
-/// Pairs: the best single with each other eligible candidate among the top six, backfitted.
-/// True with *pa, *pb set when a pair beats every model so far.
-bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Scored>& singles,
-              const Sums& base, EffectFit* pa, EffectFit* pb) {
-  const Scored& best = singles.front();
-  const auto& effects = Effects();
-  bool have_pair = false;
-  double pair_score = best.score;
-  // Forward selection from each of the three best eligible singles: every other effect is fitted
-  // to what the first leaves, the two best partners are kept, the first is refitted to what the
-  // partner leaves, and the pair is scored on the held-out rows.
-  std::vector<std::size_t> top;
-  for (std::size_t j = 0; j < singles.size() && top.size() < kPairStarts; ++j) {
-    if (singles[j].eligible && singles[j].fit.pred.size() > 0 &&
-        singles[j].score >= 0.5 * best.score) {
-      top.push_back(j);
-    }
-  }
-  std::size_t step = 0;
-  for (std::size_t x : top) {
-    const Scored& first = singles[x];
-    const Mat rest = cx.resid - first.fit.pred;
-    const Sums rest_base = Score(cx, rest, nullptr);
-    std::vector<std::pair<double, std::string>> partners;
-    // The fits of the best partners so far, reused as the first step of the backfit (FitPair);
-    // the others are released at once (memory: n × N each).
-    std::vector<std::pair<std::pair<double, std::string>, EffectFit>> partner_fits;
-    for (const auto& spec : effects) {
-      Progress(options,
-               0.65 + 0.33 * static_cast<double>(step++) / static_cast<double>(3 * effects.size()),
-               "pairs");
-      if (first.fit.name == spec.name) continue;
-      // Partners come from the effects that were claimable on their own.
-      const bool claimable = std::any_of(singles.begin(), singles.end(), [&](const Scored& q) {
-        return q.eligible && q.fit.name == spec.name;
-      });
-      if (!claimable) continue;
-      const auto t0 = std::chrono::steady_clock::now();
-      auto fb = spec.fit(cx, rest);
-      DebugTime("partner", spec.name, t0);
-      if (!fb) continue;
-      Scored sb = ScoreFit(cx, rest, std::move(*fb), rest_base.hold_sse, options.z_claim);
-      if (!sb.eligible) continue;
-      partners.emplace_back(sb.score, spec.name);
-      partner_fits.emplace_back(partners.back(), std::move(sb.fit));
-      if (partner_fits.size() > kPairPartners) {
-        partner_fits.erase(
-            std::min_element(partner_fits.begin(), partner_fits.end(),
-                             [](const auto& u, const auto& v) { return u.first < v.first; }));
-      }
-    }
-    std::sort(partners.rbegin(), partners.rend());
-    for (std::size_t y = 0; y < std::min<std::size_t>(kPairPartners, partners.size()); ++y) {
-      const EffectSpec* sa = FindEffect(first.fit.name);
-      const EffectSpec* sb = FindEffect(partners[y].second);
-      EffectFit* b0 = nullptr;
-      for (auto& pf : partner_fits) {
-        if (pf.first == partners[y]) b0 = &pf.second;
-      }
-      EffectFit fa;
-      EffectFit fb;
-      const auto t0 = std::chrono::steady_clock::now();
-      const bool ok = FitPair(cx, cx.resid, *sa, *sb, first.fit, b0, &fa, &fb);
-      DebugTime("backfit", (std::string(sa->name) + "+" + sb->name).c_str(), t0);
-      if (!ok) continue;
-      const Sums s = ScoreSum(cx, cx.resid, fa.pred, fb.pred);
-      const double delta = base.hold_sse - s.hold_sse;
-      const double score = delta - (fa.n_params + fb.n_params) * HoldPenalty(cx);
-      // The partner must add a significant held-out improvement over the first alone …
-      double dd = 0.0;
-      for (int c = 0; c < cx.nc; ++c) {
-        for (int i = 0; i < cx.n; ++i) {
-          if (cx.train[static_cast<std::size_t>(i)]) continue;
-          const double diff = (fa.pred(i, c) + fb.pred(i, c)) - first.fit.pred(i, c);
-          dd += diff * diff * cx.weight(c);
-        }
-      }
-      const double inc = first.hold_sse - s.hold_sse;
-      const double z_inc = dd > 0 ? inc / (2.0 * std::sqrt(dd)) : 0.0;
-      // … and carry a visible share (≥ 0.2 %) of the excess over noise, not a misfit's remainder.
-      const double excess = base.hold_sse - static_cast<double>(cx.n_hold) * cx.nc;
-      if (std::getenv("FTDIAG_DEBUG") != nullptr) {
-        std::fprintf(
-            stderr, "pair %s + %s: score %.1f (best single %.1f) z_inc %.1f inc %.1f excess %.1f\n",
-            fa.name.c_str(), fb.name.c_str(), score, best.score, z_inc, inc, excess);
-      }
-      // … and the pair must beat every model so far on the penalised held-out score.
-      if (z_inc > options.z_claim && inc > 0.002 * excess && score > pair_score) {
-        pair_score = score;
-        *pa = std::move(fa);
-        *pb = std::move(fb);
-        have_pair = true;
-      }
-    }
-    // Memory: a start other than the best single is not used again.
-    if (x != 0) singles[x].fit.pred = Mat();
-  }
-  return have_pair;
 }
 
 /// Thermal refinement of the claimed effects (see the comment inside).

@@ -16,6 +16,7 @@ struct DiagnoseOptions {
   double block_s = 0.5;  ///< length of the interleaved hold-out blocks, s
   double z_claim = 6.0;  ///< held-out significance an effect needs before it is claimed
   bool pairs = true;     ///< also try two effects at once
+  int threads = 0;  ///< threads for independent fits (0: the machine's, at most 4); same result
   ProgressFn progress = nullptr;
   void* progress_user = nullptr;
 };

@@ -60,14 +60,29 @@ struct EffectFit {
   nlohmann::json standard = nlohmann::json::object();
   std::string evidence;
   double train_sse_w = 0.0;  ///< whitened training SSE after the fit
+  /// The nonlinear parameters as the search left them (a RefitFn's start; not reported).
+  std::vector<double> search_state;
 };
 
 using FitFn = std::optional<EffectFit> (*)(const Context&, const Eigen::MatrixXd& target);
+/// Refits an effect near an earlier fit of the same effect: `near`'s nonlinear parameters start a
+/// local search (a full search only when the optimum leaves the local window) and its variant
+/// class is kept. The pair stage's partner fits and backfits use it: there the target differs from
+/// the one `near` was fitted to by another effect's prediction, not by a new shape.
+using RefitFn = std::optional<EffectFit> (*)(const Context&, const Eigen::MatrixXd& target,
+                                             const EffectFit& near);
 
 struct EffectSpec {
   const char* name;
   FitFn fit;
+  RefitFn refit = nullptr;  ///< nullptr: the effect has no costly search; fit() is used
+  int cost = 1;  ///< relative cost of a fit: when fits run in parallel, costlier ones start first
 };
+
+/// spec.refit near *near when both exist, else spec.fit.
+[[nodiscard]] std::optional<EffectFit> FitNear(const EffectSpec& spec, const Context& cx,
+                                               const Eigen::MatrixXd& target,
+                                               const EffectFit* near);
 
 /// Every effect of the vocabulary except `none`, in spec order.
 [[nodiscard]] const std::vector<EffectSpec>& Effects();

@@ -110,6 +110,12 @@ Vec PutChannelCoef(const Context& cx, const ChannelFit& f, int j, const char* ke
 /// Whitened training SSE of a one-coefficient-per-channel fit of `feature` (n × N), on every
 /// search_stride-th row and scaled back to the full count: the objective of parameter searches.
 double SearchSse(const Context& cx, const Mat& target, const Mat& feature);
+/// 0, 1, …, cx.nc − 1.
+inline std::vector<int> AllChannels(const Context& cx) {
+  std::vector<int> all(static_cast<std::size_t>(cx.nc));
+  for (int c = 0; c < cx.nc; ++c) all[static_cast<std::size_t>(c)] = c;
+  return all;
+}
 /// Channel whose prediction carries the largest whitened energy.
 int DominantChannel(const Context& cx, const Mat& pred);
 /// Channels carrying at least `share` of the prediction's whitened energy.
@@ -157,9 +163,15 @@ std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target);
 /// one-τ optimum `log_tau1`, then τ1 and τ2 refined in turn; replaces *best (and fills tau,
 /// tau_sigma, the channel fit and whether a gain term is in it) only when its training BIC is
 /// below `best_bic`. Returns whether it did.
+/// `start` (log τ1, log τ2), when given, replaces the coarse pair search (a refit near an earlier
+/// two-τ fit).
 bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double best_bic,
                  EffectFit* best, std::vector<double>* tau, std::vector<double>* tau_sigma,
-                 ChannelFit* best_f, bool* best_gamma);
+                 ChannelFit* best_f, bool* best_gamma, const double* start = nullptr);
+/// creep refitted near an earlier creep fit (RefitFn): τ searched in a window of ±0.5 in log τ
+/// around near's (full range when it lands on the window's edge); the two-τ variant is tried
+/// only when near is two-τ, from near's pair (effects/creep.cpp).
+std::optional<EffectFit> RefitCreep(const Context& cx, const Mat& target, const EffectFit& near);
 /// The fitted creep model (time constants tau, channel fit f with a_k per τ then γ when `gamma`)
 /// in OIML R 60's terms: e->standard["oiml_r60"] (docs/spec/diagnosis.md).
 void CreepOimlR60(const Context& cx, const std::vector<double>& tau,
@@ -180,12 +192,18 @@ std::optional<EffectFit> FitMains(const Context& cx, const Mat& target);
 /// puts h<k>_amplitude_mvv (σ) and h<k>_seen_at_hz. Returns a clause for the evidence.
 std::string AddMainsHarmonics(const Context& cx, const Mat& target, double f0, EffectFit* e);
 std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target);
+/// resonance refitted near an earlier resonance fit (RefitFn): the golden refinements of (f, ζ)
+/// start at near's mode(s), without the coarse grid; a second mode only when near has one.
+std::optional<EffectFit> RefitResonance(const Context& cx, const Mat& target,
+                                        const EffectFit& near);
 /// The two-mode variant of a one-mode resonance fit *e at (f1_hz, zeta1) (effects/
 /// resonance_family.cpp): mode 2 searched at the lines of the residual spectrum, both refined in
 /// turn and fitted jointly (a participation per channel and mode); replaces *e (variant "two
 /// modes", mode 1 the lower frequency) only when the training BIC is lower and the weaker mode
 /// carries ≥ 1 % of the ringing's whitened energy. Returns a clause for the evidence.
+/// `start` (log f2, log ζ2), when given, replaces the search at the residual's lines (a refit);
+/// e->search_state gets (log f, log ζ) of mode 1 then mode 2 when the second mode is kept.
 std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz, double zeta1,
-                             EffectFit* e);
+                             EffectFit* e, const double* start = nullptr);
 
 }  // namespace ftstack::diag::fx

@@ -10,7 +10,20 @@
 
 namespace ftstack::diag::fx {
 
-std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
+namespace {
+
+/// near's parameter `key` as log, or NaN when it has none.
+double LogParam(const EffectFit* near, const char* key) {
+  if (near == nullptr || !near->params.contains(key) || !near->params[key].is_number()) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  const double v = near->params[key].get<double>();
+  return v > 0 ? std::log(v) : std::numeric_limits<double>::quiet_NaN();
+}
+
+/// FitCreep (near == nullptr) or RefitCreep: the one-τ search on the full log grid or in a window
+/// around near's τ, then the two-τ variant (full, from near's pair, or not when near is one-τ).
+std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const EffectFit* near) {
   const auto& d = *cx.data;
   const double duration = d.t_s.back() - d.t_s.front();
   Mat lp(cx.n, cx.nc);
@@ -48,8 +61,21 @@ std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
   ChannelFit best_f;
   bool best_gamma = false;
   double best_bic = std::numeric_limits<double>::infinity();
-  // τ is searched with the plain model; the variant with a gain term reuses it.
-  const double lt = MinimizeOnGrid([&](double v) { return sse_for(v, false); }, grid, 12, nullptr);
+  // τ is searched with the plain model; the variant with a gain term reuses it. Near a one-τ fit:
+  // 5 points 0.25 apart in log τ around its τ, the full grid when the optimum is on the edge.
+  const double near_lt = LogParam(near, "tau_s");
+  double lt = std::numeric_limits<double>::quiet_NaN();
+  if (std::isfinite(near_lt)) {
+    std::vector<double> local;
+    for (int j = -2; j <= 2; ++j) local.push_back(std::clamp(near_lt + 0.25 * j, lo, hi));
+    lt = MinimizeOnGrid([&](double v) { return sse_for(v, false); }, local, 8, nullptr);
+    const bool edge = (lt <= local.front() + 0.125 && local.front() > lo) ||
+                      (lt >= local.back() - 0.125 && local.back() < hi);
+    if (edge) lt = std::numeric_limits<double>::quiet_NaN();
+  }
+  if (!std::isfinite(lt)) {
+    lt = MinimizeOnGrid([&](double v) { return sse_for(v, false); }, grid, 12, nullptr);
+  }
   for (bool gamma : {false, true}) {
     const int p = cx.nc * (gamma ? 2 : 1) + 1;
     EffectFit e;
@@ -88,8 +114,13 @@ std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
   std::vector<double> tau{std::exp(lt)};
   std::vector<double> tau_sigma{best.sigma["tau_s"].is_number() ? best.sigma["tau_s"].get<double>()
                                                                 : 0.0};
-  const bool two =
-      FitCreepTwo(cx, target, lt, best_bic, &best, &tau, &tau_sigma, &best_f, &best_gamma);
+  // The two-τ variant: searched in full alone, from near's pair when near is two-τ, not tried
+  // when near is one-τ (a refit keeps the variant class its start found).
+  const double start[2] = {LogParam(near, "tau1_s"), LogParam(near, "tau2_s")};
+  const bool near_two = std::isfinite(start[0]) && std::isfinite(start[1]);
+  const bool two = (near == nullptr || near_two) &&
+                   FitCreepTwo(cx, target, lt, best_bic, &best, &tau, &tau_sigma, &best_f,
+                               &best_gamma, near_two ? start : nullptr);
   CreepOimlR60(cx, tau, tau_sigma, best_f, best_gamma, &best);
   best.channels = ActiveChannels(cx, best.pred);
   const int c = DominantChannel(cx, best.pred);
@@ -110,6 +141,16 @@ std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
           100.0 * best.params["fraction"][static_cast<std::size_t>(c)].get<double>(),
           RowCorr(cx, target, best.pred, c));
   return best;
+}
+
+}  // namespace
+
+std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
+  return CreepSearch(cx, target, nullptr);
+}
+
+std::optional<EffectFit> RefitCreep(const Context& cx, const Mat& target, const EffectFit& near) {
+  return CreepSearch(cx, target, &near);
 }
 
 }  // namespace ftstack::diag::fx

@@ -175,7 +175,7 @@ void CreepOimlR60(const Context& cx, const std::vector<double>& tau,
 
 bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double best_bic,
                  EffectFit* best, std::vector<double>* tau, std::vector<double>* tau_sigma,
-                 ChannelFit* best_f, bool* best_gamma) {
+                 ChannelFit* best_f, bool* best_gamma, const double* start) {
   const double duration = cx.data->t_s.back() - cx.data->t_s.front();
   const double lo = std::log(std::max(3.0 * cx.dt, 0.2));
   // A second time constant longer than a third of the record cannot be told from a drift or an
@@ -195,7 +195,12 @@ bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double b
     LowPassLoad(cx, std::exp(v), &lp1);
     return FitTwo(cx, target, lp1, lp2, false, nullptr, st).sse_w * st;
   };
-  CoarsePair(cx, target, lo, hi, &lp2, &l1, &l2);
+  if (start != nullptr) {
+    l1 = std::clamp(std::min(start[0], start[1]), lo, hi);
+    l2 = std::clamp(std::max(start[0], start[1]), lo, hi);
+  } else {
+    CoarsePair(cx, target, lo, hi, &lp2, &l1, &l2);
+  }
   // Refinement: τ2 with τ1 held, τ1 with τ2 held, τ2 again (golden section between neighbours).
   const double step = (hi - lo) / 12.0;
   auto around = [&](double v, double other) {

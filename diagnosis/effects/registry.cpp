@@ -18,9 +18,9 @@ const std::vector<EffectSpec>& Effects() {
       {"zero_drift", &FitZeroDrift},
       {"thermal_zero_drift", &FitThermalZeroPlain},
       {"thermal_span_drift", &FitThermalSpan},
-      {"excitation_drift", &FitExcitation},
-      {"creep", &FitCreep},
-      {"hysteresis", &FitHysteresisFamily},
+      {"excitation_drift", &FitExcitation, nullptr, 2},
+      {"creep", &FitCreep, &RefitCreep, 4},
+      {"hysteresis", &FitHysteresisFamily, nullptr, 2},
       {"bridge_nonlinearity", &FitBridgeNonlinearity},
       {"geometric_nonlinearity", &FitGeometric},
       {"load_stiffening", &FitLoadStiffening},
@@ -30,9 +30,17 @@ const std::vector<EffectSpec>& Effects() {
       {"saturation", &FitSaturation},
       {"overload_shift", &FitOverloadShift},
       {"mains_interference", &FitMains},
-      {"resonance", &FitResonance},
+      {"resonance", &FitResonance, &RefitResonance, 8},
   };
   return kEffects;
+}
+
+std::optional<EffectFit> FitNear(const EffectSpec& spec, const Context& cx, const Mat& target,
+                                 const EffectFit* near) {
+  if (spec.refit != nullptr && near != nullptr && near->name == spec.name) {
+    return spec.refit(cx, target, *near);
+  }
+  return spec.fit(cx, target);
 }
 
 const EffectSpec* FindEffect(const std::string& name) {

@@ -90,14 +90,16 @@ int PutModes(const Context& cx, const ChannelFit& cf, const double* lf, const do
 }  // namespace
 
 std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz, double zeta1,
-                             EffectFit* e) {
+                             EffectFit* e, const double* start) {
   const double nyq_hz = 0.5 * cx.rate_hz;
-  const Mat resid = target - e->pred;
-  const std::vector<double> lines = ResidualLines(cx, resid, f1_hz);
-  if (lines.empty()) return "";
-  const std::vector<int> coarse = StrongestTwo(cx, resid);
-  std::vector<int> all(static_cast<std::size_t>(cx.nc));
-  for (int c = 0; c < cx.nc; ++c) all[static_cast<std::size_t>(c)] = c;
+  std::vector<double> lines;  // the residual's lines (none needed from a refit's start)
+  std::vector<int> coarse;
+  {
+    const Mat resid = target - e->pred;  // memory: released before the ringing buffers
+    if (start == nullptr && (lines = ResidualLines(cx, resid, f1_hz)).empty()) return "";
+    coarse = StrongestTwo(cx, resid);
+  }
+  const std::vector<int> all = AllChannels(cx);
   Mat h1(cx.n, cx.nc);
   Mat h2(cx.n, cx.nc);
   double lf[2] = {std::log(f1_hz), 0.0};
@@ -128,6 +130,11 @@ std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz,
   // Coarse: mode 2 on a grid around each residual line, mode 1 held at its one-mode optimum.
   int st = cx.search_stride;
   double best = std::numeric_limits<double>::infinity();
+  if (start != nullptr) {
+    lf[1] = start[0];
+    lz[1] = start[1];
+    best = sse(1, std::exp(lf[1]), std::exp(lz[1]), coarse, st);
+  }
   for (double line : lines) {
     for (double m : {0.92, 1.0, 1.08}) {
       for (double z : {0.01, 0.03, 0.1, 0.3}) {
@@ -141,8 +148,9 @@ std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz,
     }
   }
   if (!std::isfinite(best)) return "";
-  // Golden refinements of log f and log ζ of mode 2, then mode 1 (the other held), twice.
-  for (int round = 0; round < 2; ++round) {
+  // Golden refinements of log f and log ζ of mode 2, then mode 1 (the other held): twice, or once
+  // (the finer round) from a refit's start.
+  for (int round = start != nullptr ? 1 : 0; round < 2; ++round) {
     if (round == 1) st = std::max(1, st / 2);
     for (int m : {1, 0}) {
       Ringing(cx, std::exp(lf[1 - m]), std::exp(lz[1 - m]), coarse, h[1 - m]);
@@ -193,6 +201,7 @@ std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz,
   e->n_params = p;
   e->train_sse_w = cf.sse_w;
   e->pred = std::move(pred);
+  e->search_state = {lf[0], lz[0], lf[1], lz[1]};
   return Fmt(
       "; a second mode at %.2f Hz (damping ratio %.3f) from the residual spectrum, kept: "
       "training BIC lower by %.1f, %.0f %% of the ringing's energy in the weaker mode",

@@ -136,7 +136,26 @@ std::optional<EffectFit> FitMains(const Context& cx, const Mat& target) {
   return e;
 }
 
-std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target) {
+namespace {
+
+/// Fast load changes on channel c: runs of rows where |Δsim| per sample exceeds 20 σ.
+int FastLoadChanges(const Context& cx, int c) {
+  const auto& d = *cx.data;
+  int fast = 0;
+  bool in_fast = false;
+  for (int i = 1; i < cx.n; ++i) {
+    const bool now = std::fabs(d.sim_mvv(i, c) - d.sim_mvv(i - 1, c)) > 20.0 * cx.sigma(c);
+    if (now && !in_fast) ++fast;
+    in_fast = now;
+  }
+  return fast;
+}
+
+/// FitResonance (near == nullptr: coarse grid at the residual's lines, or a log grid without any)
+/// or RefitResonance (the refinements start at near's search state, its second mode kept as a
+/// start, none tried when near has one mode).
+std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
+                                         const EffectFit* near) {
   const auto& d = *cx.data;
   const double nyq = 0.5 * cx.rate_hz;
   Mat h(cx.n, cx.nc);
@@ -171,8 +190,7 @@ std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target) {
     return s;
   };
   const std::vector<int> coarse(order.begin(), order.begin() + std::min(2, cx.nc));
-  std::vector<int> all(static_cast<std::size_t>(cx.nc));
-  for (int c = 0; c < cx.nc; ++c) all[static_cast<std::size_t>(c)] = c;
+  const std::vector<int> all = AllChannels(cx);
   std::vector<double> fgrid;
   for (std::size_t p = 0; p < std::min<std::size_t>(cx.peak_hz.size(), 3); ++p) {
     for (double m : {0.92, 1.0, 1.08}) fgrid.push_back(cx.peak_hz[p] * m);
@@ -185,6 +203,13 @@ std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target) {
   double bf = 0.0;
   double bz = 0.0;
   double bs = std::numeric_limits<double>::infinity();
+  const bool warm = near != nullptr && near->search_state.size() >= 2;
+  if (warm) {
+    bf = std::exp(near->search_state[0]);
+    bz = std::exp(near->search_state[1]);
+    bs = sse_for(bf, bz, coarse, nullptr, nullptr);
+    fgrid.clear();
+  }
   for (double f : fgrid) {
     for (double z : zgrid) {
       const double s = sse_for(f, z, coarse, nullptr, nullptr);
@@ -199,7 +224,8 @@ std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target) {
   // Alternate golden refinements in log f and log ζ on all channels.
   double lf = std::log(bf);
   double lz = std::log(bz);
-  for (int round = 0; round < 2; ++round) {
+  // A refit starts near its optimum: only the finer second round.
+  for (int round = warm ? 1 : 0; round < 2; ++round) {
     const std::vector<int>& chans = coarse;  // all channels only in the final fit
     if (round == 1) st = std::max(1, st / 2);
     std::vector<double> g1;
@@ -231,17 +257,15 @@ std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target) {
                          lz, 0.02));
   PutChannelCoef(cx, cf, 0, "participation", &e);
   e.variant = "one mode";
-  const std::string second = AddResonanceMode(cx, target, f, z, &e);
+  e.search_state = {lf, lz};
+  const bool near_two = warm && near->search_state.size() >= 4;
+  const std::string second =
+      near == nullptr || near_two
+          ? AddResonanceMode(cx, target, f, z, &e, near_two ? &near->search_state[2] : nullptr)
+          : "";
   e.channels = ActiveChannels(cx, e.pred);
-  // Count fast load changes: steps where |Δsim| per sample exceeds 20 σ on the dominant channel.
   const int c = DominantChannel(cx, e.pred);
-  int fast = 0;
-  bool in_fast = false;
-  for (int i = 1; i < cx.n; ++i) {
-    const bool now = std::fabs(d.sim_mvv(i, c) - d.sim_mvv(i - 1, c)) > 20.0 * cx.sigma(c);
-    if (now && !in_fast) ++fast;
-    in_fast = now;
-  }
+  const int fast = FastLoadChanges(cx, c);
   e.evidence =
       Fmt("ringing at %.2f Hz (damping ratio %.3f) after the %d fast load changes on b%d, quiet "
           "during slow ramps and holds, r = %.2f",
@@ -249,6 +273,17 @@ std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target) {
           c, RowCorr(cx, target, e.pred, c)) +
       second;
   return e;
+}
+
+}  // namespace
+
+std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target) {
+  return ResonanceSearch(cx, target, nullptr);
+}
+
+std::optional<EffectFit> RefitResonance(const Context& cx, const Mat& target,
+                                        const EffectFit& near) {
+  return ResonanceSearch(cx, target, &near);
 }
 
 }  // namespace ftstack::diag::fx

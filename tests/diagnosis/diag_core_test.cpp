@@ -209,6 +209,32 @@ TEST(DiagFixturePairs, OffsetAndCreepAreBothNamed) {
   EXPECT_GE(ExcessRemoved(r), 0.7);
 }
 
+// The fits run in parallel: the report must not depend on how many threads ran them (the reference
+// is the sequential run; every candidate's score and every claimed prediction compared exactly).
+TEST(DiagFixturePairs, ReportDoesNotDependOnThreadCount) {
+  const auto fx = testing::MakeFixture({{"zero_offset", 5}, {"creep", 5}}, 2, 200.0, kNoise, 4.0);
+  DiagnoseOptions one;
+  one.threads = 1;
+  const Report a = Diagnose(fx.data, one);
+  for (int threads : {2, 5}) {
+    DiagnoseOptions many;
+    many.threads = threads;
+    const Report b = Diagnose(fx.data, many);
+    EXPECT_EQ(a.verdict, b.verdict) << threads;
+    ASSERT_EQ(a.candidates.size(), b.candidates.size()) << threads;
+    for (std::size_t k = 0; k < a.candidates.size(); ++k) {
+      EXPECT_EQ(a.candidates[k].name, b.candidates[k].name) << threads;
+      EXPECT_EQ(a.candidates[k].score, b.candidates[k].score) << threads;
+    }
+    ASSERT_EQ(a.effects.size(), b.effects.size()) << threads;
+    for (std::size_t k = 0; k < a.effects.size(); ++k) {
+      EXPECT_EQ(a.effects[k].fit.name, b.effects[k].fit.name) << threads;
+      EXPECT_EQ(a.effects[k].fit.params.dump(), b.effects[k].fit.params.dump()) << threads;
+      EXPECT_TRUE(a.effects[k].fit.pred == b.effects[k].fit.pred) << threads;
+    }
+  }
+}
+
 TEST(DiagReportHtml, NotClaimedPartnersAreSaidInWords) {
   // A pair partner left unclaimed (Report::dropped, JSON "not_claimed": "name: reason") is named
   // in the HTML apart from the claimed effects, with its reason, in words.

@@ -30,6 +30,7 @@ struct DiagnoseArgs {
   std::string sim, model, real, json, html;
   bool no_pairs = false;
   double block_s = 0.5;
+  int threads = 0;
 };
 struct ScorecardArgs {
   int seeds = 3;
@@ -71,6 +72,7 @@ int RunDiagnose(const DiagnoseArgs& args) {
     DiagnoseOptions opt;
     opt.pairs = !args.no_pairs;
     opt.block_s = args.block_s;
+    opt.threads = args.threads;
     opt.progress = &DrawBar;
     opt.progress_user = &bar;
     bar.last = -1;
@@ -166,6 +168,10 @@ int main(int argc, char** argv) {
   d->add_option("--json", diagnose.json, "JSON report (schema ftdiag-report/1)")->required();
   d->add_option("--html", diagnose.html, "self-contained HTML report with plots");
   d->add_flag("--no-pairs", diagnose.no_pairs, "consider single effects only");
+  d->add_option("--threads", diagnose.threads,
+                "threads for independent fits (default 0: the machine's, at most 4); the report "
+                "does not depend on it")
+      ->check(CLI::Range(0, 64));
   d->add_option("--block-s", diagnose.block_s,
                 "length of the interleaved hold-out blocks, s (default 0.5)");
   d->callback([&] { exit_code = RunDiagnose(diagnose); });

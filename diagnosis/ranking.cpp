@@ -1,0 +1,318 @@
+#include "diagnosis/ranking.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "diagnosis/parallel.hpp"
+
+namespace ftstack::diag {
+namespace {
+
+using Mat = Eigen::MatrixXd;
+
+double HoldPenalty(const Context& cx) {
+  return std::log(std::max(2.0, static_cast<double>(cx.n_hold) * cx.nc));
+}
+
+Scored ScoreFit(const Context& cx, const Mat& target, EffectFit fit, double base_hold,
+                double z_claim) {
+  Scored s;
+  const Sums sums = Score(cx, target, &fit.pred);
+  s.hold_sse = sums.hold_sse;
+  s.delta = base_hold - sums.hold_sse;
+  s.z = sums.hold_pp > 0 ? s.delta / (2.0 * std::sqrt(sums.hold_pp)) : 0.0;
+  s.score = s.delta - fit.n_params * HoldPenalty(cx);
+  s.eligible = s.z > z_claim && s.score > 0;
+  s.fit = std::move(fit);
+  return s;
+}
+
+/// Backfits two effects, twice: B on target − A (A first fitted alone), then A on target − B.
+/// b0, when given, is B already fitted to target − A0 (the same fit the first step would make);
+/// b_near, B's fit alone (the start of its first refit when b0 is not given). Every refit starts
+/// from the effect's previous fit (FitNear).
+bool FitPair(const Context& cx, const Mat& target, const EffectSpec& a, const EffectSpec& b,
+             const EffectFit& a0, EffectFit* b0, const EffectFit* b_near, EffectFit* fa,
+             EffectFit* fb) {
+  const EffectFit* first = &a0;
+  for (int it = 0; it < 2; ++it) {
+    if (it == 0 && b0 != nullptr) {
+      *fb = std::move(*b0);
+    } else {
+      fb->pred = Mat();  // memory: the previous B is replaced; only `first` is used now
+      auto nb = FitNear(b, cx, target - first->pred, it == 0 ? b_near : fb);
+      if (!nb) return false;
+      *fb = std::move(*nb);
+      if (first == fa) fa->pred = Mat();  // the previous A is replaced below
+    }
+    auto na = FitNear(a, cx, target - fb->pred, first);
+    if (!na) return false;
+    *fa = std::move(*na);
+    first = fa;
+  }
+  return true;
+}
+
+/// Indices of `effects` costliest first (the order parallel fits are started in).
+std::vector<std::size_t> CostOrder(const std::vector<EffectSpec>& effects) {
+  std::vector<std::size_t> order(effects.size());
+  for (std::size_t j = 0; j < order.size(); ++j) order[j] = j;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t u, std::size_t v) { return effects[u].cost > effects[v].cost; });
+  return order;
+}
+
+/// Keeps the predictions of the `keep` best eligible fits in `all` and releases the others'
+/// (memory: n × N each). The survivors do not depend on the order the fits arrived in.
+void KeepBestPredictions(std::vector<std::optional<Scored>>* all, std::size_t keep) {
+  std::vector<Scored*> kept;
+  for (auto& q : *all) {
+    if (q && q->eligible && q->fit.pred.size() > 0) kept.push_back(&*q);
+  }
+  while (kept.size() > keep) {
+    auto lowest = std::min_element(kept.begin(), kept.end(), [](const Scored* u, const Scored* v) {
+      return u->score < v->score;
+    });
+    (*lowest)->fit.pred = Mat();
+    kept.erase(lowest);
+  }
+}
+
+/// The fit of effect `name` alone (its prediction may have been released), or nullptr.
+const EffectFit* SingleOf(const std::vector<Scored>& singles, const std::string& name) {
+  for (const auto& q : singles) {
+    if (q.fit.name == name) return &q.fit;
+  }
+  return nullptr;
+}
+
+/// A partner fitted to what a pair's first effect leaves: its score there and, for the
+/// kPairPartners best, its fit (reused as the first step of the backfit).
+struct Partner {
+  std::pair<double, std::string> key;  ///< (score, name)
+  std::optional<EffectFit> fit;
+};
+
+/// Every other effect claimable alone, refitted to `rest` (= residual − first) near its single fit;
+/// the eligible ones, best first, with the fits of the kPairPartners best (parallel fits).
+std::vector<Partner> FitPartners(const Context& cx, const DiagnoseOptions& options,
+                                 const std::vector<Scored>& singles, const Scored& first,
+                                 const Mat& rest) {
+  const auto& effects = Effects();
+  const Sums rest_base = Score(cx, rest, nullptr);
+  std::vector<std::size_t> todo;
+  for (std::size_t j : CostOrder(effects)) {
+    const EffectSpec& spec = effects[j];
+    // Partners come from the effects that were claimable on their own.
+    const bool claimable = std::any_of(singles.begin(), singles.end(), [&](const Scored& q) {
+      return q.eligible && q.fit.name == spec.name;
+    });
+    if (claimable && first.fit.name != spec.name) todo.push_back(j);
+  }
+  std::vector<Partner> partners;
+  std::mutex mu;
+  ParallelFor(todo.size(), ResolveThreads(options.threads), [&](std::size_t k) {
+    const EffectSpec& spec = effects[todo[k]];
+    const auto t0 = std::chrono::steady_clock::now();
+    auto fb = FitNear(spec, cx, rest, SingleOf(singles, spec.name));
+    DebugTime("partner", spec.name, t0);
+    if (!fb) return;
+    Scored sb = ScoreFit(cx, rest, std::move(*fb), rest_base.hold_sse, options.z_claim);
+    if (!sb.eligible) return;
+    const std::lock_guard<std::mutex> lock(mu);
+    partners.push_back({{sb.score, spec.name}, std::move(sb.fit)});
+    // Memory (n × N each): only the kPairPartners best fits are kept.
+    std::vector<Partner*> with_fit;
+    for (auto& q : partners) {
+      if (q.fit) with_fit.push_back(&q);
+    }
+    if (with_fit.size() > kPairPartners) {
+      (*std::min_element(with_fit.begin(), with_fit.end(), [](const Partner* u, const Partner* v) {
+        return u->key < v->key;
+      }))->fit.reset();
+    }
+  });
+  std::sort(partners.begin(), partners.end(),
+            [](const Partner& u, const Partner& v) { return u.key > v.key; });
+  return partners;
+}
+
+/// The pair (first, partner) after backfitting, scored; `won` when it qualifies (below).
+struct PairResult {
+  EffectFit fa;
+  EffectFit fb;
+  double score = 0.0;
+  bool won = false;
+};
+
+/// Backfits first with `partner` and tests the pair: the partner must add a significant held-out
+/// improvement over the first alone and carry a visible share of the excess over noise.
+std::optional<PairResult> TryPair(const Context& cx, const DiagnoseOptions& options,
+                                  const std::vector<Scored>& singles, const Scored& first,
+                                  Partner* partner, const Sums& base, double best_score) {
+  const EffectSpec* sa = FindEffect(first.fit.name);
+  const EffectSpec* sb = FindEffect(partner->key.second);
+  PairResult p;
+  EffectFit* b0 = partner->fit ? &*partner->fit : nullptr;
+  const auto t0 = std::chrono::steady_clock::now();
+  const bool ok = FitPair(cx, cx.resid, *sa, *sb, first.fit, b0,
+                          SingleOf(singles, partner->key.second), &p.fa, &p.fb);
+  DebugTime("backfit", (std::string(sa->name) + "+" + sb->name).c_str(), t0);
+  if (!ok) return std::nullopt;
+  const Sums s = ScoreSum(cx, cx.resid, p.fa.pred, p.fb.pred);
+  const double delta = base.hold_sse - s.hold_sse;
+  p.score = delta - (p.fa.n_params + p.fb.n_params) * HoldPenalty(cx);
+  // The partner must add a significant held-out improvement over the first alone …
+  double dd = 0.0;
+  for (int c = 0; c < cx.nc; ++c) {
+    for (int i = 0; i < cx.n; ++i) {
+      if (cx.train[static_cast<std::size_t>(i)]) continue;
+      const double diff = (p.fa.pred(i, c) + p.fb.pred(i, c)) - first.fit.pred(i, c);
+      dd += diff * diff * cx.weight(c);
+    }
+  }
+  const double inc = first.hold_sse - s.hold_sse;
+  const double z_inc = dd > 0 ? inc / (2.0 * std::sqrt(dd)) : 0.0;
+  // … and carry a visible share (≥ 0.2 %) of the excess over noise, not a misfit's remainder.
+  const double excess = base.hold_sse - static_cast<double>(cx.n_hold) * cx.nc;
+  if (std::getenv("FTDIAG_DEBUG") != nullptr) {
+    std::fprintf(stderr,
+                 "pair %s + %s: score %.1f (best single %.1f) z_inc %.1f inc %.1f excess %.1f\n",
+                 p.fa.name.c_str(), p.fb.name.c_str(), p.score, best_score, z_inc, inc, excess);
+  }
+  p.won = z_inc > options.z_claim && inc > 0.002 * excess;
+  return p;
+}
+
+}  // namespace
+
+double HoldRms(const Context& cx, const Mat& target, const Mat* pred) {
+  double s = 0.0;
+  for (int c = 0; c < cx.nc; ++c) {
+    for (int i = 0; i < cx.n; ++i) {
+      if (cx.train[static_cast<std::size_t>(i)]) continue;
+      const double e = target(i, c) - (pred != nullptr ? (*pred)(i, c) : 0.0);
+      s += e * e;
+    }
+  }
+  return std::sqrt(s / std::max(1.0, static_cast<double>(cx.n_hold) * cx.nc));
+}
+
+/// FTDIAG_DEBUG: the time one fit took, on stderr.
+void DebugTime(const char* stage, const char* what, std::chrono::steady_clock::time_point t0) {
+  static const bool on = std::getenv("FTDIAG_DEBUG") != nullptr;
+  if (!on) return;
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::fprintf(stderr, "time %-8s %-40s %7.3f s\n", stage, what, s);
+}
+
+void Progress(const DiagnoseOptions& o, double f, const char* what) {
+  if (o.progress != nullptr) o.progress(f, what, o.progress_user);
+}
+
+/// Every effect fitted alone to the residual and scored on the held-out rows, best first; each is
+/// listed among the report's candidates. The fits run in parallel (options.threads); the result
+/// does not depend on their number.
+std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const Sums& base) {
+  const Context& cx = r.cx;
+  const auto& effects = Effects();
+  std::vector<std::optional<Scored>> slot(effects.size());
+  const std::vector<std::size_t> order = CostOrder(effects);
+  std::mutex mu;
+  std::size_t done = 0;
+  ParallelFor(order.size(), ResolveThreads(options.threads), [&](std::size_t k) {
+    const std::size_t j = order[k];
+    const auto t0 = std::chrono::steady_clock::now();
+    auto fit = effects[j].fit(cx, cx.resid);
+    DebugTime("single", effects[j].name, t0);
+    std::optional<Scored> s;
+    if (fit) {
+      s = ScoreFit(cx, cx.resid, std::move(*fit), base.hold_sse, options.z_claim);
+      s->hold_rms_after = HoldRms(cx, cx.resid, &s->fit.pred);
+      // Memory (n × N per prediction): only the kPairStarts best eligible singles are used again
+      // (the claim and the pair starts); every other prediction is released at once.
+      if (!s->eligible) s->fit.pred = Mat();
+    }
+    const std::lock_guard<std::mutex> lock(mu);
+    slot[j] = std::move(s);
+    KeepBestPredictions(&slot, kPairStarts);
+    Progress(options, 0.05 + 0.6 * static_cast<double>(++done) / static_cast<double>(order.size()),
+             effects[j].name);
+  });
+  std::vector<Scored> singles;
+  for (auto& q : slot) {
+    if (q) singles.push_back(std::move(*q));
+  }
+  std::sort(singles.begin(), singles.end(),
+            [](const Scored& a, const Scored& b) { return a.score > b.score; });
+  for (const auto& s : singles) {
+    CandidateScore c;
+    c.name = s.fit.name;
+    c.variant = s.fit.variant;
+    c.n_params = s.fit.n_params;
+    c.hold_rms_after = s.hold_rms_after;
+    c.z = s.z;
+    c.score = s.score;
+    c.eligible = s.eligible;
+    r.candidates.push_back(c);
+  }
+  return singles;
+}
+
+/// Pairs: forward selection from each of the three best eligible singles: every other effect is
+/// fitted to what the first leaves, the best partners are kept, each pair is backfitted and scored
+/// on the held-out rows. True with *pa, *pb set when a pair beats every model so far (the best
+/// penalised held-out score among the qualifying pairs; independent of the thread count).
+bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Scored>& singles,
+              const Sums& base, EffectFit* pa, EffectFit* pb) {
+  const Scored& best = singles.front();
+  bool have_pair = false;
+  double pair_score = best.score;
+  std::size_t win_order = 0;
+  std::vector<std::size_t> top;
+  for (std::size_t j = 0; j < singles.size() && top.size() < kPairStarts; ++j) {
+    if (singles[j].eligible && singles[j].fit.pred.size() > 0 &&
+        singles[j].score >= 0.5 * best.score) {
+      top.push_back(j);
+    }
+  }
+  for (std::size_t t = 0; t < top.size(); ++t) {
+    Progress(options, 0.65 + 0.33 * static_cast<double>(t) / static_cast<double>(top.size()),
+             "pairs");
+    const Scored& first = singles[top[t]];
+    std::vector<Partner> partners = [&] {
+      const Mat rest = cx.resid - first.fit.pred;
+      return FitPartners(cx, options, singles, first, rest);
+    }();
+    partners.resize(std::min<std::size_t>(kPairPartners, partners.size()));
+    std::mutex mu;
+    ParallelFor(partners.size(), ResolveThreads(options.threads), [&](std::size_t y) {
+      auto p = TryPair(cx, options, singles, first, &partners[y], base, best.score);
+      partners[y].fit.reset();  // memory: the partner's fit was moved into or replaced by p
+      if (!p || !p->won) return;
+      const std::lock_guard<std::mutex> lock(mu);
+      // The best qualifying pair so far wins; of equal scores the earlier start and better partner
+      // (as a sequential search would keep).
+      const std::size_t order = t * kPairPartners + y;
+      if (p->score > pair_score || (have_pair && p->score == pair_score && order < win_order)) {
+        pair_score = p->score;
+        win_order = order;
+        *pa = std::move(p->fa);
+        *pb = std::move(p->fb);
+        have_pair = true;
+      }
+    });
+    // Memory: a start other than the best single is not used again.
+    if (top[t] != 0) singles[top[t]].fit.pred = Mat();
+  }
+  return have_pair;
+}
+
+}  // namespace ftstack::diag

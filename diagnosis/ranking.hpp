@@ -1,0 +1,48 @@
+// Ranking of the candidate effects: each alone, then pairs (internal to diagnosis/).
+#pragma once
+
+#include <Eigen/Dense>
+#include <chrono>
+#include <cstddef>
+
+#include "diagnosis/diagnose.hpp"
+#include "diagnosis/effects.hpp"
+
+namespace ftstack::diag {
+
+/// An effect's fit with its held-out figures.
+struct Scored {
+  EffectFit fit;
+  double hold_sse = 0.0;
+  double delta = 0.0;
+  double z = 0.0;
+  double score = 0.0;
+  bool eligible = false;
+  double hold_rms_after = 0.0;  ///< held-out RMS after removing the prediction
+};
+
+/// Pairs start from at most this many of the best eligible singles (BestPair).
+inline constexpr std::size_t kPairStarts = 3;
+/// Partners tried with each start (the best by their score on what the start leaves).
+inline constexpr std::size_t kPairPartners = 3;
+
+/// Held-out RMS of target − pred (pred nullptr: of target), all channels, mV/V.
+double HoldRms(const Context& cx, const Eigen::MatrixXd& target, const Eigen::MatrixXd* pred);
+/// FTDIAG_DEBUG: the time one fit took since t0, on stderr.
+void DebugTime(const char* stage, const char* what, std::chrono::steady_clock::time_point t0);
+/// Reports progress through options.progress when set.
+void Progress(const DiagnoseOptions& o, double f, const char* what);
+
+/// Every effect fitted alone to the residual and scored on the held-out rows, best first; each is
+/// listed among r.candidates. The fits run in parallel (options.threads); the result does not
+/// depend on their number. Only the kPairStarts best eligible fits keep their predictions.
+std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const Sums& base);
+
+/// Pairs: forward selection from each of the three best eligible singles: every other effect is
+/// fitted to what the first leaves, the best partners are kept, each pair is backfitted and scored
+/// on the held-out rows. True with *pa, *pb set when a pair beats every model so far (the best
+/// penalised held-out score among the qualifying pairs; independent of the thread count).
+bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Scored>& singles,
+              const Sums& base, EffectFit* pa, EffectFit* pb);
+
+}  // namespace ftstack::diag
