@@ -221,5 +221,25 @@ TEST(DiagResonance, OneModeIsNotGivenASecond) {
               f.params["damping_ratio"].get<double>(), modes[0].zeta, f.evidence.c_str());
 }
 
+// A weak mode (ringing about as high as the noise): the model-free location tests may miss it,
+// but once the resonance is claimed the channels carrying it must be located (the matched filter
+// of the claimed model, docs/diagnosis.md step 4): every bridge carries it here.
+TEST(DiagResonance, WeakRingingIsLocatedOnItsChannels) {
+  const std::vector<Mode> modes{{47.0, 0.03, 0.0012}};
+  std::vector<std::array<double, 6>> p;
+  const DiagData d = Ringing(modes, 30.0, 13, &p);
+  const Report r = Diagnose(d);
+  ASSERT_EQ(r.verdict, "resonance") << ToJson(r)["candidates"].dump();
+  const std::size_t strongest =
+      static_cast<std::size_t>(std::max_element(p[0].begin(), p[0].end()) - p[0].begin());
+  EXPECT_NE(std::find(r.mismatch_channels.begin(), r.mismatch_channels.end(),
+                      static_cast<int>(strongest)),
+            r.mismatch_channels.end())
+      << ToJson(r)["mismatch"].dump();
+  std::printf("weak ringing (participation %.4f on b%zu): mismatch channels %s, %s\n",
+              p[0][strongest], strongest, ToJson(r)["mismatch"]["channels"].dump().c_str(),
+              r.effects.front().fit.evidence.c_str());
+}
+
 }  // namespace
 }  // namespace ftstack::diag
