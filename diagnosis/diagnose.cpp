@@ -4,6 +4,7 @@
 #include "diagnosis/ranking.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -380,7 +381,9 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
   Locate(r);
   ReportSpectrum(r);
   const Sums base = Score(cx, cx.resid, nullptr);
+  t0 = std::chrono::steady_clock::now();
   std::vector<Scored> singles = FitSingles(r, options, base);
+  DebugTime("stage", "singles", t0);
   if (singles.empty() || !singles.front().eligible) {
     r.model = Mat::Zero(cx.n, cx.nc);  // allocated only now: nothing claimed
     Progress(options, 1.0, "done");
@@ -388,7 +391,9 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
   }
   EffectFit pa;
   EffectFit pb;
+  t0 = std::chrono::steady_clock::now();
   const bool have_pair = options.pairs && BestPair(cx, options, singles, base, &pa, &pb);
+  DebugTime("stage", "pairs", t0);
   std::vector<EffectFit> claimed;
   if (have_pair) {
     // Stronger first: the one whose removal from the pair costs more on held-out rows.
@@ -402,11 +407,13 @@ Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
   }
   singles.clear();  // memory: the kept single predictions are not used again
   singles.shrink_to_fit();
+  t0 = std::chrono::steady_clock::now();
   RefineThermal(cx, &claimed);
   const std::vector<Confounding> partner_conf =
       DropUnidentifiedPartner(cx, options.z_claim, &claimed, &r.dropped);
   RecordClaims(r, options, claimed, partner_conf);
   LocateByModel(r);
+  DebugTime("stage", "claims", t0);
   Progress(options, 1.0, "done");
   return r;
 }

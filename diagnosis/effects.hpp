@@ -68,9 +68,11 @@ using FitFn = std::optional<EffectFit> (*)(const Context&, const Eigen::MatrixXd
 /// Refits an effect near an earlier fit of the same effect: `near`'s nonlinear parameters start a
 /// local search (a full search only when the optimum leaves the local window) and its variant
 /// class is kept. The pair stage's partner fits and backfits use it: there the target differs from
-/// the one `near` was fitted to by another effect's prediction, not by a new shape.
+/// the one `near` was fitted to by another effect's prediction, not by a new shape. Without
+/// `uncertainty` the nonlinear parameters' 1-σ are not computed (null): for intermediate fits
+/// whose parameters only start the next one, never for a fit that is reported.
 using RefitFn = std::optional<EffectFit> (*)(const Context&, const Eigen::MatrixXd& target,
-                                             const EffectFit& near);
+                                             const EffectFit& near, bool uncertainty);
 
 struct EffectSpec {
   const char* name;
@@ -81,8 +83,8 @@ struct EffectSpec {
 
 /// spec.refit near *near when both exist, else spec.fit.
 [[nodiscard]] std::optional<EffectFit> FitNear(const EffectSpec& spec, const Context& cx,
-                                               const Eigen::MatrixXd& target,
-                                               const EffectFit* near);
+                                               const Eigen::MatrixXd& target, const EffectFit* near,
+                                               bool uncertainty = true);
 
 /// Every effect of the vocabulary except `none`, in spec order.
 [[nodiscard]] const std::vector<EffectSpec>& Effects();
@@ -114,6 +116,11 @@ struct EffectSpec {
 /// BIC (effects/hysteresis_pi.cpp).
 [[nodiscard]] std::optional<EffectFit> FitHysteresisFamily(const Context& cx,
                                                            const Eigen::MatrixXd& target);
+/// hysteresis refitted near an earlier fit (RefitFn): only the sub-family (load-path operators,
+/// one operator per bridge, or Preisach per bridge) that fit came from.
+[[nodiscard]] std::optional<EffectFit> RefitHysteresis(const Context& cx,
+                                                       const Eigen::MatrixXd& target,
+                                                       const EffectFit& near, bool uncertainty);
 
 /// Whitened sums over train or hold-out rows.
 struct Sums {

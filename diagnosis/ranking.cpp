@@ -35,24 +35,19 @@ Scored ScoreFit(const Context& cx, const Mat& target, EffectFit fit, double base
 }
 
 /// Backfits two effects, twice: B on target − A (A first fitted alone), then A on target − B.
-/// b0, when given, is B already fitted to target − A0 (the same fit the first step would make);
-/// b_near, B's fit alone (the start of its first refit when b0 is not given). Every refit starts
-/// from the effect's previous fit (FitNear).
+/// Every fit starts from the effect's previous one (FitNear; B's first from b_near, its fit to
+/// what A0 leaves). The first pass's fits skip the parameters' uncertainties: only the second
+/// pass's fits are kept (and reported).
 bool FitPair(const Context& cx, const Mat& target, const EffectSpec& a, const EffectSpec& b,
-             const EffectFit& a0, EffectFit* b0, const EffectFit* b_near, EffectFit* fa,
-             EffectFit* fb) {
+             const EffectFit& a0, const EffectFit* b_near, EffectFit* fa, EffectFit* fb) {
   const EffectFit* first = &a0;
   for (int it = 0; it < 2; ++it) {
-    if (it == 0 && b0 != nullptr) {
-      *fb = std::move(*b0);
-    } else {
-      fb->pred = Mat();  // memory: the previous B is replaced; only `first` is used now
-      auto nb = FitNear(b, cx, target - first->pred, it == 0 ? b_near : fb);
-      if (!nb) return false;
-      *fb = std::move(*nb);
-      if (first == fa) fa->pred = Mat();  // the previous A is replaced below
-    }
-    auto na = FitNear(a, cx, target - fb->pred, first);
+    fb->pred = Mat();  // memory: the previous B is replaced; only `first` is used now
+    auto nb = FitNear(b, cx, target - first->pred, it == 0 ? b_near : fb, it == 1);
+    if (!nb) return false;
+    *fb = std::move(*nb);
+    if (first == fa) fa->pred = Mat();  // the previous A is replaced below
+    auto na = FitNear(a, cx, target - fb->pred, first, it == 1);
     if (!na) return false;
     *fa = std::move(*na);
     first = fa;
@@ -93,54 +88,56 @@ const EffectFit* SingleOf(const std::vector<Scored>& singles, const std::string&
   return nullptr;
 }
 
-/// A partner fitted to what a pair's first effect leaves: its score there and, for the
-/// kPairPartners best, its fit (reused as the first step of the backfit).
+/// A partner fitted to what a pair's first effect leaves: its score there and its fit's parameters
+/// (the prediction is not kept: memory; the backfit refits it near these parameters).
 struct Partner {
   std::pair<double, std::string> key;  ///< (score, name)
-  std::optional<EffectFit> fit;
+  EffectFit fit;                       ///< without pred
 };
 
-/// Every other effect claimable alone, refitted to `rest` (= residual − first) near its single fit;
-/// the eligible ones, best first, with the fits of the kPairPartners best (parallel fits).
-std::vector<Partner> FitPartners(const Context& cx, const DiagnoseOptions& options,
-                                 const std::vector<Scored>& singles, const Scored& first,
-                                 const Mat& rest) {
+/// For every start (singles[top[t]]), every other effect claimable alone, refitted near its single
+/// fit to what the start leaves: the eligible ones per start, best first. All (start, partner)
+/// fits run as one parallel batch, costliest first.
+std::vector<std::vector<Partner>> FitPartners(const Context& cx, const DiagnoseOptions& options,
+                                              const std::vector<Scored>& singles,
+                                              const std::vector<std::size_t>& top) {
   const auto& effects = Effects();
-  const Sums rest_base = Score(cx, rest, nullptr);
-  std::vector<std::size_t> todo;
+  std::vector<std::pair<std::size_t, std::size_t>> todo;  // (start t, effect j)
   for (std::size_t j : CostOrder(effects)) {
-    const EffectSpec& spec = effects[j];
     // Partners come from the effects that were claimable on their own.
     const bool claimable = std::any_of(singles.begin(), singles.end(), [&](const Scored& q) {
-      return q.eligible && q.fit.name == spec.name;
+      return q.eligible && q.fit.name == effects[j].name;
     });
-    if (claimable && first.fit.name != spec.name) todo.push_back(j);
+    for (std::size_t t = 0; t < top.size(); ++t) {
+      if (claimable && singles[top[t]].fit.name != effects[j].name) todo.emplace_back(t, j);
+    }
   }
-  std::vector<Partner> partners;
+  std::vector<std::vector<Partner>> partners(top.size());
   std::mutex mu;
+  std::size_t done = 0;
   ParallelFor(todo.size(), ResolveThreads(options.threads), [&](std::size_t k) {
-    const EffectSpec& spec = effects[todo[k]];
+    const auto [t, j] = todo[k];
+    const Scored& first = singles[top[t]];
+    const EffectSpec& spec = effects[j];
     const auto t0 = std::chrono::steady_clock::now();
-    auto fb = FitNear(spec, cx, rest, SingleOf(singles, spec.name));
+    const Mat rest = cx.resid - first.fit.pred;
+    auto fb = FitNear(spec, cx, rest, SingleOf(singles, spec.name), false);
     DebugTime("partner", spec.name, t0);
-    if (!fb) return;
-    Scored sb = ScoreFit(cx, rest, std::move(*fb), rest_base.hold_sse, options.z_claim);
-    if (!sb.eligible) return;
+    std::optional<Scored> sb;
+    // first.hold_sse is the held-out SSE of rest: the baseline the partner is scored against.
+    if (fb) sb = ScoreFit(cx, rest, std::move(*fb), first.hold_sse, options.z_claim);
     const std::lock_guard<std::mutex> lock(mu);
-    partners.push_back({{sb.score, spec.name}, std::move(sb.fit)});
-    // Memory (n × N each): only the kPairPartners best fits are kept.
-    std::vector<Partner*> with_fit;
-    for (auto& q : partners) {
-      if (q.fit) with_fit.push_back(&q);
+    if (sb && sb->eligible) {
+      sb->fit.pred = Mat();
+      partners[t].push_back({{sb->score, spec.name}, std::move(sb->fit)});
     }
-    if (with_fit.size() > kPairPartners) {
-      (*std::min_element(with_fit.begin(), with_fit.end(), [](const Partner* u, const Partner* v) {
-        return u->key < v->key;
-      }))->fit.reset();
-    }
+    Progress(options, 0.65 + 0.2 * static_cast<double>(++done) / static_cast<double>(todo.size()),
+             "pairs: partners");
   });
-  std::sort(partners.begin(), partners.end(),
-            [](const Partner& u, const Partner& v) { return u.key > v.key; });
+  for (auto& list : partners) {
+    std::sort(list.begin(), list.end(),
+              [](const Partner& u, const Partner& v) { return u.key > v.key; });
+  }
   return partners;
 }
 
@@ -155,15 +152,13 @@ struct PairResult {
 /// Backfits first with `partner` and tests the pair: the partner must add a significant held-out
 /// improvement over the first alone and carry a visible share of the excess over noise.
 std::optional<PairResult> TryPair(const Context& cx, const DiagnoseOptions& options,
-                                  const std::vector<Scored>& singles, const Scored& first,
-                                  Partner* partner, const Sums& base, double best_score) {
+                                  const Scored& first, Partner* partner, const Sums& base,
+                                  double best_score) {
   const EffectSpec* sa = FindEffect(first.fit.name);
   const EffectSpec* sb = FindEffect(partner->key.second);
   PairResult p;
-  EffectFit* b0 = partner->fit ? &*partner->fit : nullptr;
   const auto t0 = std::chrono::steady_clock::now();
-  const bool ok = FitPair(cx, cx.resid, *sa, *sb, first.fit, b0,
-                          SingleOf(singles, partner->key.second), &p.fa, &p.fb);
+  const bool ok = FitPair(cx, cx.resid, *sa, *sb, first.fit, &partner->fit, &p.fa, &p.fb);
   DebugTime("backfit", (std::string(sa->name) + "+" + sb->name).c_str(), t0);
   if (!ok) return std::nullopt;
   const Sums s = ScoreSum(cx, cx.resid, p.fa.pred, p.fb.pred);
@@ -283,34 +278,37 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Sco
       top.push_back(j);
     }
   }
+  std::vector<std::vector<Partner>> partners = FitPartners(cx, options, singles, top);
+  // Every start with each of its kPairPartners best partners, backfitted: one parallel batch.
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;  // (start t, partner y)
   for (std::size_t t = 0; t < top.size(); ++t) {
-    Progress(options, 0.65 + 0.33 * static_cast<double>(t) / static_cast<double>(top.size()),
-             "pairs");
-    const Scored& first = singles[top[t]];
-    std::vector<Partner> partners = [&] {
-      const Mat rest = cx.resid - first.fit.pred;
-      return FitPartners(cx, options, singles, first, rest);
-    }();
-    partners.resize(std::min<std::size_t>(kPairPartners, partners.size()));
-    std::mutex mu;
-    ParallelFor(partners.size(), ResolveThreads(options.threads), [&](std::size_t y) {
-      auto p = TryPair(cx, options, singles, first, &partners[y], base, best.score);
-      partners[y].fit.reset();  // memory: the partner's fit was moved into or replaced by p
-      if (!p || !p->won) return;
-      const std::lock_guard<std::mutex> lock(mu);
-      // The best qualifying pair so far wins; of equal scores the earlier start and better partner
-      // (as a sequential search would keep).
-      const std::size_t order = t * kPairPartners + y;
-      if (p->score > pair_score || (have_pair && p->score == pair_score && order < win_order)) {
-        pair_score = p->score;
-        win_order = order;
-        *pa = std::move(p->fa);
-        *pb = std::move(p->fb);
-        have_pair = true;
-      }
-    });
-    // Memory: a start other than the best single is not used again.
-    if (top[t] != 0) singles[top[t]].fit.pred = Mat();
+    for (std::size_t y = 0; y < std::min(kPairPartners, partners[t].size()); ++y) {
+      pairs.emplace_back(t, y);
+    }
+  }
+  std::mutex mu;
+  std::size_t done = 0;
+  ParallelFor(pairs.size(), ResolveThreads(options.threads), [&](std::size_t k) {
+    const auto [t, y] = pairs[k];
+    auto p = TryPair(cx, options, singles[top[t]], &partners[t][y], base, best.score);
+    const std::lock_guard<std::mutex> lock(mu);
+    Progress(options, 0.85 + 0.13 * static_cast<double>(++done) / static_cast<double>(pairs.size()),
+             "pairs: backfits");
+    if (!p || !p->won) return;
+    // The best qualifying pair wins; of equal scores the earlier start and better partner (as a
+    // sequential search would keep).
+    const std::size_t order = t * kPairPartners + y;
+    if (p->score > pair_score || (have_pair && p->score == pair_score && order < win_order)) {
+      pair_score = p->score;
+      win_order = order;
+      *pa = std::move(p->fa);
+      *pb = std::move(p->fb);
+      have_pair = true;
+    }
+  });
+  // Memory: the starts other than the best single are not used again.
+  for (std::size_t x : top) {
+    if (x != 0) singles[x].fit.pred = Mat();
   }
   return have_pair;
 }

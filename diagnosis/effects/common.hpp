@@ -163,15 +163,17 @@ std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target);
 /// one-τ optimum `log_tau1`, then τ1 and τ2 refined in turn; replaces *best (and fills tau,
 /// tau_sigma, the channel fit and whether a gain term is in it) only when its training BIC is
 /// below `best_bic`. Returns whether it did.
-/// `start` (log τ1, log τ2), when given, replaces the coarse pair search (a refit near an earlier
-/// two-τ fit).
+/// `start` (log τ1, log τ2), when given, replaces the coarse pair search and one refinement round
+/// (a refit near an earlier two-τ fit).
 bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double best_bic,
                  EffectFit* best, std::vector<double>* tau, std::vector<double>* tau_sigma,
-                 ChannelFit* best_f, bool* best_gamma, const double* start = nullptr);
+                 ChannelFit* best_f, bool* best_gamma, const double* start = nullptr,
+                 bool uncertainty = true);
 /// creep refitted near an earlier creep fit (RefitFn): τ searched in a window of ±0.5 in log τ
-/// around near's (full range when it lands on the window's edge); the two-τ variant is tried
-/// only when near is two-τ, from near's pair (effects/creep.cpp).
-std::optional<EffectFit> RefitCreep(const Context& cx, const Mat& target, const EffectFit& near);
+/// around near's τ (τ1 when near is two-τ; full range when it lands on the window's edge); the
+/// two-τ variant is tried only when near is two-τ, from near's pair (effects/creep.cpp).
+std::optional<EffectFit> RefitCreep(const Context& cx, const Mat& target, const EffectFit& near,
+                                    bool uncertainty);
 /// The fitted creep model (time constants tau, channel fit f with a_k per τ then γ when `gamma`)
 /// in OIML R 60's terms: e->standard["oiml_r60"] (docs/spec/diagnosis.md).
 void CreepOimlR60(const Context& cx, const std::vector<double>& tau,
@@ -194,8 +196,8 @@ std::string AddMainsHarmonics(const Context& cx, const Mat& target, double f0, E
 std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target);
 /// resonance refitted near an earlier resonance fit (RefitFn): the golden refinements of (f, ζ)
 /// start at near's mode(s), without the coarse grid; a second mode only when near has one.
-std::optional<EffectFit> RefitResonance(const Context& cx, const Mat& target,
-                                        const EffectFit& near);
+std::optional<EffectFit> RefitResonance(const Context& cx, const Mat& target, const EffectFit& near,
+                                        bool uncertainty);
 /// The two-mode variant of a one-mode resonance fit *e at (f1_hz, zeta1) (effects/
 /// resonance_family.cpp): mode 2 searched at the lines of the residual spectrum, both refined in
 /// turn and fitted jointly (a participation per channel and mode); replaces *e (variant "two
@@ -204,6 +206,6 @@ std::optional<EffectFit> RefitResonance(const Context& cx, const Mat& target,
 /// `start` (log f2, log ζ2), when given, replaces the search at the residual's lines (a refit);
 /// e->search_state gets (log f, log ζ) of mode 1 then mode 2 when the second mode is kept.
 std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz, double zeta1,
-                             EffectFit* e, const double* start = nullptr);
+                             EffectFit* e, const double* start = nullptr, bool uncertainty = true);
 
 }  // namespace ftstack::diag::fx

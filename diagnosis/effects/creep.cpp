@@ -21,9 +21,25 @@ double LogParam(const EffectFit* near, const char* key) {
   return v > 0 ? std::log(v) : std::numeric_limits<double>::quiet_NaN();
 }
 
+/// argmin of f: on 5 points 0.25 apart around `start` (8 golden steps) when it is finite and the
+/// minimum is inside that window, else on `grid` (12 golden steps). [lo, hi] bounds the window.
+double WindowOrGrid(const std::function<double(double)>& f, double start,
+                    const std::vector<double>& grid, double lo, double hi) {
+  if (std::isfinite(start)) {
+    std::vector<double> local;
+    for (int j = -2; j <= 2; ++j) local.push_back(std::clamp(start + 0.25 * j, lo, hi));
+    const double x = MinimizeOnGrid(f, local, 8, nullptr);
+    const bool edge = (x <= local.front() + 0.125 && local.front() > lo) ||
+                      (x >= local.back() - 0.125 && local.back() < hi);
+    if (!edge) return x;
+  }
+  return MinimizeOnGrid(f, grid, 12, nullptr);
+}
+
 /// FitCreep (near == nullptr) or RefitCreep: the one-τ search on the full log grid or in a window
 /// around near's τ, then the two-τ variant (full, from near's pair, or not when near is one-τ).
-std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const EffectFit* near) {
+std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const EffectFit* near,
+                                     bool uncertainty) {
   const auto& d = *cx.data;
   const double duration = d.t_s.back() - d.t_s.front();
   Mat lp(cx.n, cx.nc);
@@ -61,21 +77,13 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const
   ChannelFit best_f;
   bool best_gamma = false;
   double best_bic = std::numeric_limits<double>::infinity();
-  // τ is searched with the plain model; the variant with a gain term reuses it. Near a one-τ fit:
-  // 5 points 0.25 apart in log τ around its τ, the full grid when the optimum is on the edge.
-  const double near_lt = LogParam(near, "tau_s");
-  double lt = std::numeric_limits<double>::quiet_NaN();
-  if (std::isfinite(near_lt)) {
-    std::vector<double> local;
-    for (int j = -2; j <= 2; ++j) local.push_back(std::clamp(near_lt + 0.25 * j, lo, hi));
-    lt = MinimizeOnGrid([&](double v) { return sse_for(v, false); }, local, 8, nullptr);
-    const bool edge = (lt <= local.front() + 0.125 && local.front() > lo) ||
-                      (lt >= local.back() - 0.125 && local.back() < hi);
-    if (edge) lt = std::numeric_limits<double>::quiet_NaN();
-  }
-  if (!std::isfinite(lt)) {
-    lt = MinimizeOnGrid([&](double v) { return sse_for(v, false); }, grid, 12, nullptr);
-  }
+  // τ is searched with the plain model; the variant with a gain term reuses it. Near a fit: 5
+  // points 0.25 apart in log τ around its τ (τ1 of a two-τ fit: the one-τ model is then only the
+  // baseline the pair must beat), the full grid when the optimum is on the window's edge.
+  const double near_lt =
+      std::isfinite(LogParam(near, "tau_s")) ? LogParam(near, "tau_s") : LogParam(near, "tau1_s");
+  const double lt =
+      WindowOrGrid([&](double v) { return sse_for(v, false); }, near_lt, grid, lo, hi);
   for (bool gamma : {false, true}) {
     const int p = cx.nc * (gamma ? 2 : 1) + 1;
     EffectFit e;
@@ -83,7 +91,9 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const
     e.variant = gamma ? "first-order creep with a gain term" : "first-order creep";
     e.n_params = p;
     const double tau = std::exp(lt);
-    const double sl = CurvatureSigma([&](double v) { return sse_for(v, gamma); }, lt, 0.02);
+    const double sl = uncertainty
+                          ? CurvatureSigma([&](double v) { return sse_for(v, gamma); }, lt, 0.02)
+                          : std::numeric_limits<double>::quiet_NaN();
     build(tau);
     const auto feat_gamma = [&](int i, int c, double* x) {
       x[0] = lp(i, c);
@@ -120,7 +130,7 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const
   const bool near_two = std::isfinite(start[0]) && std::isfinite(start[1]);
   const bool two = (near == nullptr || near_two) &&
                    FitCreepTwo(cx, target, lt, best_bic, &best, &tau, &tau_sigma, &best_f,
-                               &best_gamma, near_two ? start : nullptr);
+                               &best_gamma, near_two ? start : nullptr, uncertainty);
   CreepOimlR60(cx, tau, tau_sigma, best_f, best_gamma, &best);
   best.channels = ActiveChannels(cx, best.pred);
   const int c = DominantChannel(cx, best.pred);
@@ -146,11 +156,12 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const
 }  // namespace
 
 std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
-  return CreepSearch(cx, target, nullptr);
+  return CreepSearch(cx, target, nullptr, true);
 }
 
-std::optional<EffectFit> RefitCreep(const Context& cx, const Mat& target, const EffectFit& near) {
-  return CreepSearch(cx, target, &near);
+std::optional<EffectFit> RefitCreep(const Context& cx, const Mat& target, const EffectFit& near,
+                                    bool uncertainty) {
+  return CreepSearch(cx, target, &near, uncertainty);
 }
 
 }  // namespace ftstack::diag::fx

@@ -175,7 +175,7 @@ void CreepOimlR60(const Context& cx, const std::vector<double>& tau,
 
 bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double best_bic,
                  EffectFit* best, std::vector<double>* tau, std::vector<double>* tau_sigma,
-                 ChannelFit* best_f, bool* best_gamma, const double* start) {
+                 ChannelFit* best_f, bool* best_gamma, const double* start, bool uncertainty) {
   const double duration = cx.data->t_s.back() - cx.data->t_s.front();
   const double lo = std::log(std::max(3.0 * cx.dt, 0.2));
   // A second time constant longer than a third of the record cannot be told from a drift or an
@@ -211,20 +211,25 @@ bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double b
     }
     return out;
   };
-  for (int round = 0; round < 3; ++round) {
+  // From a refit's start: τ2 then τ1 once each, with fewer golden steps.
+  const int rounds = start != nullptr ? 2 : 3;
+  const int golden = start != nullptr ? 6 : 8;
+  for (int round = 0; round < rounds; ++round) {
     const bool second = round != 1;
     LowPassLoad(cx, std::exp(second ? l1 : l2), second ? &lp1 : &lp2);
     const auto gr = around(second ? l2 : l1, second ? l1 : l2);
     if (gr.size() < 3) continue;
     (second ? l2 : l1) = MinimizeOnGrid(
-        second ? std::function<double(double)>(sse2) : std::function<double(double)>(sse1), gr, 8,
-        nullptr);
+        second ? std::function<double(double)>(sse2) : std::function<double(double)>(sse1), gr,
+        golden, nullptr);
   }
   if (l2 < l1) std::swap(l1, l2);
   LowPassLoad(cx, std::exp(l1), &lp1);
-  const double sl2 = CurvatureSigma(sse2, l2, 0.02);
+  const double sl2 =
+      uncertainty ? CurvatureSigma(sse2, l2, 0.02) : std::numeric_limits<double>::quiet_NaN();
   LowPassLoad(cx, std::exp(l2), &lp2);
-  const double sl1 = CurvatureSigma(sse1, l1, 0.02);
+  const double sl1 =
+      uncertainty ? CurvatureSigma(sse1, l1, 0.02) : std::numeric_limits<double>::quiet_NaN();
   LowPassLoad(cx, std::exp(l1), &lp1);
   // Two exponentials closer than a factor 3 in τ are not resolved by the data (their fractions
   // trade against each other, often with opposite signs: seen on ftsim's creep with drift).

@@ -97,6 +97,16 @@ std::optional<EffectFit> FitHysteresisFamily(const Context& cx, const Eigen::Mat
   return LowerBic(cx, best, FitHysteresisPreisach(cx, target));
 }
 
+std::optional<EffectFit> RefitHysteresis(const Context& cx, const Eigen::MatrixXd& target,
+                                         const EffectFit& near, bool /*uncertainty*/) {
+  // The sub-family near's fit came from, searched again (its σ are cheap: always computed).
+  if (near.variant.find("wrench axis") != std::string::npos) return FitHysteresisAxes(cx, target);
+  if (near.variant.rfind("Preisach", 0) == 0 && cx.n >= 4 * kRelays) {
+    return FitHysteresisPreisach(cx, target);
+  }
+  return FitHysteresisOperator(cx, target);
+}
+
 namespace {
 
 std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Eigen::MatrixXd& target) {

@@ -20,7 +20,7 @@ const std::vector<EffectSpec>& Effects() {
       {"thermal_span_drift", &FitThermalSpan},
       {"excitation_drift", &FitExcitation, nullptr, 2},
       {"creep", &FitCreep, &RefitCreep, 4},
-      {"hysteresis", &FitHysteresisFamily, nullptr, 2},
+      {"hysteresis", &FitHysteresisFamily, &RefitHysteresis, 2},
       {"bridge_nonlinearity", &FitBridgeNonlinearity},
       {"geometric_nonlinearity", &FitGeometric},
       {"load_stiffening", &FitLoadStiffening},
@@ -36,9 +36,9 @@ const std::vector<EffectSpec>& Effects() {
 }
 
 std::optional<EffectFit> FitNear(const EffectSpec& spec, const Context& cx, const Mat& target,
-                                 const EffectFit* near) {
+                                 const EffectFit* near, bool uncertainty) {
   if (spec.refit != nullptr && near != nullptr && near->name == spec.name) {
-    return spec.refit(cx, target, *near);
+    return spec.refit(cx, target, *near, uncertainty);
   }
   return spec.fit(cx, target);
 }

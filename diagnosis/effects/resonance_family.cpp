@@ -90,7 +90,7 @@ int PutModes(const Context& cx, const ChannelFit& cf, const double* lf, const do
 }  // namespace
 
 std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz, double zeta1,
-                             EffectFit* e, const double* start) {
+                             EffectFit* e, const double* start, bool uncertainty) {
   const double nyq_hz = 0.5 * cx.rate_hz;
   std::vector<double> lines;  // the residual's lines (none needed from a refit's start)
   std::vector<int> coarse;
@@ -169,9 +169,11 @@ std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz,
     }
   }
   // Profile curvatures on every channel and row (the other mode held at its optimum).
-  double slf[2];
-  double slz[2];
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  double slf[2] = {kNaN, kNaN};
+  double slz[2] = {kNaN, kNaN};
   for (int m : {0, 1}) {
+    if (!uncertainty) break;
     Ringing(cx, std::exp(lf[1 - m]), std::exp(lz[1 - m]), all, h[1 - m]);
     slf[m] = CurvatureSigma([&](double v) { return sse(m, std::exp(v), std::exp(lz[m]), all, 1); },
                             lf[m], 0.002);

@@ -151,11 +151,24 @@ int FastLoadChanges(const Context& cx, int c) {
   return fast;
 }
 
+/// The coarse frequency grid: ±8 % around each of the 3 strongest lines of the residual spectrum,
+/// or 12 log-spaced points from 1 Hz to 0.9 × Nyquist without any.
+std::vector<double> ResonanceGrid(const Context& cx) {
+  std::vector<double> fgrid;
+  for (std::size_t p = 0; p < std::min<std::size_t>(cx.peak_hz.size(), 3); ++p) {
+    for (double m : {0.92, 1.0, 1.08}) fgrid.push_back(cx.peak_hz[p] * m);
+  }
+  if (fgrid.empty()) {
+    for (int j = 0; j < 12; ++j) fgrid.push_back(std::exp(std::log(0.45 * cx.rate_hz) * j / 11.0));
+  }
+  return fgrid;
+}
+
 /// FitResonance (near == nullptr: coarse grid at the residual's lines, or a log grid without any)
 /// or RefitResonance (the refinements start at near's search state, its second mode kept as a
 /// start, none tried when near has one mode).
 std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
-                                         const EffectFit* near) {
+                                         const EffectFit* near, bool uncertainty) {
   const auto& d = *cx.data;
   const double nyq = 0.5 * cx.rate_hz;
   Mat h(cx.n, cx.nc);
@@ -191,14 +204,7 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
   };
   const std::vector<int> coarse(order.begin(), order.begin() + std::min(2, cx.nc));
   const std::vector<int> all = AllChannels(cx);
-  std::vector<double> fgrid;
-  for (std::size_t p = 0; p < std::min<std::size_t>(cx.peak_hz.size(), 3); ++p) {
-    for (double m : {0.92, 1.0, 1.08}) fgrid.push_back(cx.peak_hz[p] * m);
-  }
-  if (fgrid.empty()) {
-    for (int j = 0; j < 12; ++j)
-      fgrid.push_back(std::exp(std::log(1.0) + (std::log(0.9 * nyq) - std::log(1.0)) * j / 11.0));
-  }
+  std::vector<double> fgrid = ResonanceGrid(cx);
   const double zgrid[] = {0.01, 0.03, 0.1, 0.3};
   double bf = 0.0;
   double bz = 0.0;
@@ -249,19 +255,22 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
   e.params["freq_hz"] = f;
   e.params["damping_ratio"] = z;
   e.params["damped_freq_hz"] = f * std::sqrt(std::max(0.0, 1.0 - z * z));
-  e.sigma["freq_hz"] = JsonNum(
-      f * CurvatureSigma([&](double v) { return sse_for(std::exp(v), z, all, nullptr, nullptr); },
-                         lf, 0.002));
-  e.sigma["damping_ratio"] = JsonNum(
-      z * CurvatureSigma([&](double v) { return sse_for(f, std::exp(v), all, nullptr, nullptr); },
-                         lz, 0.02));
+  if (uncertainty) {
+    e.sigma["freq_hz"] = JsonNum(
+        f * CurvatureSigma([&](double v) { return sse_for(std::exp(v), z, all, nullptr, nullptr); },
+                           lf, 0.002));
+    e.sigma["damping_ratio"] = JsonNum(
+        z * CurvatureSigma([&](double v) { return sse_for(f, std::exp(v), all, nullptr, nullptr); },
+                           lz, 0.02));
+  }
   PutChannelCoef(cx, cf, 0, "participation", &e);
   e.variant = "one mode";
   e.search_state = {lf, lz};
   const bool near_two = warm && near->search_state.size() >= 4;
   const std::string second =
       near == nullptr || near_two
-          ? AddResonanceMode(cx, target, f, z, &e, near_two ? &near->search_state[2] : nullptr)
+          ? AddResonanceMode(cx, target, f, z, &e, near_two ? &near->search_state[2] : nullptr,
+                             uncertainty)
           : "";
   e.channels = ActiveChannels(cx, e.pred);
   const int c = DominantChannel(cx, e.pred);
@@ -278,12 +287,12 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
 }  // namespace
 
 std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target) {
-  return ResonanceSearch(cx, target, nullptr);
+  return ResonanceSearch(cx, target, nullptr, true);
 }
 
-std::optional<EffectFit> RefitResonance(const Context& cx, const Mat& target,
-                                        const EffectFit& near) {
-  return ResonanceSearch(cx, target, &near);
+std::optional<EffectFit> RefitResonance(const Context& cx, const Mat& target, const EffectFit& near,
+                                        bool uncertainty) {
+  return ResonanceSearch(cx, target, &near, uncertainty);
 }
 
 }  // namespace ftstack::diag::fx
