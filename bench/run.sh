@@ -123,17 +123,21 @@ fi
 if [ -x "$B/bench_diag" ]; then
   section "ftdiag diagnose, 60 000 rows x 6 channels (ms CPU per diagnosis; target < 2000 ms)"
   "$B/bench_diag" --benchmark_format=csv --benchmark_filter='BM_Diagnose60k' 2>/dev/null |
-    awk -F, 'NR>1 && $1 ~ /BM_/ { gsub(/"/,"",$1); t[$1]=$4; printf "  %-34s %8.0f ms CPU\n", $1, $4 }
+    awk -F, 'NR>1 && $1 ~ /BM_/ { gsub(/"/,"",$1); gsub(/\/(process_time|real_time)/,"",$1); t[$1]=$4
+        printf "  %-34s %8.0f ms wall %8.0f ms CPU (process, all threads)\n", $1, $3, $4 }
       END { a=t["BM_Diagnose60k/iterations:3"]; b=t["BM_Diagnose60kNone/iterations:3"];
             if (a > 0 && b > 0) printf "  concealed creep (pairs tried) / noise only = %.2f\n", a / b }'
   section "ftdiag diagnose, 8 channels, uniform vs +-30 % jittered clock, same run (issue 12: 1e5 rows <= 3 s, 1e6 rows <= 20 s and < 500 MB)"
   /usr/bin/time -f "%M" -o "$B/diag_clock_rss" "$B/bench_diag" --benchmark_format=csv \
       --benchmark_filter='BM_DiagnoseClock' 2>/dev/null |
-    awk -F, 'NR>1 && $1 ~ /BM_/ { gsub(/"/,"",$1); t[$1]=$3; c[$1]=$4; printf "  %-44s %8.0f ms wall %8.0f ms CPU\n", $1, $3, $4 }
+    awk -F, 'NR>1 && $1 ~ /BM_/ { gsub(/"/,"",$1); gsub(/\/(process_time|real_time)/,"",$1); t[$1]=$3; c[$1]=$4
+        printf "  %-44s %8.0f ms wall %8.0f ms CPU (process)\n", $1, $3, $4 }
       END { u=c["BM_DiagnoseClock/100000/0/iterations:1"]; j=c["BM_DiagnoseClock/100000/1/iterations:1"];
-            if (u > 0) printf "  1e5 rows: jittered / uniform CPU = %.2f\n", j / u
+            if (u > 0) printf "  1e5 rows: jittered / uniform CPU = %.2f, wall = %.2f\n", j / u,
+              t["BM_DiagnoseClock/100000/1/iterations:1"] / t["BM_DiagnoseClock/100000/0/iterations:1"]
             u=c["BM_DiagnoseClock1M/1000000/0/iterations:1"]; j=c["BM_DiagnoseClock1M/1000000/1/iterations:1"];
-            if (u > 0) printf "  1e6 rows: jittered / uniform CPU = %.2f\n", j / u }'
+            if (u > 0) printf "  1e6 rows: jittered / uniform CPU = %.2f, wall = %.2f\n", j / u,
+              t["BM_DiagnoseClock1M/1000000/1/iterations:1"] / t["BM_DiagnoseClock1M/1000000/0/iterations:1"] }'
   [ -s "$B/diag_clock_rss" ] && echo "  peak resident memory of the run (largest case): $(( $(cat "$B/diag_clock_rss") / 1024 )) MB"
   # The real command on the same data written as CSV: wall and user CPU time (reading included; the
   # CPU time is the steadier figure on a loaded machine) and peak memory.
