@@ -1,5 +1,7 @@
 #include "diagnosis/ranking.hpp"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -205,7 +207,10 @@ void DebugTime(const char* stage, const char* what, std::chrono::steady_clock::t
   static const bool on = std::getenv("FTDIAG_DEBUG") != nullptr;
   if (!on) return;
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::fprintf(stderr, "time %-8s %-40s %7.3f s\n", stage, what, s);
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  std::fprintf(stderr, "time %-8s %-40s %7.3f s (peak RSS so far %ld MB)\n", stage, what, s,
+               u.ru_maxrss / 1024);
 }
 
 void Progress(const DiagnoseOptions& o, double f, const char* what) {

@@ -33,6 +33,31 @@ double CurvatureSigma(const std::function<double(double)>& f, double x, double h
   return d2 > 0 ? std::sqrt(2.0 / d2) : std::numeric_limits<double>::quiet_NaN();
 }
 
+void RingingRows(const Context& cx, double f_hz, double zeta, const std::vector<int>& chans, int i0,
+                 int m, Mat* h) {
+  const auto& d = *cx.data;
+  std::vector<const double*> in;
+  std::vector<double*> out;
+  for (int c : chans) {
+    in.push_back(d.sim_mvv.col(c).data() + i0);
+    out.push_back(h->col(c).data() + i0);
+  }
+  const std::uint8_t* restart = Restarts(cx);
+  SecondOrderLowPassColumns(d.t_s.data() + i0, static_cast<std::size_t>(m), f_hz, zeta, in.data(),
+                            out.data(), in.size(), restart != nullptr ? restart + i0 : nullptr);
+  for (int c : chans) h->col(c).segment(i0, m) -= d.sim_mvv.col(c).segment(i0, m);
+}
+
+std::vector<int> StrongestTwo(const Context& cx, const Mat& r) {
+  std::vector<int> order(static_cast<std::size_t>(cx.nc));
+  for (int c = 0; c < cx.nc; ++c) order[static_cast<std::size_t>(c)] = c;
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return r.col(a).squaredNorm() * cx.weight(a) > r.col(b).squaredNorm() * cx.weight(b);
+  });
+  order.resize(static_cast<std::size_t>(std::min(2, cx.nc)));
+  return order;
+}
+
 nlohmann::json JsonNum(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }

@@ -116,6 +116,13 @@ inline std::vector<int> AllChannels(const Context& cx) {
   for (int c = 0; c < cx.nc; ++c) all[static_cast<std::size_t>(c)] = c;
   return all;
 }
+/// h(i, c) = H_{f,ζ}[sim_c](i) − sim_c(i) for rows i0 … i0 + m − 1 and the channels `chans`: the
+/// exact second-order low pass on the actual dt of every row, at rest at row i0 and restarting
+/// at rest at every segment (a resonance's ringing).
+void RingingRows(const Context& cx, double f_hz, double zeta, const std::vector<int>& chans, int i0,
+                 int m, Mat* h);
+/// The two channels carrying the most whitened energy of r (where ringing searches look).
+std::vector<int> StrongestTwo(const Context& cx, const Mat& r);
 /// Channel whose prediction carries the largest whitened energy.
 int DominantChannel(const Context& cx, const Mat& pred);
 /// Channels carrying at least `share` of the prediction's whitened energy.

@@ -16,16 +16,7 @@ namespace {
 /// h(·, c) = H_{f,ζ}[sim_c] − sim_c on the channels `chans`: the exact second-order low pass on the
 /// actual dt of every row, restarting at rest at every segment.
 void Ringing(const Context& cx, double f_hz, double zeta, const std::vector<int>& chans, Mat* h) {
-  const auto& d = *cx.data;
-  std::vector<const double*> in;
-  std::vector<double*> out;
-  for (int c : chans) {
-    in.push_back(d.sim_mvv.col(c).data());
-    out.push_back(h->col(c).data());
-  }
-  SecondOrderLowPassColumns(d.t_s.data(), static_cast<std::size_t>(cx.n), f_hz, zeta, in.data(),
-                            out.data(), in.size(), Restarts(cx));
-  for (int c : chans) h->col(c) -= d.sim_mvv.col(c);
+  RingingRows(cx, f_hz, zeta, chans, 0, cx.n, h);
 }
 
 /// Whether two modes are far enough apart to be told apart (more than 15 % in frequency).
@@ -51,17 +42,6 @@ double ModeEnergy(const Context& cx, const ChannelFit& f, int j, const Mat& h) {
     e += s * f.beta(j, c) * f.beta(j, c) * cx.weight(c);
   }
   return e;
-}
-
-/// The two channels carrying the most whitened energy of r (where the search looks).
-std::vector<int> StrongestTwo(const Context& cx, const Mat& r) {
-  std::vector<int> order(static_cast<std::size_t>(cx.nc));
-  for (int c = 0; c < cx.nc; ++c) order[static_cast<std::size_t>(c)] = c;
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return r.col(a).squaredNorm() * cx.weight(a) > r.col(b).squaredNorm() * cx.weight(b);
-  });
-  order.resize(static_cast<std::size_t>(std::min(2, cx.nc)));
-  return order;
 }
 
 /// Puts both modes' parameters and 1-σ into *e, mode 1 the lower frequency (log f, log ζ and their

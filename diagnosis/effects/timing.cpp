@@ -164,36 +164,76 @@ std::vector<double> ResonanceGrid(const Context& cx) {
   return fgrid;
 }
 
+/// Rows of ringing searches' coarse stage: [0, n) up to kCoarseRows rows, else the kCoarseRows
+/// consecutive rows carrying the most load-step energy Σ w_c·(Δsim_c)² on `chans` (the ringing is
+/// excited there; the filter starts at rest at the window's first row and restarts inside it).
+constexpr int kCoarseRows = 100000;
+std::pair<int, int> CoarseWindow(const Context& cx, const std::vector<int>& chans) {
+  if (cx.n <= kCoarseRows) return {0, cx.n};
+  const auto& d = *cx.data;
+  std::vector<double> e(static_cast<std::size_t>(cx.n), 0.0);
+  for (int i = 1; i < cx.n; ++i) {
+    if (!cx.restart.empty() && cx.restart[static_cast<std::size_t>(i)] != 0) continue;
+    for (int c : chans) {
+      const double s = d.sim_mvv(i, c) - d.sim_mvv(i - 1, c);
+      e[static_cast<std::size_t>(i)] += s * s * cx.weight(c);
+    }
+  }
+  double run = 0.0;
+  for (int i = 0; i < kCoarseRows; ++i) run += e[static_cast<std::size_t>(i)];
+  double best = run;
+  int best0 = 0;
+  for (int i0 = 1; i0 + kCoarseRows <= cx.n; ++i0) {
+    run += e[static_cast<std::size_t>(i0 + kCoarseRows - 1)] - e[static_cast<std::size_t>(i0 - 1)];
+    if (run > best) {
+      best = run;
+      best0 = i0;
+    }
+  }
+  return {best0, best0 + kCoarseRows};
+}
+
+/// Whitened training SSE of a one-coefficient fit of target to h per channel of `chans`, on rows
+/// [w0, w1) (the coarse stage of a windowed ringing search).
+double WindowSse(const Context& cx, const Mat& target, const Mat& h, const std::vector<int>& chans,
+                 int w0, int w1) {
+  double s = 0.0;
+  for (int c : chans) {
+    double hh = 0.0;
+    double hy = 0.0;
+    double yy = 0.0;
+    for (int i = w0; i < w1; ++i) {
+      if (!cx.train[static_cast<std::size_t>(i)]) continue;
+      hh += h(i, c) * h(i, c);
+      hy += h(i, c) * target(i, c);
+      yy += target(i, c) * target(i, c);
+    }
+    s += std::max(0.0, yy - (hh > 0 ? hy * hy / hh : 0.0)) * cx.weight(c);
+  }
+  return s;
+}
+
 /// FitResonance (near == nullptr: coarse grid at the residual's lines, or a log grid without any)
 /// or RefitResonance (the refinements start at near's search state, its second mode kept as a
 /// start, none tried when near has one mode).
 std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
                                          const EffectFit* near, bool uncertainty) {
-  const auto& d = *cx.data;
   const double nyq = 0.5 * cx.rate_hz;
   Mat h(cx.n, cx.nc);
-  // Coarse search on the two channels with the most residual energy.
-  std::vector<int> order(static_cast<std::size_t>(cx.nc));
-  for (int c = 0; c < cx.nc; ++c) order[static_cast<std::size_t>(c)] = c;
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return target.col(a).squaredNorm() * cx.weight(a) > target.col(b).squaredNorm() * cx.weight(b);
-  });
+  // Coarse search on the two channels with the most residual energy, on all rows or (long records)
+  // the window with the most load-step energy.
+  const std::vector<int> coarse = StrongestTwo(cx, target);
+  const auto [w0, w1] = CoarseWindow(cx, coarse);
+  bool windowed = false;
   auto build = [&](double f, double z, const std::vector<int>& chans) {
-    std::vector<const double*> in;
-    std::vector<double*> out;
-    for (int c : chans) {
-      in.push_back(d.sim_mvv.col(c).data());
-      out.push_back(h.col(c).data());
-    }
-    SecondOrderLowPassColumns(d.t_s.data(), static_cast<std::size_t>(cx.n), f, z, in.data(),
-                              out.data(), in.size(), Restarts(cx));
-    for (int c : chans) h.col(c) -= d.sim_mvv.col(c);
+    RingingRows(cx, f, z, chans, windowed ? w0 : 0, windowed ? w1 - w0 : cx.n, &h);
   };
   int st = cx.search_stride;
   auto sse_for = [&](double f, double z, const std::vector<int>& chans, Mat* out, ChannelFit* cf) {
     if (f <= 0.05 || f >= 0.98 * nyq || z <= 1e-4 || z > 2.0)
       return std::numeric_limits<double>::infinity();
     build(f, z, chans);
+    if (windowed) return WindowSse(cx, target, h, chans, w0, w1);
     auto r = FitChannels(
         cx, target, 1, [&](int i, int c, double* x) { x[0] = h(i, c); }, out, &chans,
         out != nullptr || cf != nullptr ? 1 : st);
@@ -202,7 +242,6 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
     for (int c : chans) s += r.sse(c) * cx.weight(c);
     return s;
   };
-  const std::vector<int> coarse(order.begin(), order.begin() + std::min(2, cx.nc));
   const std::vector<int> all = AllChannels(cx);
   std::vector<double> fgrid = ResonanceGrid(cx);
   const double zgrid[] = {0.01, 0.03, 0.1, 0.3};
@@ -216,6 +255,7 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
     bs = sse_for(bf, bz, coarse, nullptr, nullptr);
     fgrid.clear();
   }
+  windowed = w1 - w0 < cx.n;  // the coarse grid and the first round
   for (double f : fgrid) {
     for (double z : zgrid) {
       const double s = sse_for(f, z, coarse, nullptr, nullptr);
@@ -227,13 +267,16 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
     }
   }
   if (!std::isfinite(bs)) return std::nullopt;
-  // Alternate golden refinements in log f and log ζ on all channels.
+  // Alternate golden refinements in log f and log ζ on the coarse channels (a refit starts near
+  // its optimum: only the finer second round).
   double lf = std::log(bf);
   double lz = std::log(bz);
-  // A refit starts near its optimum: only the finer second round.
   for (int round = warm ? 1 : 0; round < 2; ++round) {
     const std::vector<int>& chans = coarse;  // all channels only in the final fit
-    if (round == 1) st = std::max(1, st / 2);
+    if (round == 1) {
+      st = std::max(1, st / 2);
+      windowed = false;
+    }
     std::vector<double> g1;
     for (int j = -2; j <= 2; ++j) g1.push_back(lf + 0.04 * j / (round + 1));
     lf = MinimizeOnGrid(
