@@ -36,10 +36,49 @@ double WindowOrGrid(const std::function<double(double)>& f, double start,
   return MinimizeOnGrid(f, grid, 12, nullptr);
 }
 
+/// The standard's figures, channels and evidence of a finished creep fit (one or two τ).
+void FinishCreep(const Context& cx, const Mat& target, bool two, const std::vector<double>& tau,
+                 const std::vector<double>& tau_sigma, const ChannelFit& f, bool gamma,
+                 EffectFit* e) {
+  CreepOimlR60(cx, tau, tau_sigma, f, gamma, e);
+  e->channels = ActiveChannels(cx, e->pred);
+  const int c = DominantChannel(cx, e->pred);
+  if (two) {
+    const auto k = static_cast<std::size_t>(c);
+    e->evidence =
+        Fmt("during load holds b%d keeps moving toward a new value along two exponentials, τ1 = "
+            "%.1f s (%.2f %% of the load) and τ2 = %.1f s (%.2f %%), and recovers after "
+            "unloading, r = %.2f",
+            c, tau[0], 100.0 * e->params["fraction1"][k].get<double>(), tau[1],
+            100.0 * e->params["fraction2"][k].get<double>(), RowCorr(cx, target, e->pred, c));
+    return;
+  }
+  e->evidence =
+      Fmt("during load holds b%d keeps moving toward a new value with τ = %.1f s (%.2f %% of the "
+          "load) and recovers after unloading, r = %.2f",
+          c, e->params["tau_s"].get<double>(),
+          100.0 * e->params["fraction"][static_cast<std::size_t>(c)].get<double>(),
+          RowCorr(cx, target, e->pred, c));
+}
+
 /// FitCreep (near == nullptr) or RefitCreep: the one-τ search on the full log grid or in a window
 /// around near's τ, then the two-τ variant (full, from near's pair, or not when near is one-τ).
 std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const EffectFit* near,
                                      bool uncertainty) {
+  EffectFit best;
+  ChannelFit best_f;
+  bool best_gamma = false;
+  // A refit of a two-τ fit stays two-τ, from its pair (the one-τ baseline is not searched); the
+  // one-τ search below runs only when the pair now fails its own checks.
+  const double start[2] = {LogParam(near, "tau1_s"), LogParam(near, "tau2_s")};
+  const bool near_two = std::isfinite(start[0]) && std::isfinite(start[1]);
+  std::vector<double> taus;
+  std::vector<double> tau_sigmas;
+  if (near_two && FitCreepTwo(cx, target, start[0], std::numeric_limits<double>::infinity(), &best,
+                              &taus, &tau_sigmas, &best_f, &best_gamma, start, uncertainty)) {
+    FinishCreep(cx, target, true, taus, tau_sigmas, best_f, best_gamma, &best);
+    return best;
+  }
   const auto& d = *cx.data;
   const double duration = d.t_s.back() - d.t_s.front();
   Mat lp(cx.n, cx.nc);
@@ -73,9 +112,6 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const
   const double lo = std::log(std::max(3.0 * cx.dt, 0.2));
   const double hi = std::log(std::max(duration, 1.0));
   for (int j = 0; j <= 12; ++j) grid.push_back(lo + (hi - lo) * j / 12.0);
-  EffectFit best;
-  ChannelFit best_f;
-  bool best_gamma = false;
   double best_bic = std::numeric_limits<double>::infinity();
   // τ is searched with the plain model; the variant with a gain term reuses it. Near a fit: 5
   // points 0.25 apart in log τ around its τ (τ1 of a two-τ fit: the one-τ model is then only the
@@ -121,35 +157,13 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const
     best_gamma = gamma;
   }
   lp = Mat();  // the two-τ search filters into buffers of its own
-  std::vector<double> tau{std::exp(lt)};
-  std::vector<double> tau_sigma{best.sigma["tau_s"].is_number() ? best.sigma["tau_s"].get<double>()
-                                                                : 0.0};
-  // The two-τ variant: searched in full alone, from near's pair when near is two-τ, not tried
-  // when near is one-τ (a refit keeps the variant class its start found).
-  const double start[2] = {LogParam(near, "tau1_s"), LogParam(near, "tau2_s")};
-  const bool near_two = std::isfinite(start[0]) && std::isfinite(start[1]);
-  const bool two = (near == nullptr || near_two) &&
-                   FitCreepTwo(cx, target, lt, best_bic, &best, &tau, &tau_sigma, &best_f,
-                               &best_gamma, near_two ? start : nullptr, uncertainty);
-  CreepOimlR60(cx, tau, tau_sigma, best_f, best_gamma, &best);
-  best.channels = ActiveChannels(cx, best.pred);
-  const int c = DominantChannel(cx, best.pred);
-  if (two) {
-    const auto k = static_cast<std::size_t>(c);
-    best.evidence =
-        Fmt("during load holds b%d keeps moving toward a new value along two exponentials, τ1 = "
-            "%.1f s (%.2f %% of the load) and τ2 = %.1f s (%.2f %%), and recovers after "
-            "unloading, r = %.2f",
-            c, tau[0], 100.0 * best.params["fraction1"][k].get<double>(), tau[1],
-            100.0 * best.params["fraction2"][k].get<double>(), RowCorr(cx, target, best.pred, c));
-    return best;
-  }
-  best.evidence =
-      Fmt("during load holds b%d keeps moving toward a new value with τ = %.1f s (%.2f %% of the "
-          "load) and recovers after unloading, r = %.2f",
-          c, best.params["tau_s"].get<double>(),
-          100.0 * best.params["fraction"][static_cast<std::size_t>(c)].get<double>(),
-          RowCorr(cx, target, best.pred, c));
+  taus = {std::exp(lt)};
+  tau_sigmas = {best.sigma["tau_s"].is_number() ? best.sigma["tau_s"].get<double>() : 0.0};
+  // The two-τ variant: searched in full alone, not in a refit (a refit keeps the variant class its
+  // start found).
+  const bool two = near == nullptr && FitCreepTwo(cx, target, lt, best_bic, &best, &taus,
+                                                  &tau_sigmas, &best_f, &best_gamma, nullptr, true);
+  FinishCreep(cx, target, two, taus, tau_sigmas, best_f, best_gamma, &best);
   return best;
 }
 
