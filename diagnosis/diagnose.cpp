@@ -239,9 +239,10 @@ void Locate(Report& r) {
   LocateLoadRegion(r);
 }
 
-/// A time-based partner of a load effect that one offset per load hold explains as well (a misfit
-/// of the first effect's shape left from hold to hold, which a time curve follows) is not
-/// claimed: the data cannot tell it from the first effect's remainder. Returns the partner's
+/// A time-based partner of a load effect that one offset per load hold or a smooth (quadratic)
+/// function of the load explains as well (a misfit of the first effect's shape left as a function
+/// of the load, which a time curve follows) is not claimed: the data cannot tell it from the first
+/// effect's remainder. Returns the partner's
 /// confounding when it stays (empty otherwise).
 std::vector<Confounding> DropUnidentifiedPartner(const Context& cx, double z_claim,
                                                  std::vector<EffectFit>* claimed,
@@ -251,7 +252,8 @@ std::vector<Confounding> DropUnidentifiedPartner(const Context& cx, double z_cla
   const Mat rest = cx.resid - (*claimed)[0].pred;
   partner_conf.push_back(CheckConfounders(cx, rest, (*claimed)[1], z_claim));
   const auto& with = partner_conf.back().with;
-  if (std::find(with.begin(), with.end(), "hold_offsets") != with.end()) {
+  if (std::find(with.begin(), with.end(), "hold_offsets") != with.end() ||
+      std::find(with.begin(), with.end(), "load_polynomial") != with.end()) {
     dropped->push_back((*claimed)[1].name + ": " + partner_conf.back().words);
     claimed->pop_back();
     partner_conf.clear();

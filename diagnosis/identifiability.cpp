@@ -7,6 +7,8 @@
 #include <functional>
 #include <map>
 
+#include "diagnosis/signal.hpp"
+
 namespace ftstack::diag {
 namespace {
 
@@ -28,6 +30,43 @@ Mat GroupOffsets(const Context& cx, const Mat& target, const std::vector<int>& g
     const int g = group[static_cast<std::size_t>(i)];
     const double k = count[static_cast<std::size_t>(g)];
     pred.row(i) = k > 0 ? Eigen::RowVectorXd(sum.row(g) / k) : Eigen::RowVectorXd::Zero(cx.nc);
+  }
+  return pred;
+}
+
+/// Number of terms of LoadPolynomial: 1, the 6 wrench components, their 21 products (the
+/// report's words say 28).
+constexpr int kLoadTerms = 28;
+
+/// Per channel, target ≈ a quadratic polynomial of the reference wrench (each component scaled by
+/// its peak), fitted on the training rows: a smooth function of the load, ramps included.
+Mat LoadPolynomial(const Context& cx, const Mat& target) {
+  const auto& w = cx.data->wrench;
+  Eigen::Matrix<double, 6, 1> scale;
+  for (int k = 0; k < 6; ++k) scale(k) = std::max(w.col(k).cwiseAbs().maxCoeff(), 1e-300);
+  auto terms = [&](int i, double* x) {
+    int j = 0;
+    x[j++] = 1.0;
+    double u[6];
+    for (int k = 0; k < 6; ++k) x[j++] = u[k] = w(i, k) / scale(k);
+    for (int k = 0; k < 6; ++k) {
+      for (int l = k; l < 6; ++l) x[j++] = u[k] * u[l];
+    }
+  };
+  Mat pred(cx.n, cx.nc);
+  double x[kLoadTerms];
+  for (int c = 0; c < cx.nc; ++c) {
+    NormalEq ne(kLoadTerms);
+    for (int i = 0; i < cx.n; i += cx.search_stride) {
+      if (!cx.train[static_cast<std::size_t>(i)]) continue;
+      terms(i, x);
+      ne.Add(x, target(i, c));
+    }
+    const Eigen::VectorXd beta = ne.Solve().beta;
+    for (int i = 0; i < cx.n; ++i) {
+      terms(i, x);
+      pred(i, c) = Eigen::Map<const Eigen::VectorXd>(x, kLoadTerms).dot(beta);
+    }
   }
   return pred;
 }
@@ -63,6 +102,26 @@ std::string Fmt(const char* f, double a, double b) {
   char buf[256];
   std::snprintf(buf, sizeof buf, f, a, b);
   return buf;
+}
+
+/// What a confounder is, in words ("… explains it as well" follows).
+std::string ConfounderWords(const std::string& what, int groups) {
+  if (what == "segment_offsets")
+    return Fmt("one offset per joined recording (%.0f segments)", groups, 0);
+  if (what == "load_function")
+    return Fmt("one offset per distinct static load (%.0f loads)", groups, 0);
+  if (what == "load_polynomial") {
+    return Fmt("a quadratic function of the reference wrench per channel (%.0f terms)", groups, 0);
+  }
+  return Fmt("one offset per load hold (%.0f holds: a function of the load's history)", groups, 0);
+}
+
+/// The rest of a confounding sentence: the effect's held-out improvement beyond the confounder.
+std::string BeyondWords(double z_rest, double z_alone) {
+  return Fmt(
+      " explains it as well: beyond that, the effect improves the held-out rows by z = %.1f "
+      "only (alone z = %.1f)",
+      z_rest, z_alone);
 }
 
 }  // namespace
@@ -227,19 +286,16 @@ Confounding CheckConfounders(const Context& cx, const Mat& target, const EffectF
     }
     if (identified) continue;
     out.with.push_back(name);
-    const std::string what = name;
-    words.push_back(
-        (what == "segment_offsets"
-             ? Fmt("one offset per joined recording (%.0f segments)", groups, 0)
-         : what == "load_function"
-             ? Fmt("one offset per distinct static load (%.0f loads)", groups, 0)
-             : Fmt("one offset per load hold (%.0f holds: a function of the load's history)",
-                   groups, 0)) +
-        Fmt(" explains it as well: beyond that, the effect improves the held-out rows "
-            "by z = %.1f only (alone z = %.1f)",
-            z_rest, z_alone));
+    words.push_back(ConfounderWords(name, groups) + BeyondWords(z_rest, z_alone));
   }
   const DiagData& d = *cx.data;
+  // A smooth function of the load, ramps included (where holds are short or absent).
+  double z_poly = 0.0;
+  if (d.has_wrench() && !history && cx.n > 20 * kLoadTerms &&
+      !beyond([&](const Mat& y) { return LoadPolynomial(cx, y); }, kLoadTerms * cx.nc, &z_poly)) {
+    out.with.push_back("load_polynomial");
+    words.push_back(ConfounderWords("load_polynomial", kLoadTerms) + BeyondWords(z_poly, z_alone));
+  }
   if (fit.name.rfind("thermal", 0) == 0 && d.has_temp()) {
     const double rho = SpearmanWithTime(d.temp_c);
     const EffectSpec* drift = FindEffect("zero_drift");

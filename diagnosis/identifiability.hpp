@@ -11,9 +11,9 @@ namespace ftstack::diag {
 
 /// What a claimed effect could not be told apart from.
 struct Confounding {
-  std::vector<std::string>
-      with;           ///< "segment_offsets", "load_function", "hold_offsets", "zero_drift"
-  std::string words;  ///< one sentence for a person
+  std::vector<std::string> with;  ///< "segment_offsets", "load_function", "hold_offsets",
+                                  ///< "load_polynomial", "zero_drift"
+  std::string words;              ///< one sentence for a person
 };
 
 /// True for the effects whose shape is a function of time (zero_drift, excitation_drift,
@@ -31,6 +31,8 @@ struct Confounding {
 ///    0.5 % of each axis's range; only where loads are held, ≤ rows/20 distinct loads);
 ///  - hold_offsets: one offset per channel and load hold (a run of ≥ 0.25 s at one load, with the
 ///    movement into it): any function of the load's history (a hysteresis or creep misfit);
+///  - load_polynomial: a quadratic polynomial of the reference wrench per channel (28 terms): a
+///    smooth function of the load, ramps included (not for hysteresis);
 ///  - zero_drift, for thermal effects when the temperature is monotone in time (|Spearman ρ| >
 ///    0.95).
 [[nodiscard]] Confounding CheckConfounders(const Context& cx, const Eigen::MatrixXd& target,
