@@ -3,9 +3,11 @@
 
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "bench/diag_jitter_data.hpp"
 #include "diagnosis/diagnose.hpp"
+#include "diagnosis/signal.hpp"
 #include "sim/record.hpp"
 
 namespace {
@@ -82,6 +84,59 @@ BENCHMARK(BM_DiagnoseClock)
     ->MeasureProcessCPUTime()
     ->UseRealTime()
     ->Name("BM_DiagnoseClock1M");
+
+// The low-pass filters alone on 10^6 rows × 8 columns of the clock benchmark's data: first order
+// (τ = 1 s) and second order (10 Hz, ζ = 0.3), uniform against ±30 % jittered timestamps, so
+// the cost of a jittered clock (per-row step coefficients) reads side by side with a uniform one.
+const diag::DiagData& ClockData(bool jitter) {
+  if (jitter) {
+    static const diag::DiagData jittered = bench::MakeJitterData(1000000, true);
+    return jittered;
+  }
+  static const diag::DiagData uniform = bench::MakeJitterData(1000000, false);
+  return uniform;
+}
+
+void RunLowPass(benchmark::State& state, int order, bool jitter, double zeta) {
+  const diag::DiagData& data = ClockData(jitter);
+  const auto rows = static_cast<std::size_t>(data.rows());
+  Eigen::MatrixXd out(data.real_mvv.rows(), data.real_mvv.cols());
+  std::vector<const double*> in;
+  std::vector<double*> o;
+  for (Eigen::Index c = 0; c < data.real_mvv.cols(); ++c) {
+    in.push_back(data.real_mvv.col(c).data());
+    o.push_back(out.col(c).data());
+  }
+  for (auto _ : state) {
+    if (order == 1) {
+      diag::FirstOrderLowPassColumns(data.t_s.data(), rows, 1.0, in.data(), o.data(), in.size());
+    } else {
+      diag::SecondOrderLowPassColumns(data.t_s.data(), rows, 10.0, zeta, in.data(), o.data(),
+                                      in.size());
+    }
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["rows"] = static_cast<double>(rows);
+  state.SetLabel(jitter ? "jittered" : "uniform");
+}
+
+// BM_LowPassClock/<order>/<jitter>: order 1 or 2 (underdamped), jitter 0 (uniform) or 1 (±30 %).
+void BM_LowPassClock(benchmark::State& state) {
+  RunLowPass(state, static_cast<int>(state.range(0)), state.range(1) != 0, 0.3);
+}
+BENCHMARK(BM_LowPassClock)
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->Args({2, 0})
+    ->Args({2, 1})
+    ->Unit(benchmark::kMillisecond);
+
+// The same for an overdamped second order (ζ = 1.5; the diagnosis searches ζ up to 2).
+void BM_LowPassClockOverdamped(benchmark::State& state) {
+  RunLowPass(state, 2, state.range(0) != 0, 1.5);
+}
+BENCHMARK(BM_LowPassClockOverdamped)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
