@@ -13,7 +13,7 @@
 /// loader picks one (function multiversioning): AVX2 doubles the width of the coefficient loops.
 /// "avx2" does not include FMA, so both versions round alike and give bit-identical results.
 /// (Clang does not combine target_clones with the filters' flatten attribute.)
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#if __x86_64__ && __GNUC__ && !__clang__  // (undefined macros are 0 in #if)
 #define FTSTACK_LOWPASS_TARGETS [[gnu::target_clones("avx2", "default")]]
 #else
 #define FTSTACK_LOWPASS_TARGETS

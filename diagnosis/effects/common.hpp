@@ -165,6 +165,9 @@ std::optional<EffectFit> FitZeroDrift(const Context& cx, const Mat& target);
 std::optional<EffectFit> FitThermalZeroPlain(const Context& cx, const Mat& target);
 std::optional<EffectFit> FitThermalSpan(const Context& cx, const Mat& target);
 std::optional<EffectFit> FitExcitation(const Context& cx, const Mat& target);
+/// excitation_drift refitted near an earlier fit (RefitFn): near's knot count and its neighbours.
+std::optional<EffectFit> RefitExcitation(const Context& cx, const Mat& target,
+                                         const EffectFit& near, bool uncertainty);
 std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target);
 /// creep with two time constants τ1 < τ2 (effects/creep_family.cpp): τ2 searched with τ1 at the
 /// one-τ optimum `log_tau1`, then τ1 and τ2 refined in turn; replaces *best (and fills tau,

@@ -18,7 +18,7 @@ const std::vector<EffectSpec>& Effects() {
       {"zero_drift", &FitZeroDrift},
       {"thermal_zero_drift", &FitThermalZeroPlain},
       {"thermal_span_drift", &FitThermalSpan},
-      {"excitation_drift", &FitExcitation, nullptr, 2},
+      {"excitation_drift", &FitExcitation, &RefitExcitation, 2},
       {"creep", &FitCreep, &RefitCreep, 4},
       {"hysteresis", &FitHysteresisFamily, &RefitHysteresis, 2},
       {"bridge_nonlinearity", &FitBridgeNonlinearity},
