@@ -127,6 +127,12 @@ if [ -x "$B/bench_diag" ]; then
         printf "  %-34s %8.0f ms wall %8.0f ms CPU (process, all threads)\n", $1, $3, $4 }
       END { a=t["BM_Diagnose60k/iterations:3"]; b=t["BM_Diagnose60kNone/iterations:3"];
             if (a > 0 && b > 0) printf "  concealed creep (pairs tried) / noise only = %.2f\n", a / b }'
+  section "exact low passes on 1e6 rows x 8 columns, uniform vs +-30 % jittered clock, same run (ms per pass)"
+  "$B/bench_diag" --benchmark_format=csv --benchmark_filter='BM_LowPassClock' 2>/dev/null |
+    awk -F, 'NR>1 && $1 ~ /BM_/ { gsub(/"/,"",$1); t[$1]=$3; printf "  %-34s %8.1f ms\n", $1, $3 }
+      END { if (t["BM_LowPassClock/1/0"] > 0) printf "  jittered / uniform: first order %.2f, second order %.2f, overdamped %.2f\n",
+              t["BM_LowPassClock/1/1"] / t["BM_LowPassClock/1/0"], t["BM_LowPassClock/2/1"] / t["BM_LowPassClock/2/0"],
+              t["BM_LowPassClockOverdamped/1"] / t["BM_LowPassClockOverdamped/0"] }'
   section "ftdiag diagnose, 8 channels, uniform vs +-30 % jittered clock, same run (issue 12: 1e5 rows <= 3 s, 1e6 rows <= 20 s and < 500 MB)"
   /usr/bin/time -f "%M" -o "$B/diag_clock_rss" "$B/bench_diag" --benchmark_format=csv \
       --benchmark_filter='BM_DiagnoseClock' 2>/dev/null |
