@@ -12,8 +12,10 @@
 /// With GCC on x86-64 the filters are compiled twice, for the baseline (SSE2) and for AVX2, and the
 /// loader picks one (function multiversioning): AVX2 doubles the width of the coefficient loops.
 /// "avx2" does not include FMA, so both versions round alike and give bit-identical results.
-/// (Clang does not combine target_clones with the filters' flatten attribute.)
-#if __x86_64__ && __GNUC__ && !__clang__  // (undefined macros are 0 in #if)
+/// (Clang does not combine target_clones with the filters' flatten attribute. Not under
+/// ThreadSanitizer: its runtime is not ready when the loader runs the ifunc resolvers, and the
+/// instrumented resolver crashes at start-up.)
+#if __x86_64__ && __GNUC__ && !__clang__ && !__SANITIZE_THREAD__  // undefined macros are 0
 #define FTSTACK_LOWPASS_TARGETS [[gnu::target_clones("avx2", "default")]]
 #else
 #define FTSTACK_LOWPASS_TARGETS
