@@ -178,6 +178,12 @@ void LocateLoadRegion(Report& r) {
   }
 }
 
+/// Rows per location block (block_s of rows) and the number of blocks.
+std::pair<int, int> LocateBlocks(const Context& cx) {
+  const auto m = static_cast<int>(std::llround(cx.block_s * cx.rate_hz));
+  return {m, std::max(1, cx.n / std::max(1, m))};
+}
+
 /// One-sided normal quantile: z with P(Z > z) = p (bisection on erfc; 0 < p < 0.5).
 double UpperZ(double p) {
   double lo = 0.0;
@@ -221,8 +227,7 @@ void LocateByModel(Report& r) {
   }
   if (!grew) return;
   std::sort(r.mismatch_channels.begin(), r.mismatch_channels.end());
-  const auto m = static_cast<int>(std::llround(cx.block_s * cx.rate_hz));
-  const int blocks = std::max(1, cx.n / std::max(1, m));
+  const auto [m, blocks] = LocateBlocks(cx);
   r.windows.clear();
   r.load_region = nlohmann::json();
   LocateWindows(r, m, blocks);
@@ -230,9 +235,7 @@ void LocateByModel(Report& r) {
 }
 
 void Locate(Report& r) {
-  const Context& cx = r.cx;
-  const auto m = static_cast<int>(std::llround(cx.block_s * cx.rate_hz));
-  const int blocks = std::max(1, cx.n / std::max(1, m));
+  const auto [m, blocks] = LocateBlocks(r.cx);
   LocateChannels(r, m, blocks);
   if (r.mismatch_channels.empty()) return;
   LocateWindows(r, m, blocks);

@@ -229,9 +229,11 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
     RingingRows(cx, f, z, chans, windowed ? w0 : 0, windowed ? w1 - w0 : cx.n, &h);
   };
   int st = cx.search_stride;
+  const auto in_range = [&](double f, double z) {
+    return f > 0.05 && f < 0.98 * nyq && z > 1e-4 && z <= 2.0;
+  };
   auto sse_for = [&](double f, double z, const std::vector<int>& chans, Mat* out, ChannelFit* cf) {
-    if (f <= 0.05 || f >= 0.98 * nyq || z <= 1e-4 || z > 2.0)
-      return std::numeric_limits<double>::infinity();
+    if (!in_range(f, z)) return std::numeric_limits<double>::infinity();
     build(f, z, chans);
     if (windowed) return WindowSse(cx, target, h, chans, w0, w1);
     auto r = FitChannels(
@@ -252,7 +254,7 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
   if (warm) {
     bf = std::exp(near->search_state[0]);
     bz = std::exp(near->search_state[1]);
-    bs = sse_for(bf, bz, coarse, nullptr, nullptr);
+    if (in_range(bf, bz)) bs = 0.0;  // only its finiteness is used below: no filter pass needed
     fgrid.clear();
   }
   windowed = w1 - w0 < cx.n;  // the coarse grid and the first round
