@@ -163,6 +163,16 @@ DiagData FromRecordings(const Recording& sim, const Recording& real) {
   return d;
 }
 
+namespace {
+
+/// Frees the bridge columns of `rec` once they are copied (memory: 8 bytes × rows each).
+void ReleaseBridges(Recording* rec, std::size_t n) {
+  for (std::size_t c = 0; c < n; ++c)
+    std::vector<double>().swap(rec->Column("b" + std::to_string(c)));
+}
+
+}  // namespace
+
 DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path, ProgressFn progress,
                      void* user) {
   ProgressRelay r1{progress, user, 0.0, 0.5, "reading sim"};
@@ -170,10 +180,36 @@ DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path, 
   try {
     std::string sim_unit;
     std::string real_unit;
-    const Recording sim = Read(sim_path, &r1, &sim_unit, false);
-    const Recording real = Read(real_path, &r2, &real_unit, true);
-    DiagData d = FromRecordings(sim, real);
+    // Memory: the sim's bridges are copied and released before the real file is read, and the
+    // real's once copied; the peak is about one recording plus the diagnosis data.
+    Recording sim = Read(sim_path, &r1, &sim_unit, false);
+    const std::size_t ns = sim.BridgeCount();
+    Eigen::MatrixXd sim_mvv = Bridges(sim, ns);
+    ReleaseBridges(&sim, ns);
+    std::vector<std::size_t>().swap(sim.data_lines);
+    Recording real = Read(real_path, &r2, &real_unit, true);
+    const std::size_t nr = real.BridgeCount();
+    if (nr == 0) throw DiagInputError(real.path + ": no bridge columns b0…");
+    if (ns != nr) {
+      throw DiagInputError(sim.path + ": has " + std::to_string(ns) + " bridge columns but " +
+                           real.path + " has " + std::to_string(nr));
+    }
+    CheckAligned(sim, real);
+    DiagData d;
+    d.sim_name = sim.path;
+    d.real_name = real.path;
     d.real_unit = real_unit;
+    d.sim_mvv = std::move(sim_mvv);
+    d.real_mvv = Bridges(real, nr);
+    ReleaseBridges(&real, nr);
+    d.wrench = HasWrench(real)  ? WrenchOf(real)
+               : HasWrench(sim) ? WrenchOf(sim)
+                                : Eigen::MatrixXd();
+    sim = Recording();
+    if (real.Has("temp_C")) d.temp_c = std::move(real.Column("temp_C"));
+    d.segment = FindSegments(real);
+    d.t_s = std::move(real.Column("t"));
+    CheckUsable(d);
     return d;
   } catch (const RecordingError& e) {
     throw DiagInputError(e.what());

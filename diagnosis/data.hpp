@@ -35,9 +35,15 @@ struct DiagData {
   /// periods. Empty: one recording.
   std::vector<int> segment;
   std::string real_unit = "mV/V";  ///< the real file's declared bridge unit (converted to mV/V)
+  /// Bridges whose sim_mvv and real_mvv became a context's load and residual
+  /// (MakeContext(DiagData*), which leaves both matrices empty to save their memory); 0 while they
+  /// are held here.
+  int released_channels = 0;
 
   [[nodiscard]] std::size_t rows() const { return t_s.size(); }
-  [[nodiscard]] int channels() const { return static_cast<int>(real_mvv.cols()); }
+  [[nodiscard]] int channels() const {
+    return real_mvv.cols() > 0 ? static_cast<int>(real_mvv.cols()) : released_channels;
+  }
   [[nodiscard]] bool has_wrench() const { return wrench.cols() == 6; }
   [[nodiscard]] bool has_temp() const { return !temp_c.empty(); }
   /// Median sample rate, Hz.

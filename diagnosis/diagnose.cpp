@@ -349,33 +349,49 @@ void RecordClaims(Report& r, const DiagnoseOptions& options, std::vector<EffectF
 
 }  // namespace
 
-Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
-                    const Eigen::VectorXd* sigma);
+/// One pass on a context made already (the noise is the context's).
+Report DiagnoseWith(Context cx, const DiagnoseOptions& options);
+
+namespace {
+
+/// A strong broadband effect (skew on fast edges, ringing) lifts the spectrum's median and so the
+/// first noise estimate; when the claimed model reveals a clearly lower noise, diagnose again
+/// with it (on the same context, its noise replaced) so that weaker effects are weighed against
+/// the true noise.
+Report WithRefinedNoise(Report r, const DiagnoseOptions& options) {
+  if (r.effects.empty()) return r;
+  bool lower = false;
+  for (int c = 0; c < r.noise_rms.size(); ++c)
+    lower = lower || r.noise_rms(c) < 0.8 * r.cx.sigma(c);
+  if (!lower) return r;
+  const Eigen::VectorXd sigma = r.noise_rms;
+  Context cx = std::move(r.cx);
+  r = Report();  // release the first pass (its model) before the second
+  SetNoise(&cx, sigma);
+  return DiagnoseWith(std::move(cx), options);
+}
+
+}  // namespace
 
 Report Diagnose(const DiagData& data, const DiagnoseOptions& options) {
-  Report r = DiagnoseOnce(data, options, nullptr);
-  // A strong broadband effect (skew on fast edges, ringing) lifts the spectrum's median and so the
-  // first noise estimate; when the claimed model reveals a clearly lower noise, diagnose again
-  // with it so that weaker effects are weighed against the true noise.
-  if (!r.effects.empty()) {
-    bool lower = false;
-    for (int c = 0; c < r.noise_rms.size(); ++c)
-      lower = lower || r.noise_rms(c) < 0.8 * r.cx.sigma(c);
-    if (lower) {
-      const Eigen::VectorXd sigma = r.noise_rms;
-      r = Report();  // release the first pass (its context and model) before the second
-      r = DiagnoseOnce(data, options, &sigma);
-    }
-  }
-  return r;
+  Progress(options, 0.0, "noise and hold-out split");
+  return WithRefinedNoise(DiagnoseWith(MakeContext(data, options.block_s), options), options);
+}
+
+Report Diagnose(DiagData* data, const DiagnoseOptions& options) {
+  Progress(options, 0.0, "noise and hold-out split");
+  return WithRefinedNoise(DiagnoseWith(MakeContext(data, options.block_s), options), options);
 }
 
 Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
                     const Eigen::VectorXd* sigma) {
+  return DiagnoseWith(MakeContext(data, options.block_s, sigma), options);
+}
+
+Report DiagnoseWith(Context context, const DiagnoseOptions& options) {
   Report r;
-  Progress(options, 0.0, "noise and hold-out split");
   auto t0 = std::chrono::steady_clock::now();
-  r.cx = MakeContext(data, options.block_s, sigma);
+  r.cx = std::move(context);
   DebugTime("context", "", t0);
   const Context& cx = r.cx;
   r.rate_hz = cx.rate_hz;

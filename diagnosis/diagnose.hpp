@@ -69,6 +69,9 @@ struct Report {
 
 /// Runs the whole diagnosis on aligned data. `data` must outlive the report.
 [[nodiscard]] Report Diagnose(const DiagData& data, const DiagnoseOptions& options = {});
+/// The same, taking the memory of data->sim_mvv and data->real_mvv (left empty) for the context's
+/// load and residual: two n × N matrices fewer (MakeContext(DiagData*)). The result is the same.
+[[nodiscard]] Report Diagnose(DiagData* data, const DiagnoseOptions& options = {});
 /// One pass with the given noise per channel (nullptr: the robust estimate). Diagnose() runs it
 /// once more with the refined noise when the claimed model shows the first estimate too high.
 [[nodiscard]] Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,

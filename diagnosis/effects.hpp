@@ -40,12 +40,22 @@ struct Context {
   int segments = 1;             ///< number of joined recordings
   std::vector<double> peak_hz;  ///< prominent lines of the residual spectrum, strongest first
   std::vector<double> peak_ratio;
+
+  /// The sim's output of row i, channel c, mV/V (load + zero: the data's sim_mvv may be released).
+  [[nodiscard]] double sim_mvv(int i, int c) const { return load(i, c) + zero(c); }
 };
 
 /// Builds the context: residual, noise, hold-out blocks (every third block of ~block_s).
 /// `sigma` (one per channel), when given, replaces the robust noise estimate.
 [[nodiscard]] Context MakeContext(const DiagData& d, double block_s = 0.5,
                                   const Eigen::VectorXd* sigma = nullptr);
+/// The same, taking the memory of d->real_mvv and d->sim_mvv for the residual and the load (both
+/// are left empty; d->released_channels keeps their width). Memory: two n × N matrices fewer.
+[[nodiscard]] Context MakeContext(DiagData* d, double block_s = 0.5,
+                                  const Eigen::VectorXd* sigma = nullptr);
+/// Replaces the context's noise per channel (and what depends on it: weights, spectral lines);
+/// the same as MakeContext with `sigma`, without the data's bridge matrices.
+void SetNoise(Context* cx, const Eigen::VectorXd& sigma);
 
 /// A fitted effect: its prediction of the residual and what to report.
 struct EffectFit {

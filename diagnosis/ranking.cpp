@@ -1,11 +1,10 @@
 #include "diagnosis/ranking.hpp"
 
-#include <sys/resource.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -36,16 +35,25 @@ Scored ScoreFit(const Context& cx, const Mat& target, EffectFit fit, double base
   return s;
 }
 
-/// Backfits two effects, twice: B on target − A (A first fitted alone), then A on target − B.
-/// Every fit starts from the effect's previous one (FitNear; B's first from b_near, its fit to
-/// what A0 leaves). The first pass's fits skip the parameters' uncertainties: only the second
-/// pass's fits are kept (and reported).
+/// target − the start's prediction (held in double or single precision).
+Mat Remainder(const Mat& target, const Scored& start) {
+  if (start.fit.pred.size() > 0) return target - start.fit.pred;
+  return target - start.pred_f.cast<double>();
+}
+
+/// Backfits two effects, twice: B on target − A (A first fitted alone: a0, with a0_rest = target −
+/// its prediction), then A on target − B. Every fit starts from the effect's previous one
+/// (FitNear; B's first from b_near, its fit to what A0 leaves). The first pass's fits skip the
+/// parameters' uncertainties: only the second pass's fits are kept (and reported).
 bool FitPair(const Context& cx, const Mat& target, const EffectSpec& a, const EffectSpec& b,
-             const EffectFit& a0, const EffectFit* b_near, EffectFit* fa, EffectFit* fb) {
+             const EffectFit& a0, Mat a0_rest, const EffectFit* b_near, EffectFit* fa,
+             EffectFit* fb) {
   const EffectFit* first = &a0;
   for (int it = 0; it < 2; ++it) {
     fb->pred = Mat();  // memory: the previous B is replaced; only `first` is used now
-    auto nb = FitNear(b, cx, target - first->pred, it == 0 ? b_near : fb, it == 1);
+    auto nb = it == 0 ? FitNear(b, cx, a0_rest, b_near, false)
+                      : FitNear(b, cx, target - first->pred, fb, true);
+    a0_rest = Mat();
     if (!nb) return false;
     *fb = std::move(*nb);
     if (first == fa) fa->pred = Mat();  // the previous A is replaced below
@@ -71,13 +79,14 @@ std::vector<std::size_t> CostOrder(const std::vector<EffectSpec>& effects) {
 void KeepBestPredictions(std::vector<std::optional<Scored>>* all, std::size_t keep) {
   std::vector<Scored*> kept;
   for (auto& q : *all) {
-    if (q && q->eligible && q->fit.pred.size() > 0) kept.push_back(&*q);
+    if (q && q->eligible && q->HasPrediction()) kept.push_back(&*q);
   }
   while (kept.size() > keep) {
     auto lowest = std::min_element(kept.begin(), kept.end(), [](const Scored* u, const Scored* v) {
       return u->score < v->score;
     });
     (*lowest)->fit.pred = Mat();
+    (*lowest)->pred_f = Eigen::MatrixXf();
     kept.erase(lowest);
   }
 }
@@ -104,40 +113,45 @@ std::vector<std::vector<Partner>> FitPartners(const Context& cx, const DiagnoseO
                                               const std::vector<Scored>& singles,
                                               const std::vector<std::size_t>& top) {
   const auto& effects = Effects();
-  std::vector<std::pair<std::size_t, std::size_t>> todo;  // (start t, effect j)
+  std::vector<std::vector<std::size_t>> todo(top.size());  // per start: effects j
+  std::size_t total = 0;
   for (std::size_t j : CostOrder(effects)) {
     // Partners come from the effects that were claimable on their own.
     const bool claimable = std::any_of(singles.begin(), singles.end(), [&](const Scored& q) {
       return q.eligible && q.fit.name == effects[j].name;
     });
     for (std::size_t t = 0; t < top.size(); ++t) {
-      if (claimable && singles[top[t]].fit.name != effects[j].name) todo.emplace_back(t, j);
+      if (claimable && singles[top[t]].fit.name != effects[j].name) {
+        todo[t].push_back(j);
+        ++total;
+      }
     }
   }
   std::vector<std::vector<Partner>> partners(top.size());
   std::mutex mu;
   std::size_t done = 0;
-  ParallelFor(todo.size(), ResolveThreads(options.threads), [&](std::size_t k) {
-    const auto [t, j] = todo[k];
+  // One start at a time, its partners in parallel on one shared remainder (memory: one n × N
+  // remainder, not one per running fit).
+  for (std::size_t t = 0; t < top.size(); ++t) {
     const Scored& first = singles[top[t]];
-    const EffectSpec& spec = effects[j];
-    const auto t0 = std::chrono::steady_clock::now();
-    // One n × N remainder per running task, not one per start kept through the batch (memory
-    // over a subtraction: at 10^6 × 8 rows it is ≈ 15 ms of a fit's seconds).
-    const Mat rest = cx.resid - first.fit.pred;
-    auto fb = FitNear(spec, cx, rest, SingleOf(singles, spec.name), false);
-    DebugTime("partner", spec.name, t0);
-    std::optional<Scored> sb;
-    // first.hold_sse is the held-out SSE of rest: the baseline the partner is scored against.
-    if (fb) sb = ScoreFit(cx, rest, std::move(*fb), first.hold_sse, options.z_claim);
-    const std::lock_guard<std::mutex> lock(mu);
-    if (sb && sb->eligible) {
-      sb->fit.pred = Mat();
-      partners[t].push_back({{sb->score, spec.name}, std::move(sb->fit)});
-    }
-    Progress(options, 0.65 + 0.2 * static_cast<double>(++done) / static_cast<double>(todo.size()),
-             "pairs: partners");
-  });
+    const Mat rest = Remainder(cx.resid, first);
+    ParallelFor(todo[t].size(), ResolveThreads(options.threads), [&](std::size_t k) {
+      const EffectSpec& spec = effects[todo[t][k]];
+      const auto t0 = std::chrono::steady_clock::now();
+      auto fb = FitNear(spec, cx, rest, SingleOf(singles, spec.name), false);
+      DebugTime("partner", spec.name, t0);
+      std::optional<Scored> sb;
+      // first.hold_sse is the held-out SSE of rest: the baseline the partner is scored against.
+      if (fb) sb = ScoreFit(cx, rest, std::move(*fb), first.hold_sse, options.z_claim);
+      const std::lock_guard<std::mutex> lock(mu);
+      if (sb && sb->eligible) {
+        sb->fit.pred = Mat();
+        partners[t].push_back({{sb->score, spec.name}, std::move(sb->fit)});
+      }
+      Progress(options, 0.65 + 0.2 * static_cast<double>(++done) / static_cast<double>(total),
+               "pairs: partners");
+    });
+  }
   for (auto& list : partners) {
     std::sort(list.begin(), list.end(),
               [](const Partner& u, const Partner& v) { return u.key > v.key; });
@@ -162,7 +176,8 @@ std::optional<PairResult> TryPair(const Context& cx, const DiagnoseOptions& opti
   const EffectSpec* sb = FindEffect(partner->key.second);
   PairResult p;
   const auto t0 = std::chrono::steady_clock::now();
-  const bool ok = FitPair(cx, cx.resid, *sa, *sb, first.fit, &partner->fit, &p.fa, &p.fb);
+  const bool ok = FitPair(cx, cx.resid, *sa, *sb, first.fit, Remainder(cx.resid, first),
+                          &partner->fit, &p.fa, &p.fb);
   DebugTime("backfit", (std::string(sa->name) + "+" + sb->name).c_str(), t0);
   if (!ok) return std::nullopt;
   const Sums s = ScoreSum(cx, cx.resid, p.fa.pred, p.fb.pred);
@@ -173,7 +188,7 @@ std::optional<PairResult> TryPair(const Context& cx, const DiagnoseOptions& opti
   for (int c = 0; c < cx.nc; ++c) {
     for (int i = 0; i < cx.n; ++i) {
       if (cx.train[static_cast<std::size_t>(i)]) continue;
-      const double diff = (p.fa.pred(i, c) + p.fb.pred(i, c)) - first.fit.pred(i, c);
+      const double diff = (p.fa.pred(i, c) + p.fb.pred(i, c)) - first.Prediction(i, c);
       dd += diff * diff * cx.weight(c);
     }
   }
@@ -210,13 +225,37 @@ bool DebugOn() {
   return on;
 }
 
+namespace {
+
+/// kB of a line "Key:   N kB" of /proc/self/status (0 when absent).
+long StatusKb(const char* key) {
+  long kb = 0;
+  if (std::FILE* f = std::fopen("/proc/self/status", "r")) {
+    char line[256];
+    const std::size_t len = std::strlen(key);
+    while (std::fgets(line, sizeof line, f) != nullptr) {
+      if (std::strncmp(line, key, len) == 0) kb = std::atol(line + len);
+    }
+    std::fclose(f);
+  }
+  return kb;
+}
+
+}  // namespace
+
 void DebugTime(const char* stage, const char* what, std::chrono::steady_clock::time_point t0) {
   if (!DebugOn()) return;
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  std::fprintf(stderr, "time %-8s %-40s %7.3f s (peak RSS so far %ld MB)\n", stage, what, s,
-               u.ru_maxrss / 1024);
+  // Resident now, and the peak since the previous line (the high-water mark is reset after
+  // reading it; with --threads 1 it is the peak of this one fit).
+  const long now_kb = StatusKb("VmRSS:");
+  const long hwm_kb = StatusKb("VmHWM:");
+  if (std::FILE* f = std::fopen("/proc/self/clear_refs", "w")) {
+    std::fputs("5", f);
+    std::fclose(f);
+  }
+  std::fprintf(stderr, "time %-8s %-40s %7.3f s (RSS %ld MB, peak since last %ld MB)\n", stage,
+               what, s, now_kb / 1024, hwm_kb / 1024);
 }
 
 void Progress(const DiagnoseOptions& o, double f, const char* what) {
@@ -258,6 +297,15 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
   }
   std::sort(singles.begin(), singles.end(),
             [](const Scored& a, const Scored& b) { return a.score > b.score; });
+  // Memory: the best single (it may be claimed alone) keeps its prediction in double precision;
+  // the other pair starts hold theirs in single precision (6e-8 relative, far below the noise of
+  // any recording: they only start a pair's backfit).
+  for (std::size_t j = 1; j < singles.size(); ++j) {
+    Scored& q = singles[j];
+    if (q.fit.pred.size() == 0) continue;
+    q.pred_f = q.fit.pred.cast<float>();
+    q.fit.pred = Mat();
+  }
   for (const auto& s : singles) {
     CandidateScore c;
     c.name = s.fit.name;
@@ -284,8 +332,7 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Sco
   std::size_t win_order = 0;
   std::vector<std::size_t> top;
   for (std::size_t j = 0; j < singles.size() && top.size() < kPairStarts; ++j) {
-    if (singles[j].eligible && singles[j].fit.pred.size() > 0 &&
-        singles[j].score >= 0.5 * best.score) {
+    if (singles[j].eligible && singles[j].HasPrediction() && singles[j].score >= 0.5 * best.score) {
       top.push_back(j);
     }
   }
@@ -319,7 +366,7 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Sco
   });
   // Memory: the starts other than the best single are not used again.
   for (std::size_t x : top) {
-    if (x != 0) singles[x].fit.pred = Mat();
+    if (x != 0) singles[x].pred_f = Eigen::MatrixXf();
   }
   return have_pair;
 }

@@ -19,6 +19,16 @@ struct Scored {
   double score = 0.0;
   bool eligible = false;
   double hold_rms_after = 0.0;  ///< held-out RMS after removing the prediction
+  /// A pair start's prediction in single precision, when fit.pred was released to save memory
+  /// (every start but the best single: StartPrediction); empty otherwise.
+  Eigen::MatrixXf pred_f;
+
+  /// Whether the prediction is held (fit.pred or pred_f).
+  [[nodiscard]] bool HasPrediction() const { return fit.pred.size() > 0 || pred_f.size() > 0; }
+  /// The prediction at row i, channel c, mV/V.
+  [[nodiscard]] double Prediction(int i, int c) const {
+    return fit.pred.size() > 0 ? fit.pred(i, c) : static_cast<double>(pred_f(i, c));
+  }
 };
 
 /// Pairs start from at most this many of the best eligible singles (BestPair).

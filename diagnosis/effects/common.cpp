@@ -39,13 +39,13 @@ void RingingRows(const Context& cx, double f_hz, double zeta, const std::vector<
   std::vector<const double*> in;
   std::vector<double*> out;
   for (int c : chans) {
-    in.push_back(d.sim_mvv.col(c).data() + i0);
+    in.push_back(cx.load.col(c).data() + i0);  // LP[sim] − sim = LP[load] − load
     out.push_back(h->col(c).data() + i0);
   }
   const std::uint8_t* restart = Restarts(cx);
   SecondOrderLowPassColumns(d.t_s.data() + i0, static_cast<std::size_t>(m), f_hz, zeta, in.data(),
                             out.data(), in.size(), restart != nullptr ? restart + i0 : nullptr);
-  for (int c : chans) h->col(c).segment(i0, m) -= d.sim_mvv.col(c).segment(i0, m);
+  for (int c : chans) h->col(c).segment(i0, m) -= cx.load.col(c).segment(i0, m);
 }
 
 std::vector<int> StrongestTwo(const Context& cx, const Mat& r) {

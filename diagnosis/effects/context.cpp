@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "diagnosis/effects/common.hpp"
@@ -27,12 +28,15 @@ void FindSpectralLines(Context& cx) {
 
 }  // namespace
 
-Context MakeContext(const DiagData& d, double block_s, const Eigen::VectorXd* sigma) {
+namespace {
+
+/// The context from the residual and the sim's outputs (n × N each, mV/V): `sim` becomes the load.
+Context Build(const DiagData& d, Mat resid, Mat sim, double block_s, const Eigen::VectorXd* sigma) {
   Context cx;
   cx.data = &d;
   cx.n = static_cast<int>(d.rows());
   cx.nc = d.channels();
-  cx.resid = d.real_mvv - d.sim_mvv;
+  cx.resid = std::move(resid);
   cx.rate_hz = d.rate_hz();
   cx.dt = 1.0 / cx.rate_hz;
   cx.uniform = true;
@@ -47,7 +51,7 @@ Context MakeContext(const DiagData& d, double block_s, const Eigen::VectorXd* si
   for (int c = 0; c < cx.nc; ++c) {
     double s = RobustNoise(cx.resid.col(c).data(), static_cast<std::size_t>(cx.n), cx.rate_hz);
     // Floor: a tiny fraction of the channel's signal scale, so identical files do not divide by 0.
-    const double scale = std::max(1e-9, d.sim_mvv.col(c).cwiseAbs().maxCoeff() * 1e-9);
+    const double scale = std::max(1e-9, sim.col(c).cwiseAbs().maxCoeff() * 1e-9);
     s = std::max(s, scale);
     if (sigma != nullptr) s = (*sigma)(c);
     cx.sigma(c) = s;
@@ -94,14 +98,15 @@ Context MakeContext(const DiagData& d, double block_s, const Eigen::VectorXd* si
       for (int i = 0; i < cx.n; ++i) {
         x[0] = 1.0;
         for (int k = 0; k < 6; ++k) x[k + 1] = d.wrench(i, k);
-        ne.Add(x, d.sim_mvv(i, c));
+        ne.Add(x, sim(i, c));
       }
       const auto r = ne.Solve();
       cx.zero(c) = r.beta(0);
       for (int k = 0; k < 6; ++k) cx.sens(c, k) = r.beta(k + 1);
     }
   }
-  cx.load = d.sim_mvv.rowwise() - cx.zero.transpose();
+  sim.rowwise() -= cx.zero.transpose();
+  cx.load = std::move(sim);
   cx.load_range.resize(cx.nc);
   for (int c = 0; c < cx.nc; ++c)
     cx.load_range(c) = cx.load.col(c).maxCoeff() - cx.load.col(c).minCoeff();
@@ -119,6 +124,30 @@ Context MakeContext(const DiagData& d, double block_s, const Eigen::VectorXd* si
   }
   FindSpectralLines(cx);
   return cx;
+}
+
+}  // namespace
+
+Context MakeContext(const DiagData& d, double block_s, const Eigen::VectorXd* sigma) {
+  return Build(d, d.real_mvv - d.sim_mvv, d.sim_mvv, block_s, sigma);
+}
+
+Context MakeContext(DiagData* d, double block_s, const Eigen::VectorXd* sigma) {
+  d->released_channels = d->channels();
+  Mat resid = std::move(d->real_mvv);
+  resid -= d->sim_mvv;
+  Mat sim = std::move(d->sim_mvv);
+  d->real_mvv = Mat();
+  d->sim_mvv = Mat();
+  return Build(*d, std::move(resid), std::move(sim), block_s, sigma);
+}
+
+void SetNoise(Context* cx, const Eigen::VectorXd& sigma) {
+  cx->sigma = sigma;
+  cx->weight = sigma.array().square().inverse().matrix();
+  cx->peak_hz.clear();
+  cx->peak_ratio.clear();
+  FindSpectralLines(*cx);
 }
 
 namespace {

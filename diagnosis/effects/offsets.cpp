@@ -208,7 +208,7 @@ std::optional<EffectFit> ExcitationSearch(const Context& cx, const Mat& target,
         if (!cx.train[static_cast<std::size_t>(i)]) continue;
         const int j = hat_j[static_cast<std::size_t>(i)];
         const double fr = hat_fr[static_cast<std::size_t>(i)];
-        const double s = d.sim_mvv(i, c);
+        const double s = cx.sim_mvv(i, c);
         const int idx[2] = {j, j + 1};
         const double val[2] = {(1.0 - fr) * s, fr * s};
         ne.AddSparse(idx, val, 2, target(i, c), cx.weight(c));
@@ -234,7 +234,7 @@ std::optional<EffectFit> ExcitationSearch(const Context& cx, const Mat& target,
         double fr = 0.0;
         hb.At(d.t_s[static_cast<std::size_t>(i)], &j, &fr);
         factor(i) = r.beta(j) * (1.0 - fr) + r.beta(j + 1) * fr;
-        for (int c = 0; c < cx.nc; ++c) e.pred(i, c) = factor(i) * d.sim_mvv(i, c);
+        for (int c = 0; c < cx.nc; ++c) e.pred(i, c) = factor(i) * cx.sim_mvv(i, c);
       }
       e.params["knots"] = p;
       e.params["factor_min"] = 1.0 + factor.minCoeff();

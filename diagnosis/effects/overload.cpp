@@ -11,7 +11,6 @@
 namespace ftstack::diag::fx {
 
 std::optional<EffectFit> FitSaturation(const Context& cx, const Mat& target) {
-  const auto& d = *cx.data;
   // Real = sim + residual; a clipping limit shows up as the extremes of the real outputs.
   double hi = -std::numeric_limits<double>::infinity();
   double lo = std::numeric_limits<double>::infinity();
@@ -19,7 +18,7 @@ std::optional<EffectFit> FitSaturation(const Context& cx, const Mat& target) {
   double sim_lo = lo;
   for (int c = 0; c < cx.nc; ++c) {
     for (int i = 0; i < cx.n; ++i) {
-      const double s = d.sim_mvv(i, c);
+      const double s = cx.sim_mvv(i, c);
       const double r = s + target(i, c);
       hi = std::max(hi, r);
       lo = std::min(lo, r);
@@ -34,7 +33,7 @@ std::optional<EffectFit> FitSaturation(const Context& cx, const Mat& target) {
     for (int c = 0; c < cx.nc; ++c) {
       double acc = 0.0;
       for (int i = 0; i < cx.n; ++i) {
-        const double s = d.sim_mvv(i, c);
+        const double s = cx.sim_mvv(i, c);
         const double v = std::clamp(s, l, h) - s;
         if (out != nullptr) (*out)(i, c) = v;
         if (cx.train[static_cast<std::size_t>(i)]) acc += (target(i, c) - v) * (target(i, c) - v);
@@ -78,7 +77,7 @@ std::optional<EffectFit> FitSaturation(const Context& cx, const Mat& target) {
   const double l = e.params["limit"].get<double>();
   for (int c = 0; c < cx.nc; ++c) {
     for (int i = 0; i < cx.n; ++i) {
-      if (std::fabs(d.sim_mvv(i, c)) > l) ++pinned;
+      if (std::fabs(cx.sim_mvv(i, c)) > l) ++pinned;
     }
   }
   e.evidence = Fmt(

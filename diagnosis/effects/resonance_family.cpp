@@ -67,6 +67,15 @@ int PutModes(const Context& cx, const ChannelFit& cf, const double* lf, const do
   return 1 - lo;
 }
 
+/// The prediction β₁·h1 + β₂·h2 (the sums FitChannels makes), written over h1 (memory: one n × N
+/// buffer less).
+Mat TwoModePrediction(const Context& cx, const ChannelFit& cf, Mat h1, const Mat& h2) {
+  for (int c = 0; c < cx.nc; ++c) {
+    for (int i = 0; i < cx.n; ++i) h1(i, c) = cf.beta(0, c) * h1(i, c) + cf.beta(1, c) * h2(i, c);
+  }
+  return h1;
+}
+
 }  // namespace
 
 std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz, double zeta1,
@@ -162,8 +171,7 @@ std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz,
   }
   Ringing(cx, std::exp(lf[0]), std::exp(lz[0]), all, &h1);
   Ringing(cx, std::exp(lf[1]), std::exp(lz[1]), all, &h2);
-  Mat pred(cx.n, cx.nc);
-  const ChannelFit cf = fit(all, &pred, 1);
+  const ChannelFit cf = fit(all, nullptr, 1);  // the prediction only if kept (memory, below)
   const int p = 2 * cx.nc + 4;
   const double gain = e->train_sse_w + e->n_params * Penalty(cx) - (cf.sse_w + p * Penalty(cx));
   const double e1 = ModeEnergy(cx, cf, 0, h1);
@@ -182,7 +190,8 @@ std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz,
   e->variant = "two modes";
   e->n_params = p;
   e->train_sse_w = cf.sse_w;
-  e->pred = std::move(pred);
+  e->pred = Mat();
+  e->pred = TwoModePrediction(cx, cf, std::move(h1), h2);
   e->search_state = {lf[0], lz[0], lf[1], lz[1]};
   return Fmt(
       "; a second mode at %.2f Hz (damping ratio %.3f) from the residual spectrum, kept: "

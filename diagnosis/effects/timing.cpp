@@ -16,7 +16,7 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Mat& target) {
     double sse = 0.0;
     const int st = out == nullptr ? cx.search_stride : 1;
     for (int c = 0; c < cx.nc; ++c) {
-      const double* s = d.sim_mvv.col(c).data();
+      const double* s = cx.load.col(c).data();  // load = sim − zero: the same differences
       double acc = 0.0;
       for (int i = 0; i < cx.n; i += st) {
         const bool tr = cx.train[static_cast<std::size_t>(i)] != 0;
@@ -39,7 +39,7 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Mat& target) {
     for (int i = 1; i + 1 < cx.n; ++i) {
       if (!cx.train[static_cast<std::size_t>(i)]) continue;
       const double ds =
-          (d.sim_mvv(i + 1, c) - d.sim_mvv(i - 1, c)) /
+          (cx.sim_mvv(i + 1, c) - cx.sim_mvv(i - 1, c)) /
           (d.t_s[static_cast<std::size_t>(i + 1)] - d.t_s[static_cast<std::size_t>(i - 1)]);
       num += -target(i, c) * ds * cx.weight(c);
       den += ds * ds * cx.weight(c);
@@ -140,11 +140,10 @@ namespace {
 
 /// Fast load changes on channel c: runs of rows where |Δsim| per sample exceeds 20 σ.
 int FastLoadChanges(const Context& cx, int c) {
-  const auto& d = *cx.data;
   int fast = 0;
   bool in_fast = false;
   for (int i = 1; i < cx.n; ++i) {
-    const bool now = std::fabs(d.sim_mvv(i, c) - d.sim_mvv(i - 1, c)) > 20.0 * cx.sigma(c);
+    const bool now = std::fabs(cx.sim_mvv(i, c) - cx.sim_mvv(i - 1, c)) > 20.0 * cx.sigma(c);
     if (now && !in_fast) ++fast;
     in_fast = now;
   }
@@ -170,12 +169,11 @@ std::vector<double> ResonanceGrid(const Context& cx) {
 constexpr int kCoarseRows = 100000;
 std::pair<int, int> CoarseWindow(const Context& cx, const std::vector<int>& chans) {
   if (cx.n <= kCoarseRows) return {0, cx.n};
-  const auto& d = *cx.data;
   std::vector<double> e(static_cast<std::size_t>(cx.n), 0.0);
   for (int i = 1; i < cx.n; ++i) {
     if (!cx.restart.empty() && cx.restart[static_cast<std::size_t>(i)] != 0) continue;
     for (int c : chans) {
-      const double s = d.sim_mvv(i, c) - d.sim_mvv(i - 1, c);
+      const double s = cx.sim_mvv(i, c) - cx.sim_mvv(i - 1, c);
       e[static_cast<std::size_t>(i)] += s * s * cx.weight(c);
     }
   }
@@ -309,6 +307,7 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
                            lz, 0.02));
   }
   PutChannelCoef(cx, cf, 0, "participation", &e);
+  h = Mat();  // memory: the second mode's search has buffers of its own
   e.variant = "one mode";
   e.search_state = {lf, lz};
   const bool near_two = warm && near->search_state.size() >= 4;

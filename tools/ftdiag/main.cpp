@@ -67,8 +67,8 @@ int RunDiagnose(const DiagnoseArgs& args) {
           "ftdiag diagnose: give exactly one of --sim SIM.csv or --model SENSOR.json");
     }
     if (!(args.block_s > 0)) throw DiagInputError("ftdiag diagnose: --block-s must be positive");
-    const DiagData data = args.sim.empty() ? LoadModelReal(args.model, args.real, &DrawBar, &bar)
-                                           : LoadSimReal(args.sim, args.real, &DrawBar, &bar);
+    DiagData data = args.sim.empty() ? LoadModelReal(args.model, args.real, &DrawBar, &bar)
+                                     : LoadSimReal(args.sim, args.real, &DrawBar, &bar);
     DiagnoseOptions opt;
     opt.pairs = !args.no_pairs;
     opt.block_s = args.block_s;
@@ -76,7 +76,7 @@ int RunDiagnose(const DiagnoseArgs& args) {
     opt.progress = &DrawBar;
     opt.progress_user = &bar;
     bar.last = -1;
-    const Report report = Diagnose(data, opt);
+    const Report report = Diagnose(&data, opt);  // its bridges become the context's (memory)
     if (bar.tty) std::fprintf(stderr, "\n");
     auto json = ToJson(report);
     json["real_bridge_unit"] = data.real_unit;
