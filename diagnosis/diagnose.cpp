@@ -430,9 +430,12 @@ Report DiagnoseWith(Context context, const DiagnoseOptions& options) {
   singles.shrink_to_fit();
   t0 = std::chrono::steady_clock::now();
   RefineThermal(cx, &claimed);
+  DebugTime("claims", "thermal lag", t0);
   const std::vector<Confounding> partner_conf =
       DropUnidentifiedPartner(cx, options.z_claim, &claimed, &r.dropped);
+  DebugTime("claims", "partner identifiability", t0);
   RecordClaims(r, options, claimed, partner_conf);
+  DebugTime("claims", "claims and confounders", t0);
   LocateByModel(r);
   DebugTime("stage", "claims", t0);
   Progress(options, 1.0, "done");

@@ -51,12 +51,14 @@ bool FitPair(const Context& cx, const Mat& target, const EffectSpec& a, const Ef
   const EffectFit* first = &a0;
   for (int it = 0; it < 2; ++it) {
     fb->pred = Mat();  // memory: the previous B is replaced; only `first` is used now
-    auto nb = it == 0 ? FitNear(b, cx, a0_rest, b_near, false)
-                      : FitNear(b, cx, target - first->pred, fb, true);
-    a0_rest = Mat();
+    Mat rest = it == 0 ? std::move(a0_rest) : Mat(target - first->pred);
+    // Memory: the previous A is refitted below (near its parameters); its prediction lives on
+    // in `rest` until B is fitted.
+    if (first == fa) fa->pred = Mat();
+    auto nb = FitNear(b, cx, rest, it == 0 ? b_near : fb, it == 1);
+    rest = Mat();
     if (!nb) return false;
     *fb = std::move(*nb);
-    if (first == fa) fa->pred = Mat();  // the previous A is replaced below
     auto na = FitNear(a, cx, target - fb->pred, first, it == 1);
     if (!na) return false;
     *fa = std::move(*na);
@@ -75,19 +77,28 @@ std::vector<std::size_t> CostOrder(const std::vector<EffectSpec>& effects) {
 }
 
 /// Keeps the predictions of the `keep` best eligible fits in `all` and releases the others'
-/// (memory: n × N each). The survivors do not depend on the order the fits arrived in.
+/// (memory: n × N each); of those kept, the best (ties: the earliest in `all`) in double
+/// precision, the others in single precision (half the memory; they only start a pair's backfit).
+/// The best so far always arrived last with its double prediction, so the result does not depend
+/// on the order the fits arrived in.
 void KeepBestPredictions(std::vector<std::optional<Scored>>* all, std::size_t keep) {
   std::vector<Scored*> kept;
   for (auto& q : *all) {
     if (q && q->eligible && q->HasPrediction()) kept.push_back(&*q);
   }
+  const auto by_score = [](const Scored* u, const Scored* v) { return u->score < v->score; };
   while (kept.size() > keep) {
-    auto lowest = std::min_element(kept.begin(), kept.end(), [](const Scored* u, const Scored* v) {
-      return u->score < v->score;
-    });
+    auto lowest = std::min_element(kept.begin(), kept.end(), by_score);
     (*lowest)->fit.pred = Mat();
     (*lowest)->pred_f = Eigen::MatrixXf();
     kept.erase(lowest);
+  }
+  if (kept.empty()) return;
+  const Scored* best = *std::max_element(kept.begin(), kept.end(), by_score);
+  for (Scored* q : kept) {
+    if (q == best || q->fit.pred.size() == 0) continue;
+    q->pred_f = q->fit.pred.cast<float>();
+    q->fit.pred = Mat();
   }
 }
 
@@ -295,16 +306,16 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
   for (auto& q : slot) {
     if (q) singles.push_back(std::move(*q));
   }
-  std::sort(singles.begin(), singles.end(),
-            [](const Scored& a, const Scored& b) { return a.score > b.score; });
-  // Memory: the best single (it may be claimed alone) keeps its prediction in double precision;
-  // the other pair starts hold theirs in single precision (6e-8 relative, far below the noise of
-  // any recording: they only start a pair's backfit).
-  for (std::size_t j = 1; j < singles.size(); ++j) {
-    Scored& q = singles[j];
-    if (q.fit.pred.size() == 0) continue;
-    q.pred_f = q.fit.pred.cast<float>();
-    q.fit.pred = Mat();
+  // Stable: of equal scores the earlier effect first, as KeepBestPredictions chooses its best.
+  std::stable_sort(singles.begin(), singles.end(),
+                   [](const Scored& a, const Scored& b) { return a.score > b.score; });
+  // The best single (it may be claimed alone) holds its prediction in double precision; the other
+  // pair starts in single precision (6e-8 relative, far below the noise of any recording: they
+  // only start a pair's backfit). KeepBestPredictions keeps it so; this is only a guard.
+  if (!singles.empty() && singles.front().fit.pred.size() == 0 &&
+      singles.front().pred_f.size() > 0) {
+    singles.front().fit.pred = singles.front().pred_f.cast<double>();
+    singles.front().pred_f = Eigen::MatrixXf();
   }
   for (const auto& s : singles) {
     CandidateScore c;

@@ -142,12 +142,7 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const
     e.train_sse_w = f.sse_w;
     const double bic = f.sse_w + p * Penalty(cx);
     if (bic >= best_bic) continue;
-    best.pred = Mat();
-    if (gamma) {
-      PredictChannels(cx, f, 2, feat_gamma, &e.pred);
-    } else {
-      PredictChannels(cx, f, 1, feat_plain, &e.pred);
-    }
+    best.pred = Mat();  // the kept variant's prediction is made after the loop, over lp
     best_bic = bic;
     e.params["tau_s"] = tau;
     e.sigma["tau_s"] = JsonNum(tau * sl);
@@ -156,7 +151,20 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const
     best_f = f;
     best_gamma = gamma;
   }
-  lp = Mat();  // the two-τ search filters into buffers of its own
+  // lp holds LP_τ[load] (every variant ended with build(τ)): the prediction Σ β_j·x_j (the sums
+  // FitChannels makes) is written over it (memory: one n × N buffer less); the two-τ search
+  // filters into buffers of its own.
+  for (int c = 0; c < cx.nc; ++c) {
+    const double b0 = best_f.beta(0, c);
+    const double b1 = best_gamma ? best_f.beta(1, c) : 0.0;
+    for (int i = 0; i < cx.n; ++i) {
+      double v = 0.0;
+      v += b0 * lp(i, c);
+      if (best_gamma) v += b1 * cx.load(i, c);
+      lp(i, c) = v;
+    }
+  }
+  best.pred = std::move(lp);
   taus = {std::exp(lt)};
   tau_sigmas = {best.sigma["tau_s"].is_number() ? best.sigma["tau_s"].get<double>() : 0.0};
   // The two-τ variant: searched in full alone, not in a refit (a refit keeps the variant class its

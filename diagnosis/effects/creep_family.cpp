@@ -46,17 +46,22 @@ ChannelFit FitTwo(const Context& cx, const Mat& target, const Mat& lp1, const Ma
       pred, nullptr, st);
 }
 
-/// The prediction of a FitTwo fit (the same sums FitChannels would have filled in).
-void PredictTwo(const Context& cx, const ChannelFit& f, const Mat& lp1, const Mat& lp2, bool gamma,
-                Mat* pred) {
-  PredictChannels(
-      cx, f, gamma ? 3 : 2,
-      [&](int i, int c, double* x) {
-        x[0] = lp1(i, c);
-        x[1] = lp2(i, c);
-        if (gamma) x[2] = cx.load(i, c);
-      },
-      pred);
+/// The prediction of a FitTwo fit (the same sums FitChannels would have filled in), written over
+/// lp1 (memory: one n × N buffer less).
+Mat PredictTwoOver(const Context& cx, const ChannelFit& f, Mat lp1, const Mat& lp2, bool gamma) {
+  for (int c = 0; c < cx.nc; ++c) {
+    const double b0 = f.beta(0, c);
+    const double b1 = f.beta(1, c);
+    const double b2 = gamma ? f.beta(2, c) : 0.0;
+    for (int i = 0; i < cx.n; ++i) {
+      double v = 0.0;
+      v += b0 * lp1(i, c);
+      v += b1 * lp2(i, c);
+      if (gamma) v += b2 * cx.load(i, c);
+      lp1(i, c) = v;
+    }
+  }
+  return lp1;
 }
 
 /// Coarse 2-D search of (log τ1 < log τ2) over pairs of a 13-point log grid on [lo, hi]: every grid
@@ -256,8 +261,7 @@ bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double b
     }
     if (std::min(amp[0], amp[1]) < 0.01 * std::max(amp[0], amp[1])) continue;
     best_bic = bic;
-    best->pred = Mat();  // replaced below: one n × N prediction at a time
-    PredictTwo(cx, f, lp1, lp2, gamma, &e.pred);
+    best->pred = Mat();  // replaced after the loop, over lp1: one n × N prediction at a time
     const double t1 = std::exp(l1);
     const double t2 = std::exp(l2);
     e.params["tau1_s"] = t1;
@@ -273,6 +277,7 @@ bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double b
     *best = std::move(e);
     won = true;
   }
+  if (won) best->pred = PredictTwoOver(cx, *best_f, std::move(lp1), lp2, *best_gamma);
   return won;
 }
 
