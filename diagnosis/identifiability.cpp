@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <functional>
 #include <map>
 
+#include "diagnosis/debug.hpp"
 #include "diagnosis/signal.hpp"
 
 namespace ftstack::diag {
@@ -280,7 +280,7 @@ Confounding CheckConfounders(const Context& cx, const Mat& target, const EffectF
     double z_rest = 0.0;
     const auto offsets = [&](const Mat& y) { return GroupOffsets(cx, y, g, groups); };
     const bool identified = beyond(offsets, groups * cx.nc, &z_rest);
-    if (std::getenv("FTDIAG_DEBUG") != nullptr) {
+    if (DebugOn()) {
       std::fprintf(stderr, "confounder %s (%d groups) for %s: z_rest %.1f -> %s\n", name, groups,
                    fit.name.c_str(), z_rest, identified ? "identified" : "confounded");
     }

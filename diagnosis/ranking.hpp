@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstddef>
 
+#include "diagnosis/debug.hpp"
 #include "diagnosis/diagnose.hpp"
 #include "diagnosis/effects.hpp"
 
@@ -38,10 +39,6 @@ inline constexpr std::size_t kPairPartners = 3;
 
 /// Held-out RMS of target − pred (pred nullptr: of target), all channels, mV/V.
 double HoldRms(const Context& cx, const Eigen::MatrixXd& target, const Eigen::MatrixXd* pred);
-/// Whether FTDIAG_DEBUG is set (read once).
-bool DebugOn();
-/// FTDIAG_DEBUG: the time one fit took since t0, on stderr.
-void DebugTime(const char* stage, const char* what, std::chrono::steady_clock::time_point t0);
 /// Reports progress through options.progress when set.
 void Progress(const DiagnoseOptions& o, double f, const char* what);
 
