@@ -133,9 +133,21 @@ std::vector<int> FindSegments(const Recording& real) {
   return seg;
 }
 
-DiagData FromRecordings(const Recording& sim, const Recording& real) {
+namespace {
+
+/// Frees the bridge columns of `rec` once they are copied (memory: 8 bytes × rows each).
+void ReleaseBridges(Recording* rec, std::size_t n) {
+  for (std::size_t c = 0; c < n; ++c) {
+    std::vector<double>().swap(rec->Column("b" + std::to_string(c)));
+  }
+}
+
+/// The pair from the sim recording (its `ns` bridge columns already copied into sim_mvv: they may
+/// have been released) and the real one, checked; `release_real` (the real recording, or nullptr)
+/// has its bridge columns released once copied.
+DiagData Assemble(const Recording& sim, std::size_t ns, Eigen::MatrixXd sim_mvv,
+                  const Recording& real, Recording* release_real) {
   const std::size_t nr = real.BridgeCount();
-  const std::size_t ns = sim.BridgeCount();
   if (nr == 0) throw DiagInputError(real.path + ": no bridge columns b0…");
   if (ns != nr) {
     throw DiagInputError(sim.path + ": has " + std::to_string(ns) + " bridge columns but " +
@@ -149,29 +161,27 @@ DiagData FromRecordings(const Recording& sim, const Recording& real) {
   DiagData d;
   d.sim_name = sim.path;
   d.real_name = real.path;
-  d.t_s = real.Column("t");
-  d.sim_mvv = Bridges(sim, nr);
+  d.sim_mvv = std::move(sim_mvv);
   d.real_mvv = Bridges(real, nr);
+  if (release_real != nullptr) ReleaseBridges(release_real, nr);
   if (HasWrench(real)) {
     d.wrench = WrenchOf(real);
   } else if (HasWrench(sim)) {
     d.wrench = WrenchOf(sim);
   }
+  d.t_s = real.Column("t");
   if (real.Has("temp_C")) d.temp_c = real.Column("temp_C");
   d.segment = FindSegments(real);
   CheckUsable(d);
   return d;
 }
 
-namespace {
-
-/// Frees the bridge columns of `rec` once they are copied (memory: 8 bytes × rows each).
-void ReleaseBridges(Recording* rec, std::size_t n) {
-  for (std::size_t c = 0; c < n; ++c)
-    std::vector<double>().swap(rec->Column("b" + std::to_string(c)));
-}
-
 }  // namespace
+
+DiagData FromRecordings(const Recording& sim, const Recording& real) {
+  const std::size_t ns = sim.BridgeCount();
+  return Assemble(sim, ns, Bridges(sim, ns), real, nullptr);
+}
 
 DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path, ProgressFn progress,
                      void* user) {
@@ -188,28 +198,8 @@ DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path, 
     ReleaseBridges(&sim, ns);
     std::vector<std::size_t>().swap(sim.data_lines);
     Recording real = Read(real_path, &r2, &real_unit, true);
-    const std::size_t nr = real.BridgeCount();
-    if (nr == 0) throw DiagInputError(real.path + ": no bridge columns b0…");
-    if (ns != nr) {
-      throw DiagInputError(sim.path + ": has " + std::to_string(ns) + " bridge columns but " +
-                           real.path + " has " + std::to_string(nr));
-    }
-    CheckAligned(sim, real);
-    DiagData d;
-    d.sim_name = sim.path;
-    d.real_name = real.path;
+    DiagData d = Assemble(sim, ns, std::move(sim_mvv), real, &real);
     d.real_unit = real_unit;
-    d.sim_mvv = std::move(sim_mvv);
-    d.real_mvv = Bridges(real, nr);
-    ReleaseBridges(&real, nr);
-    d.wrench = HasWrench(real)  ? WrenchOf(real)
-               : HasWrench(sim) ? WrenchOf(sim)
-                                : Eigen::MatrixXd();
-    sim = Recording();
-    if (real.Has("temp_C")) d.temp_c = std::move(real.Column("temp_C"));
-    d.segment = FindSegments(real);
-    d.t_s = std::move(real.Column("t"));
-    CheckUsable(d);
     return d;
   } catch (const RecordingError& e) {
     throw DiagInputError(e.what());

@@ -84,10 +84,12 @@ ChannelFit FitChannels(const Context& cx, const Mat& target, int p, F feat, Mat*
 
 /// pred(i, c) = Σ_j f.beta(j, c) · feat(i, c)_j on every row and channel: the prediction
 /// FitChannels fills (same sums in the same order), made only once a fit is kept (memory: n × N).
+/// *pred may be a feature buffer that feat reads at (i, c) only (it is read before it is written):
+/// the prediction then replaces that buffer instead of taking one of its own.
 template <class F>
 void PredictChannels(const Context& cx, const ChannelFit& f, int p, F feat, Mat* pred) {
   std::vector<double> x(static_cast<std::size_t>(p));
-  pred->setZero(cx.n, cx.nc);
+  if (pred->rows() != cx.n || pred->cols() != cx.nc) pred->resize(cx.n, cx.nc);  // all written
   for (int c = 0; c < cx.nc; ++c) {
     for (int i = 0; i < cx.n; ++i) {
       feat(i, c, x.data());
@@ -107,6 +109,21 @@ nlohmann::json JsonNum(double v);
 nlohmann::json VecJson(const Vec& v);
 /// Puts coefficient j of every channel and its σ into e.params[key] / e.sigma[key]; returns it.
 Vec PutChannelCoef(const Context& cx, const ChannelFit& f, int j, const char* key, EffectFit* e);
+/// A search that starts near an earlier fit of the same effect when given one (RefitFn's
+/// contract), else searches in full; `uncertainty` as RefitFn's.
+using NearSearchFn = std::optional<EffectFit> (*)(const Context& cx, const Mat& target,
+                                                  const EffectFit* near, bool uncertainty);
+/// The FitFn of an effect whose fit is one NearSearchFn: the full search, with uncertainties.
+template <NearSearchFn Search>
+std::optional<EffectFit> FitBy(const Context& cx, const Mat& target) {
+  return Search(cx, target, nullptr, true);
+}
+/// Its RefitFn: the search near an earlier fit.
+template <NearSearchFn Search>
+std::optional<EffectFit> RefitBy(const Context& cx, const Mat& target, const EffectFit& near,
+                                 bool uncertainty) {
+  return Search(cx, target, &near, uncertainty);
+}
 /// Whitened training SSE of a one-coefficient-per-channel fit of `feature` (n × N), on every
 /// search_stride-th row and scaled back to the full count: the objective of parameter searches.
 double SearchSse(const Context& cx, const Mat& target, const Mat& feature);
@@ -168,7 +185,12 @@ std::optional<EffectFit> FitExcitation(const Context& cx, const Mat& target);
 /// excitation_drift refitted near an earlier fit (RefitFn): near's knot count and its neighbours.
 std::optional<EffectFit> RefitExcitation(const Context& cx, const Mat& target,
                                          const EffectFit& near, bool uncertainty);
-std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target);
+/// creep: the one-τ search on the full log grid (near == nullptr) or in a window of ±0.5 in log τ
+/// around near's τ (τ1 when near is two-τ; the full range when the optimum lands on the window's
+/// edge), then the two-τ variant: searched in full alone, from near's pair when near is two-τ,
+/// not at all when near is one-τ (effects/creep.cpp).
+std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const EffectFit* near,
+                                     bool uncertainty);
 /// creep with two time constants τ1 < τ2 (effects/creep_family.cpp): τ2 searched with τ1 at the
 /// one-τ optimum `log_tau1`, then τ1 and τ2 refined in turn; replaces *best (and fills tau,
 /// tau_sigma, the channel fit and whether a gain term is in it) only when its training BIC is
@@ -179,11 +201,6 @@ bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double b
                  EffectFit* best, std::vector<double>* tau, std::vector<double>* tau_sigma,
                  ChannelFit* best_f, bool* best_gamma, const double* start = nullptr,
                  bool uncertainty = true);
-/// creep refitted near an earlier creep fit (RefitFn): τ searched in a window of ±0.5 in log τ
-/// around near's τ (τ1 when near is two-τ; full range when it lands on the window's edge); the
-/// two-τ variant is tried only when near is two-τ, from near's pair (effects/creep.cpp).
-std::optional<EffectFit> RefitCreep(const Context& cx, const Mat& target, const EffectFit& near,
-                                    bool uncertainty);
 /// The fitted creep model (time constants tau, channel fit f with a_k per τ then γ when `gamma`)
 /// in OIML R 60's terms: e->standard["oiml_r60"] (docs/spec/diagnosis.md).
 void CreepOimlR60(const Context& cx, const std::vector<double>& tau,
@@ -203,11 +220,11 @@ std::optional<EffectFit> FitMains(const Context& cx, const Mat& target);
 /// BIC penalty of its 2 coefficients per channel; refits pred jointly with the fundamental and
 /// puts h<k>_amplitude_mvv (σ) and h<k>_seen_at_hz. Returns a clause for the evidence.
 std::string AddMainsHarmonics(const Context& cx, const Mat& target, double f0, EffectFit* e);
-std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target);
-/// resonance refitted near an earlier resonance fit (RefitFn): the golden refinements of (f, ζ)
-/// start at near's mode(s), without the coarse grid; a second mode only when near has one.
-std::optional<EffectFit> RefitResonance(const Context& cx, const Mat& target, const EffectFit& near,
-                                        bool uncertainty);
+/// resonance: a coarse grid at the residual's lines (a log grid without any) then golden
+/// refinements of (f, ζ), and the second-mode search (near == nullptr); or the refinements only,
+/// from near's mode(s), a second mode only when near has one (effects/timing.cpp).
+std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
+                                         const EffectFit* near, bool uncertainty);
 /// The two-mode variant of a one-mode resonance fit *e at (f1_hz, zeta1) (effects/
 /// resonance_family.cpp): mode 2 searched at the lines of the residual spectrum, both refined in
 /// turn and fitted jointly (a participation per channel and mode); replaces *e (variant "two

@@ -136,9 +136,7 @@ Context MakeContext(DiagData* d, double block_s, const Eigen::VectorXd* sigma) {
   d->released_channels = d->channels();
   Mat resid = std::move(d->real_mvv);
   resid -= d->sim_mvv;
-  Mat sim = std::move(d->sim_mvv);
-  d->real_mvv = Mat();
-  d->sim_mvv = Mat();
+  Mat sim = std::move(d->sim_mvv);  // both moved-from matrices are left empty
   return Build(*d, std::move(resid), std::move(sim), block_s, sigma);
 }
 

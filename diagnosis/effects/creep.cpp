@@ -61,8 +61,8 @@ void FinishCreep(const Context& cx, const Mat& target, bool two, const std::vect
           RowCorr(cx, target, e->pred, c));
 }
 
-/// FitCreep (near == nullptr) or RefitCreep: the one-τ search on the full log grid or in a window
-/// around near's τ, then the two-τ variant (full, from near's pair, or not when near is one-τ).
+}  // namespace
+
 std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const EffectFit* near,
                                      bool uncertainty) {
   EffectFit best;
@@ -151,19 +151,16 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const
     best_f = f;
     best_gamma = gamma;
   }
-  // lp holds LP_τ[load] (every variant ended with build(τ)): the prediction Σ β_j·x_j (the sums
-  // FitChannels makes) is written over it (memory: one n × N buffer less); the two-τ search
-  // filters into buffers of its own.
-  for (int c = 0; c < cx.nc; ++c) {
-    const double b0 = best_f.beta(0, c);
-    const double b1 = best_gamma ? best_f.beta(1, c) : 0.0;
-    for (int i = 0; i < cx.n; ++i) {
-      double v = 0.0;
-      v += b0 * lp(i, c);
-      if (best_gamma) v += b1 * cx.load(i, c);
-      lp(i, c) = v;
-    }
-  }
+  // lp holds LP_τ[load] (every variant ended with build(τ)): the kept variant's prediction is
+  // written over it (memory: one n × N buffer less); the two-τ search filters into buffers of its
+  // own.
+  PredictChannels(
+      cx, best_f, best_gamma ? 2 : 1,
+      [&](int i, int c, double* x) {
+        x[0] = lp(i, c);
+        if (best_gamma) x[1] = cx.load(i, c);
+      },
+      &lp);
   best.pred = std::move(lp);
   taus = {std::exp(lt)};
   tau_sigmas = {best.sigma["tau_s"].is_number() ? best.sigma["tau_s"].get<double>() : 0.0};
@@ -173,17 +170,6 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const
                                                   &tau_sigmas, &best_f, &best_gamma, nullptr, true);
   FinishCreep(cx, target, two, taus, tau_sigmas, best_f, best_gamma, &best);
   return best;
-}
-
-}  // namespace
-
-std::optional<EffectFit> FitCreep(const Context& cx, const Mat& target) {
-  return CreepSearch(cx, target, nullptr, true);
-}
-
-std::optional<EffectFit> RefitCreep(const Context& cx, const Mat& target, const EffectFit& near,
-                                    bool uncertainty) {
-  return CreepSearch(cx, target, &near, uncertainty);
 }
 
 }  // namespace ftstack::diag::fx

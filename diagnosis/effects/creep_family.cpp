@@ -46,22 +46,18 @@ ChannelFit FitTwo(const Context& cx, const Mat& target, const Mat& lp1, const Ma
       pred, nullptr, st);
 }
 
-/// The prediction of a FitTwo fit (the same sums FitChannels would have filled in), written over
-/// lp1 (memory: one n × N buffer less).
-Mat PredictTwoOver(const Context& cx, const ChannelFit& f, Mat lp1, const Mat& lp2, bool gamma) {
-  for (int c = 0; c < cx.nc; ++c) {
-    const double b0 = f.beta(0, c);
-    const double b1 = f.beta(1, c);
-    const double b2 = gamma ? f.beta(2, c) : 0.0;
-    for (int i = 0; i < cx.n; ++i) {
-      double v = 0.0;
-      v += b0 * lp1(i, c);
-      v += b1 * lp2(i, c);
-      if (gamma) v += b2 * cx.load(i, c);
-      lp1(i, c) = v;
-    }
-  }
-  return lp1;
+/// The prediction of a FitTwo fit (the same sums FitChannels would have filled in); `pred` may be
+/// &lp1 (PredictChannels reads each element before it writes it).
+void PredictTwo(const Context& cx, const ChannelFit& f, const Mat& lp1, const Mat& lp2, bool gamma,
+                Mat* pred) {
+  PredictChannels(
+      cx, f, gamma ? 3 : 2,
+      [&](int i, int c, double* x) {
+        x[0] = lp1(i, c);
+        x[1] = lp2(i, c);
+        if (gamma) x[2] = cx.load(i, c);
+      },
+      pred);
 }
 
 /// Coarse 2-D search of (log τ1 < log τ2) over pairs of a 13-point log grid on [lo, hi]: every grid
@@ -277,7 +273,10 @@ bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double b
     *best = std::move(e);
     won = true;
   }
-  if (won) best->pred = PredictTwoOver(cx, *best_f, std::move(lp1), lp2, *best_gamma);
+  if (won) {  // over lp1: one n × N buffer less
+    PredictTwo(cx, *best_f, lp1, lp2, *best_gamma, &lp1);
+    best->pred = std::move(lp1);
+  }
   return won;
 }
 

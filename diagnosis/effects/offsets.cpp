@@ -230,9 +230,8 @@ std::optional<EffectFit> ExcitationSearch(const Context& cx, const Mat& target,
       e.pred.resize(cx.n, cx.nc);
       Vec factor(cx.n);
       for (int i = 0; i < cx.n; ++i) {
-        int j = 0;
-        double fr = 0.0;
-        hb.At(d.t_s[static_cast<std::size_t>(i)], &j, &fr);
+        const int j = hat_j[static_cast<std::size_t>(i)];
+        const double fr = hat_fr[static_cast<std::size_t>(i)];
         factor(i) = r.beta(j) * (1.0 - fr) + r.beta(j + 1) * fr;
         for (int c = 0; c < cx.nc; ++c) e.pred(i, c) = factor(i) * cx.sim_mvv(i, c);
       }

@@ -19,7 +19,7 @@ const std::vector<EffectSpec>& Effects() {
       {"thermal_zero_drift", &FitThermalZeroPlain},
       {"thermal_span_drift", &FitThermalSpan},
       {"excitation_drift", &FitExcitation, &RefitExcitation, 2},
-      {"creep", &FitCreep, &RefitCreep, 4},
+      {"creep", &FitBy<&CreepSearch>, &RefitBy<&CreepSearch>, 4},
       {"hysteresis", &FitHysteresisFamily, &RefitHysteresis, 2},
       {"bridge_nonlinearity", &FitBridgeNonlinearity},
       {"geometric_nonlinearity", &FitGeometric},
@@ -30,7 +30,7 @@ const std::vector<EffectSpec>& Effects() {
       {"saturation", &FitSaturation},
       {"overload_shift", &FitOverloadShift},
       {"mains_interference", &FitMains},
-      {"resonance", &FitResonance, &RefitResonance, 8},
+      {"resonance", &FitBy<&ResonanceSearch>, &RefitBy<&ResonanceSearch>, 8},
   };
   return kEffects;
 }

@@ -67,15 +67,6 @@ int PutModes(const Context& cx, const ChannelFit& cf, const double* lf, const do
   return 1 - lo;
 }
 
-/// The prediction β₁·h1 + β₂·h2 (the sums FitChannels makes), written over h1 (memory: one n × N
-/// buffer less).
-Mat TwoModePrediction(const Context& cx, const ChannelFit& cf, Mat h1, const Mat& h2) {
-  for (int c = 0; c < cx.nc; ++c) {
-    for (int i = 0; i < cx.n; ++i) h1(i, c) = cf.beta(0, c) * h1(i, c) + cf.beta(1, c) * h2(i, c);
-  }
-  return h1;
-}
-
 }  // namespace
 
 std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz, double zeta1,
@@ -94,14 +85,12 @@ std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz,
   double lf[2] = {std::log(f1_hz), 0.0};
   double lz[2] = {std::log(zeta1), 0.0};
   Mat* h[2] = {&h1, &h2};
+  const auto modes = [&](int i, int c, double* x) {  // both modes' ringing
+    x[0] = h1(i, c);
+    x[1] = h2(i, c);
+  };
   auto fit = [&](const std::vector<int>& chans, Mat* pred, int stride) {
-    return FitChannels(
-        cx, target, 2,
-        [&](int i, int c, double* x) {
-          x[0] = h1(i, c);
-          x[1] = h2(i, c);
-        },
-        pred, &chans, stride);
+    return FitChannels(cx, target, 2, modes, pred, &chans, stride);
   };
   // Whitened training SSE with mode m at (f, ζ) and the other mode's ringing held.
   auto sse = [&](int m, double f_hz, double zeta, const std::vector<int>& chans, int stride) {
@@ -191,7 +180,8 @@ std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz,
   e->n_params = p;
   e->train_sse_w = cf.sse_w;
   e->pred = Mat();
-  e->pred = TwoModePrediction(cx, cf, std::move(h1), h2);
+  PredictChannels(cx, cf, 2, modes, &h1);  // over h1: one n × N buffer less
+  e->pred = std::move(h1);
   e->search_state = {lf[0], lz[0], lf[1], lz[1]};
   return Fmt(
       "; a second mode at %.2f Hz (damping ratio %.3f) from the residual spectrum, kept: "

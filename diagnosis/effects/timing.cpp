@@ -211,9 +211,8 @@ double WindowSse(const Context& cx, const Mat& target, const Mat& h, const std::
   return s;
 }
 
-/// FitResonance (near == nullptr: coarse grid at the residual's lines, or a log grid without any)
-/// or RefitResonance (the refinements start at near's search state, its second mode kept as a
-/// start, none tried when near has one mode).
+}  // namespace
+
 std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
                                          const EffectFit* near, bool uncertainty) {
   const double nyq = 0.5 * cx.rate_hz;
@@ -326,17 +325,6 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
           c, RowCorr(cx, target, e.pred, c)) +
       second;
   return e;
-}
-
-}  // namespace
-
-std::optional<EffectFit> FitResonance(const Context& cx, const Mat& target) {
-  return ResonanceSearch(cx, target, nullptr, true);
-}
-
-std::optional<EffectFit> RefitResonance(const Context& cx, const Mat& target, const EffectFit& near,
-                                        bool uncertainty) {
-  return ResonanceSearch(cx, target, &near, uncertainty);
 }
 
 }  // namespace ftstack::diag::fx

@@ -36,6 +36,8 @@ void ExpectSameReport(const Report& a, const Report& b) {
 // Diagnose(DiagData*) takes the bridges' memory for the residual and the load. The reference is
 // the const path on an untouched copy: every score, parameter and prediction must be equal, the
 // residual must be real − sim exactly, and the data must keep its width without its matrices.
+// One of the two fixtures' diagnoses runs the noise-refined second pass, on the reused context
+// (SetNoise), in both paths (FTDIAG_DEBUG shows six contexts for the four diagnoses).
 TEST(DiagMemory, ConsumingDiagnosisGivesTheSameReport) {
   for (const char* effect : {"creep", "time_skew"}) {
     const auto fx = testing::MakeFixture({{effect, 8}}, 4, 200.0, kNoise, 4.0);
