@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 
 #include "diagnosis/lowpass_kernels.hpp"
 #include "diagnosis/signal.hpp"
@@ -146,20 +147,23 @@ void FirstOrderCoefficients(const double* t_s, std::size_t i0, std::size_t len, 
   }
 }
 
-/// The recursion over the rows of a chunk for B columns at once (their states in registers).
+/// The recursion over the rows of a chunk for B columns at once (their states in registers). Row i
+/// of column b is y[b][i − y_off] (y_off 0: whole columns; a stream's window otherwise).
 template <int B>
 void FirstOrderBlock(const FirstOrderChunk& k, std::size_t i0, std::size_t len,
-                     const double* const* x, double* const* y, const std::uint8_t* restart) {
+                     const double* const* x, double* const* y, std::ptrdiff_t y_off,
+                     const std::uint8_t* restart) {
   double yp[B];
   double xp[B];
+  const auto at = [&](std::size_t i) { return static_cast<std::ptrdiff_t>(i) - y_off; };
   for (int b = 0; b < B; ++b) {
-    yp[b] = y[b][i0 - 1];
+    yp[b] = y[b][at(i0 - 1)];
     xp[b] = x[b][i0 - 1];
   }
   for (std::size_t j = 0; j < len; ++j) {
     const std::size_t i = i0 + j;
     if (restart != nullptr && restart[i] != 0) {  // a new recording: at rest at its first input
-      for (int b = 0; b < B; ++b) y[b][i] = yp[b] = xp[b] = x[b][i];
+      for (int b = 0; b < B; ++b) y[b][at(i)] = yp[b] = xp[b] = x[b][i];
       continue;
     }
     const double a = k.a[j];
@@ -169,21 +173,42 @@ void FirstOrderBlock(const FirstOrderChunk& k, std::size_t i0, std::size_t len,
       const double xi = x[b][i];
       yp[b] = a * yp[b] + b0 * xi + b1 * xp[b];
       xp[b] = xi;
-      y[b][i] = yp[b];
+      y[b][at(i)] = yp[b];
     }
   }
 }
 
 /// FirstOrderBlock for 0 ≤ m < 8 columns.
 void FirstOrderBlocks(std::size_t m, const FirstOrderChunk& k, std::size_t i0, std::size_t len,
-                      const double* const* x, double* const* y, const std::uint8_t* restart) {
-  if (m == 7) FirstOrderBlock<7>(k, i0, len, x, y, restart);
-  if (m == 6) FirstOrderBlock<6>(k, i0, len, x, y, restart);
-  if (m == 5) FirstOrderBlock<5>(k, i0, len, x, y, restart);
-  if (m == 4) FirstOrderBlock<4>(k, i0, len, x, y, restart);
-  if (m == 3) FirstOrderBlock<3>(k, i0, len, x, y, restart);
-  if (m == 2) FirstOrderBlock<2>(k, i0, len, x, y, restart);
-  if (m == 1) FirstOrderBlock<1>(k, i0, len, x, y, restart);
+                      const double* const* x, double* const* y, std::ptrdiff_t y_off,
+                      const std::uint8_t* restart) {
+  if (m == 7) FirstOrderBlock<7>(k, i0, len, x, y, y_off, restart);
+  if (m == 6) FirstOrderBlock<6>(k, i0, len, x, y, y_off, restart);
+  if (m == 5) FirstOrderBlock<5>(k, i0, len, x, y, y_off, restart);
+  if (m == 4) FirstOrderBlock<4>(k, i0, len, x, y, y_off, restart);
+  if (m == 3) FirstOrderBlock<3>(k, i0, len, x, y, y_off, restart);
+  if (m == 2) FirstOrderBlock<2>(k, i0, len, x, y, y_off, restart);
+  if (m == 1) FirstOrderBlock<1>(k, i0, len, x, y, y_off, restart);
+}
+
+/// Rows [i_begin, i_end) (i_begin ≥ 1, i_begin − 1 a multiple of kChunk, so that every caller
+/// computes the coefficients over the same chunks and gets the same bits) of m columns, row i of
+/// column c at y[c][i − y_off]; row i_begin − 1 must be there already.
+// Flattened: every helper inlined, which the compiler does not do on its own here and which is
+// measurably faster (the loops are then compiled with what the caller knows).
+FTSTACK_LOWPASS_TARGETS [[gnu::flatten]] void FirstOrderRows(
+    const double* t_s, std::size_t i_begin, std::size_t i_end, double tau_s, const double* const* x,
+    double* const* y, std::ptrdiff_t y_off, std::size_t m, const std::uint8_t* restart,
+    FirstOrderChunk* k) {
+  for (std::size_t i0 = i_begin; i0 < i_end; i0 += kChunk) {
+    const std::size_t len = std::min(kChunk, i_end - i0);
+    FirstOrderCoefficients(t_s, i0, len, tau_s, k);
+    // All columns of a chunk in one pass (up to eight: every input and output stream at once is
+    // what the memory system likes best here).
+    std::size_t c = 0;
+    for (; c + 8 <= m; c += 8) FirstOrderBlock<8>(*k, i0, len, x + c, y + c, y_off, restart);
+    FirstOrderBlocks(m - c, *k, i0, len, x + c, y + c, y_off, restart);
+  }
 }
 
 }  // namespace
@@ -192,23 +217,55 @@ void FirstOrderLowPass(const double* t_s, const double* x, std::size_t n, double
   FirstOrderLowPassColumns(t_s, n, tau_s, &x, &y, 1);
 }
 
-// Flattened: every helper inlined, which the compiler does not do on its own here and which is
-// measurably faster (the loops are then compiled with what the caller knows).
-FTSTACK_LOWPASS_TARGETS [[gnu::flatten]] void FirstOrderLowPassColumns(
-    const double* t_s, std::size_t n, double tau_s, const double* const* x, double* const* y,
-    std::size_t m, const std::uint8_t* restart) {
+void FirstOrderLowPassColumns(const double* t_s, std::size_t n, double tau_s,
+                              const double* const* x, double* const* y, std::size_t m,
+                              const std::uint8_t* restart) {
   if (n == 0) return;
   for (std::size_t c = 0; c < m; ++c) y[c][0] = x[c][0];
   FirstOrderChunk k;
-  for (std::size_t i0 = 1; i0 < n; i0 += kChunk) {
-    const std::size_t len = std::min(kChunk, n - i0);
-    FirstOrderCoefficients(t_s, i0, len, tau_s, &k);
-    // All columns of a chunk in one pass (up to eight: every input and output stream at once is
-    // what the memory system likes best here).
-    std::size_t c = 0;
-    for (; c + 8 <= m; c += 8) FirstOrderBlock<8>(k, i0, len, x + c, y + c, restart);
-    FirstOrderBlocks(m - c, k, i0, len, x + c, y + c, restart);
+  FirstOrderRows(t_s, 1, n, tau_s, x, y, 0, m, restart, &k);
+}
+
+static_assert(FirstOrderLowPassStream::kRows % kChunk == 0, "windows must start on chunk bounds");
+
+struct FirstOrderLowPassStream::Coefficients {
+  FirstOrderChunk k;
+};
+
+FirstOrderLowPassStream::FirstOrderLowPassStream(const double* t_s, std::size_t n, double tau_s,
+                                                 const double* const* x, std::size_t m,
+                                                 const std::uint8_t* restart)
+    : t_s_(t_s),
+      n_(n),
+      tau_s_(tau_s),
+      x_(x, x + m),
+      restart_(restart),
+      buf_(m * (kRows + 2)),
+      y_(m),
+      k_(std::make_unique<Coefficients>()) {
+  for (std::size_t c = 0; c < m; ++c) y_[c] = buf_.data() + c * (kRows + 2);
+}
+
+FirstOrderLowPassStream::~FirstOrderLowPassStream() = default;
+
+bool FirstOrderLowPassStream::Next() {
+  if (next_ >= n_) return false;
+  const std::size_t m = x_.size();
+  // Slot 0 of a column holds row begin − 1 (the filter's state), slot s row begin − 1 + s.
+  if (next_ == 0) {
+    begin_ = 0;
+    for (std::size_t c = 0; c < m; ++c) y_[c][1] = x_[c][0];
+    next_ = 1;
+  } else {
+    begin_ = next_;
+    for (std::size_t c = 0; c < m; ++c) y_[c][0] = y_[c][size_];
   }
+  const std::size_t end = std::min(n_, next_ + kRows);
+  FirstOrderRows(t_s_, next_, end, tau_s_, x_.data(), y_.data(),
+                 static_cast<std::ptrdiff_t>(begin_) - 1, m, restart_, &k_->k);
+  size_ = end - begin_;
+  next_ = end;
+  return true;
 }
 
 }  // namespace ftstack::diag

@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "measurement/numerics.hpp"
@@ -57,6 +58,42 @@ void FirstOrderLowPass(const double* t_s, const double* x, std::size_t n, double
 void FirstOrderLowPassColumns(const double* t_s, std::size_t n, double tau_s,
                               const double* const* x, double* const* y, std::size_t m,
                               const std::uint8_t* restart = nullptr);
+/// FirstOrderLowPassColumns row window by row window, for consumers that read every row once
+/// (memory: kRows rows per column instead of n; the same bits as the whole columns):
+///   FirstOrderLowPassStream s(t, n, tau, x, m, restart);
+///   while (s.Next()) for (i = s.begin(); i < s.begin() + s.size(); ++i) … s.col(c)[i − s.begin()]
+class FirstOrderLowPassStream {
+ public:
+  /// Rows per window after the first (which has one more: row 0).
+  static constexpr std::size_t kRows = 4096;
+  FirstOrderLowPassStream(const double* t_s, std::size_t n, double tau_s, const double* const* x,
+                          std::size_t m, const std::uint8_t* restart = nullptr);
+  ~FirstOrderLowPassStream();
+  FirstOrderLowPassStream(const FirstOrderLowPassStream&) = delete;
+  FirstOrderLowPassStream& operator=(const FirstOrderLowPassStream&) = delete;
+  /// Filters the next window of rows; false after the last.
+  [[nodiscard]] bool Next();
+  /// First row of the current window, and its number of rows.
+  [[nodiscard]] std::size_t begin() const { return begin_; }
+  [[nodiscard]] std::size_t size() const { return size_; }
+  /// Column c's output over the window: col(c)[j] is row begin() + j.
+  [[nodiscard]] const double* col(std::size_t c) const { return y_[c] + 1; }
+
+ private:
+  struct Coefficients;
+  const double* t_s_;
+  std::size_t n_;
+  double tau_s_;
+  std::vector<const double*> x_;
+  const std::uint8_t* restart_;
+  std::vector<double> buf_;
+  std::vector<double*> y_;
+  std::unique_ptr<Coefficients> k_;
+  std::size_t next_ = 0;
+  std::size_t begin_ = 0;
+  std::size_t size_ = 0;
+};
+
 /// Second-order low pass ÿ + 2ζω ẏ + ω² y = ω² x (ω = 2π·freq_hz), unit DC gain, exact for inputs
 /// linear between samples; starts at rest at the first input value.
 void SecondOrderLowPass(const double* t_s, const double* x, std::size_t n, double freq_hz,

@@ -78,13 +78,12 @@ Vec PutChannelCoef(const Context& cx, const ChannelFit& f, int j, const char* ke
   return v;
 }
 
-/// Whitened training SSE of a one-coefficient-per-channel fit of `feature` (n × N), on every
-/// search_stride-th row and scaled back to the full count: the objective of parameter searches.
-double SearchSse(const Context& cx, const Mat& target, const Mat& feature) {
+double SearchSse(const Context& cx, const Mat& target, const Mat& feature, bool compact) {
   // FitChannels with one feature, unrolled: the sums of NormalEq::Add with unit weight and the
   // arithmetic of NormalEq::Solve for p = 1 (Jacobi scaling, 1e-12 on the scaled diagonal), so the
   // value is the same to the last bit, without a per-row call or a covariance per channel.
   const int st = cx.search_stride;
+  const int step = compact ? 1 : st;  // feature rows per searched row
   double sse_w = 0.0;
   for (int c = 0; c < cx.nc; ++c) {
     const double* x = feature.col(c).data();
@@ -92,10 +91,10 @@ double SearchSse(const Context& cx, const Mat& target, const Mat& feature) {
     double sxx = 0.0;
     double sxy = 0.0;
     double syy = 0.0;
-    for (int i = 0; i < cx.n; i += st) {
+    for (int i = 0, r = 0; i < cx.n; i += st, r += step) {
       if (!cx.train[static_cast<std::size_t>(i)]) continue;
-      sxy += x[i] * y[i];
-      sxx += x[i] * x[i];
+      sxy += x[r] * y[i];
+      sxx += x[r] * x[r];
       syy += y[i] * y[i];
     }
     const double d = sxx > 0 ? 1.0 / std::sqrt(sxx) : 1.0;
@@ -105,6 +104,46 @@ double SearchSse(const Context& cx, const Mat& target, const Mat& feature) {
     sse_w += std::max(0.0, syy - beta * sxy) * cx.weight(c);
   }
   return sse_w * st;
+}
+
+std::vector<int> StrideRows(const Context& cx) {
+  std::vector<int> rows;
+  for (int i = 0; i < cx.n; i += cx.search_stride) rows.push_back(i);
+  return rows;
+}
+
+void LowPassLoadRows(const Context& cx, double tau, const std::vector<int>& rows, Mat* out) {
+  std::vector<const double*> in;
+  for (int c = 0; c < cx.nc; ++c) in.push_back(cx.load.col(c).data());
+  out->resize(static_cast<Eigen::Index>(rows.size()), cx.nc);
+  FirstOrderLowPassStream s(cx.data->t_s.data(), static_cast<std::size_t>(cx.n), tau, in.data(),
+                            in.size(), Restarts(cx));
+  std::size_t r = 0;
+  while (s.Next() && r < rows.size()) {
+    const auto end = s.begin() + s.size();
+    for (; r < rows.size() && static_cast<std::size_t>(rows[r]) < end; ++r) {
+      const std::size_t j = static_cast<std::size_t>(rows[r]) - s.begin();
+      for (int c = 0; c < cx.nc; ++c) {
+        (*out)(static_cast<Eigen::Index>(r), c) = s.col(static_cast<std::size_t>(c))[j];
+      }
+    }
+  }
+}
+
+ChannelFit ChannelSums::Solve(const Context& cx) const {
+  const int p = eq_.empty() ? 0 : eq_.front().p();
+  ChannelFit out;
+  out.beta = Mat::Zero(p, cx.nc);
+  out.cov.assign(static_cast<std::size_t>(cx.nc), Mat::Zero(p, p));
+  out.sse = Vec::Zero(cx.nc);
+  for (int c = 0; c < cx.nc; ++c) {
+    const auto r = eq_[static_cast<std::size_t>(c)].Solve();
+    out.beta.col(c) = r.beta;
+    out.cov[static_cast<std::size_t>(c)] = r.cov_unit;
+    out.sse(c) = r.sse;
+    out.sse_w += r.sse * cx.weight(c);
+  }
+  return out;
 }
 
 /// Channel whose prediction carries the largest whitened energy.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -124,9 +125,64 @@ std::optional<EffectFit> RefitBy(const Context& cx, const Mat& target, const Eff
                                  bool uncertainty) {
   return Search(cx, target, &near, uncertainty);
 }
-/// Whitened training SSE of a one-coefficient-per-channel fit of `feature` (n × N), on every
+/// Restart flags of the context's segments for the filters (nullptr for one recording).
+const std::uint8_t* Restarts(const Context& cx);
+/// Whitened training SSE of a one-coefficient-per-channel fit of `feature`, on every
 /// search_stride-th row and scaled back to the full count: the objective of parameter searches.
-double SearchSse(const Context& cx, const Mat& target, const Mat& feature);
+/// `feature` is n × N, or compact (`compact`: its row r is row r·search_stride, StrideRows).
+double SearchSse(const Context& cx, const Mat& target, const Mat& feature, bool compact = false);
+/// Rows 0, st, 2·st, … below cx.n for st = cx.search_stride: the rows a search reads, and the rows
+/// of a compact search buffer (row i is at i / st).
+std::vector<int> StrideRows(const Context& cx);
+/// out(r, c) = LP_τ[load_c] at row rows[r] (rows increasing): the first-order lag of the load,
+/// restarting per segment, kept only at `rows` (memory: rows × N instead of n × N; the same values
+/// as the whole filter).
+void LowPassLoadRows(const Context& cx, double tau, const std::vector<int>& rows, Mat* out);
+
+/// Streams the first-order lags of the load LP_τ[load] (restarting per segment) for the k time
+/// constants taus[0..k) over every row: visit(i, c, lag) with lag[q] the lag of τ_q at row i,
+/// channel c; per channel the rows come in increasing order (memory: windows of rows, not n × N).
+template <class F>
+void ForLaggedLoad(const Context& cx, const double* taus, int k, F visit) {
+  std::vector<const double*> in;
+  for (int c = 0; c < cx.nc; ++c) in.push_back(cx.load.col(c).data());
+  std::vector<std::unique_ptr<FirstOrderLowPassStream>> s;
+  for (int q = 0; q < k; ++q) {
+    s.push_back(std::make_unique<FirstOrderLowPassStream>(cx.data->t_s.data(),
+                                                          static_cast<std::size_t>(cx.n), taus[q],
+                                                          in.data(), in.size(), Restarts(cx)));
+  }
+  std::vector<double> lag(static_cast<std::size_t>(k));
+  for (;;) {
+    bool more = true;
+    for (auto& q : s) more = q->Next() && more;  // every stream has the same windows
+    if (!more) return;
+    const std::size_t b = s.front()->begin();
+    for (int c = 0; c < cx.nc; ++c) {
+      for (std::size_t j = 0; j < s.front()->size(); ++j) {
+        for (int q = 0; q < k; ++q) {
+          lag[static_cast<std::size_t>(q)] =
+              s[static_cast<std::size_t>(q)]->col(static_cast<std::size_t>(c))[j];
+        }
+        visit(static_cast<int>(b + j), c, lag.data());
+      }
+    }
+  }
+}
+
+/// FitChannels' normal equations for features that arrive row window by row window (streamed
+/// filters, FirstOrderLowPassStream): Add rows of one channel in increasing order, then Solve. The
+/// same sums in the same order per channel as FitChannels over every row, so the same fit.
+class ChannelSums {
+ public:
+  ChannelSums(const Context& cx, int p) : eq_(static_cast<std::size_t>(cx.nc), NormalEq(p)) {}
+  void Add(int c, const double* x, double y) { eq_[static_cast<std::size_t>(c)].Add(x, y); }
+  /// The fit of every channel (FitChannels with all channels active), without a prediction.
+  [[nodiscard]] ChannelFit Solve(const Context& cx) const;
+
+ private:
+  std::vector<NormalEq> eq_;
+};
 /// 0, 1, …, cx.nc − 1.
 inline std::vector<int> AllChannels(const Context& cx) {
   std::vector<int> all(static_cast<std::size_t>(cx.nc));
@@ -172,9 +228,6 @@ HatBasis MakeHat(const Context& cx, int k);
 /// Lines of r's Welch spectra, whitened and summed over channels: local maxima (from the 4th bin)
 /// over 4 × the median level, strongest first, as (level / median level, frequency in Hz).
 std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Mat& r);
-
-/// Restart flags of the context's segments for the filters (nullptr for one recording).
-const std::uint8_t* Restarts(const Context& cx);
 
 // The effect models (one family per file of diagnosis/effects/).
 std::optional<EffectFit> FitZeroOffset(const Context& cx, const Mat& target);

@@ -81,32 +81,25 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const
   }
   const auto& d = *cx.data;
   const double duration = d.t_s.back() - d.t_s.front();
-  Mat lp(cx.n, cx.nc);
-  std::vector<const double*> in_cols;
-  std::vector<double*> out_cols;
-  for (int c = 0; c < cx.nc; ++c) {
-    in_cols.push_back(cx.load.col(c).data());
-    out_cols.push_back(lp.col(c).data());
-  }
-  auto build = [&](double tau) {
-    FirstOrderLowPassColumns(d.t_s.data(), static_cast<std::size_t>(cx.n), tau, in_cols.data(),
-                             out_cols.data(), in_cols.size(), Restarts(cx));
-  };
+  // The searches read every search_stride-th row: the lagged load is kept only there (memory: a
+  // compact buffer instead of n × N); the final fits stream it over every row.
+  const std::vector<int> rows = StrideRows(cx);
+  const int st = cx.search_stride;
+  Mat lp;
   auto sse_for = [&](double log_tau, bool gamma) {
-    build(std::exp(log_tau));
-    const int st = cx.search_stride;
+    LowPassLoadRows(cx, std::exp(log_tau), rows, &lp);
     if (gamma) {
       return FitChannels(
                  cx, target, 2,
                  [&](int i, int c, double* x) {
-                   x[0] = lp(i, c);
+                   x[0] = lp(i / st, c);
                    x[1] = cx.load(i, c);
                  },
                  nullptr, nullptr, st)
                  .sse_w *
              st;
     }
-    return SearchSse(cx, target, lp);
+    return SearchSse(cx, target, lp, true);
   };
   std::vector<double> grid;
   const double lo = std::log(std::max(3.0 * cx.dt, 0.2));
@@ -120,29 +113,28 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const
       std::isfinite(LogParam(near, "tau_s")) ? LogParam(near, "tau_s") : LogParam(near, "tau1_s");
   const double lt =
       WindowOrGrid([&](double v) { return sse_for(v, false); }, near_lt, grid, lo, hi);
+  const double tau = std::exp(lt);
+  // Both variants' fits over every row in one streamed pass of LP_τ[load].
+  ChannelSums sums[2] = {ChannelSums(cx, 1), ChannelSums(cx, 2)};
+  ForLaggedLoad(cx, &tau, 1, [&](int i, int c, const double* lag) {
+    if (!cx.train[static_cast<std::size_t>(i)]) return;
+    const double x[2] = {lag[0], cx.load(i, c)};
+    sums[0].Add(c, x, target(i, c));
+    sums[1].Add(c, x, target(i, c));
+  });
   for (bool gamma : {false, true}) {
     const int p = cx.nc * (gamma ? 2 : 1) + 1;
     EffectFit e;
     e.name = "creep";
     e.variant = gamma ? "first-order creep with a gain term" : "first-order creep";
     e.n_params = p;
-    const double tau = std::exp(lt);
     const double sl = uncertainty
                           ? CurvatureSigma([&](double v) { return sse_for(v, gamma); }, lt, 0.02)
                           : std::numeric_limits<double>::quiet_NaN();
-    build(tau);
-    const auto feat_gamma = [&](int i, int c, double* x) {
-      x[0] = lp(i, c);
-      x[1] = cx.load(i, c);
-    };
-    const auto feat_plain = [&](int i, int c, double* x) { x[0] = lp(i, c); };
-    // The prediction only for the variant kept (memory: one n × N prediction at a time).
-    const ChannelFit f = gamma ? FitChannels(cx, target, 2, feat_gamma, nullptr)
-                               : FitChannels(cx, target, 1, feat_plain, nullptr);
+    const ChannelFit f = sums[gamma ? 1 : 0].Solve(cx);
     e.train_sse_w = f.sse_w;
     const double bic = f.sse_w + p * Penalty(cx);
     if (bic >= best_bic) continue;
-    best.pred = Mat();  // the kept variant's prediction is made after the loop, over lp
     best_bic = bic;
     e.params["tau_s"] = tau;
     e.sigma["tau_s"] = JsonNum(tau * sl);
@@ -151,17 +143,15 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const
     best_f = f;
     best_gamma = gamma;
   }
-  // lp holds LP_τ[load] (every variant ended with build(τ)): the kept variant's prediction is
-  // written over it (memory: one n × N buffer less); the two-τ search filters into buffers of its
-  // own.
-  PredictChannels(
-      cx, best_f, best_gamma ? 2 : 1,
-      [&](int i, int c, double* x) {
-        x[0] = lp(i, c);
-        if (best_gamma) x[1] = cx.load(i, c);
-      },
-      &lp);
-  best.pred = std::move(lp);
+  lp = Mat();
+  // The kept variant's prediction, streamed (PredictChannels' sums).
+  best.pred.resize(cx.n, cx.nc);
+  ForLaggedLoad(cx, &tau, 1, [&](int i, int c, const double* lag) {
+    double v = 0.0;
+    v += best_f.beta(0, c) * lag[0];
+    if (best_gamma) v += best_f.beta(1, c) * cx.load(i, c);
+    best.pred(i, c) = v;
+  });
   taus = {std::exp(lt)};
   tau_sigmas = {best.sigma["tau_s"].is_number() ? best.sigma["tau_s"].get<double>() : 0.0};
   // The two-τ variant: searched in full alone, not in a refit (a refit keeps the variant class its

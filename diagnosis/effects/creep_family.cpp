@@ -12,58 +12,26 @@
 namespace ftstack::diag::fx {
 namespace {
 
-/// out = LP_τ[load] per channel (first-order lag, restarting per segment).
-void LowPassLoad(const Context& cx, double tau, Mat* out) {
-  std::vector<const double*> in;
-  std::vector<double*> o;
-  for (int c = 0; c < cx.nc; ++c) {
-    in.push_back(cx.load.col(c).data());
-    o.push_back(out->col(c).data());
-  }
-  FirstOrderLowPassColumns(cx.data->t_s.data(), static_cast<std::size_t>(cx.n), tau, in.data(),
-                           o.data(), in.size(), Restarts(cx));
-}
-
-/// Per-channel fit of target ≈ a1·lp1 + a2·lp2 (+ γ·load); whitened SSE (strided when st > 1).
-ChannelFit FitTwo(const Context& cx, const Mat& target, const Mat& lp1, const Mat& lp2, bool gamma,
-                  Mat* pred, int st) {
-  if (!gamma) {
-    return FitChannels(
-        cx, target, 2,
-        [&](int i, int c, double* x) {
-          x[0] = lp1(i, c);
-          x[1] = lp2(i, c);
-        },
-        pred, nullptr, st);
-  }
+/// Per-channel fit of target ≈ a1·lp1 + a2·lp2 on every search_stride-th training row, lp1 and
+/// lp2 compact (row i at i / search_stride: LowPassLoadRows on StrideRows); whitened SSE scaled
+/// to the full count.
+double SearchTwo(const Context& cx, const Mat& target, const Mat& lp1, const Mat& lp2) {
+  const int st = cx.search_stride;
   return FitChannels(
-      cx, target, 3,
-      [&](int i, int c, double* x) {
-        x[0] = lp1(i, c);
-        x[1] = lp2(i, c);
-        x[2] = cx.load(i, c);
-      },
-      pred, nullptr, st);
-}
-
-/// The prediction of a FitTwo fit (the same sums FitChannels would have filled in); `pred` may be
-/// &lp1 (PredictChannels reads each element before it writes it).
-void PredictTwo(const Context& cx, const ChannelFit& f, const Mat& lp1, const Mat& lp2, bool gamma,
-                Mat* pred) {
-  PredictChannels(
-      cx, f, gamma ? 3 : 2,
-      [&](int i, int c, double* x) {
-        x[0] = lp1(i, c);
-        x[1] = lp2(i, c);
-        if (gamma) x[2] = cx.load(i, c);
-      },
-      pred);
+             cx, target, 2,
+             [&](int i, int c, double* x) {
+               x[0] = lp1(i / st, c);
+               x[1] = lp2(i / st, c);
+             },
+             nullptr, nullptr, st)
+             .sse_w *
+         st;
 }
 
 /// Coarse 2-D search of (log τ1 < log τ2) over pairs of a 13-point log grid on [lo, hi]: every grid
-/// τ filtered once (into buf) and only its strided training rows kept (at most ~20 000), so every
-/// pair costs a 2 × 2 solve per channel on those rows.
-void CoarsePair(const Context& cx, const Mat& target, double lo, double hi, Mat* buf, double* l1,
+/// τ filtered once and only its strided training rows kept (at most ~20 000), so every pair costs
+/// a 2 × 2 solve per channel on those rows.
+void CoarsePair(const Context& cx, const Mat& target, double lo, double hi, double* l1,
                 double* l2) {
   // At most ~20 000 rows per grid column: the coarse pair only has to land in the right basin.
   const int st = std::max(cx.search_stride, static_cast<int>(cx.n_train / 20000));
@@ -74,11 +42,8 @@ void CoarsePair(const Context& cx, const Mat& target, double lo, double hi, Mat*
     if (cx.train[static_cast<std::size_t>(i)]) rows.push_back(i);
   }
   const auto m = static_cast<Eigen::Index>(rows.size());
-  std::vector<Mat> g(grid.size(), Mat(m, cx.nc));
-  for (std::size_t j = 0; j < grid.size(); ++j) {
-    LowPassLoad(cx, std::exp(grid[j]), buf);
-    for (Eigen::Index r = 0; r < m; ++r) g[j].row(r) = buf->row(rows[static_cast<std::size_t>(r)]);
-  }
+  std::vector<Mat> g(grid.size());
+  for (std::size_t j = 0; j < grid.size(); ++j) LowPassLoadRows(cx, std::exp(grid[j]), rows, &g[j]);
   Mat y(m, cx.nc);
   for (Eigen::Index r = 0; r < m; ++r) y.row(r) = target.row(rows[static_cast<std::size_t>(r)]);
   double coarse = std::numeric_limits<double>::infinity();
@@ -104,6 +69,65 @@ void CoarsePair(const Context& cx, const Mat& target, double lo, double hi, Mat*
       }
     }
   }
+}
+
+/// The time constants of the two-τ model, (log τ1 < log τ2) in [lo, hi]: CoarsePair (or `start`,
+/// a refit's pair) then golden refinements of each in turn; *sl1, *sl2 their 1-σ in log τ (NaN
+/// without `uncertainty`).
+void SearchPair(const Context& cx, const Mat& target, double log_tau1, double lo, double hi,
+                const double* start, bool uncertainty, double* l1_out, double* l2_out, double* sl1,
+                double* sl2) {
+  // The searches keep the lagged loads only at the rows they read (compact, StrideRows); the
+  // final fits and the prediction stream them over every row (memory: no n × N buffer but the
+  // prediction).
+  const std::vector<int> rows = StrideRows(cx);
+  Mat lp1;
+  Mat lp2;
+  double& l1 = *l1_out;
+  double& l2 = *l2_out;
+  l1 = log_tau1;
+  l2 = 0.0;
+  auto sse2 = [&](double v) {  // τ2 varies, lp1 held
+    LowPassLoadRows(cx, std::exp(v), rows, &lp2);
+    return SearchTwo(cx, target, lp1, lp2);
+  };
+  auto sse1 = [&](double v) {  // τ1 varies, lp2 held
+    LowPassLoadRows(cx, std::exp(v), rows, &lp1);
+    return SearchTwo(cx, target, lp1, lp2);
+  };
+  if (start != nullptr) {
+    l1 = std::clamp(std::min(start[0], start[1]), lo, hi);
+    l2 = std::clamp(std::max(start[0], start[1]), lo, hi);
+  } else {
+    CoarsePair(cx, target, lo, hi, &l1, &l2);
+  }
+  // Refinement: τ2 with τ1 held, τ1 with τ2 held, τ2 again (golden section between neighbours).
+  const double step = (hi - lo) / 12.0;
+  auto around = [&](double v, double other) {
+    std::vector<double> out;
+    for (int j = -2; j <= 2; ++j) {
+      const double x = v + 0.5 * step * j;
+      if (std::fabs(x - other) > 0.2 && x >= lo && x <= hi) out.push_back(x);
+    }
+    return out;
+  };
+  // From a refit's start: τ2 then τ1 once each, with fewer golden steps.
+  const int rounds = start != nullptr ? 2 : 3;
+  const int golden = start != nullptr ? 6 : 8;
+  for (int round = 0; round < rounds; ++round) {
+    const bool second = round != 1;
+    LowPassLoadRows(cx, std::exp(second ? l1 : l2), rows, second ? &lp1 : &lp2);
+    const auto gr = around(second ? l2 : l1, second ? l1 : l2);
+    if (gr.size() < 3) continue;
+    (second ? l2 : l1) = MinimizeOnGrid(
+        second ? std::function<double(double)>(sse2) : std::function<double(double)>(sse1), gr,
+        golden, nullptr);
+  }
+  if (l2 < l1) std::swap(l1, l2);
+  LowPassLoadRows(cx, std::exp(l1), rows, &lp1);
+  *sl2 = uncertainty ? CurvatureSigma(sse2, l2, 0.02) : std::numeric_limits<double>::quiet_NaN();
+  LowPassLoadRows(cx, std::exp(l2), rows, &lp2);
+  *sl1 = uncertainty ? CurvatureSigma(sse1, l1, 0.02) : std::numeric_limits<double>::quiet_NaN();
 }
 
 }  // namespace
@@ -183,58 +207,23 @@ bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double b
   // offset over the record (seen with zero_offset + creep): the pair search stops there.
   const double hi = std::log(std::max(duration / 3.0, 1.0));
   if (hi - lo < 1.0) return false;
-  const int st = cx.search_stride;
-  Mat lp1(cx.n, cx.nc);
-  Mat lp2(cx.n, cx.nc);
-  double l1 = log_tau1;
+  double l1 = 0.0;
   double l2 = 0.0;
-  auto sse2 = [&](double v) {  // τ2 varies, lp1 held
-    LowPassLoad(cx, std::exp(v), &lp2);
-    return FitTwo(cx, target, lp1, lp2, false, nullptr, st).sse_w * st;
-  };
-  auto sse1 = [&](double v) {  // τ1 varies, lp2 held
-    LowPassLoad(cx, std::exp(v), &lp1);
-    return FitTwo(cx, target, lp1, lp2, false, nullptr, st).sse_w * st;
-  };
-  if (start != nullptr) {
-    l1 = std::clamp(std::min(start[0], start[1]), lo, hi);
-    l2 = std::clamp(std::max(start[0], start[1]), lo, hi);
-  } else {
-    CoarsePair(cx, target, lo, hi, &lp2, &l1, &l2);
-  }
-  // Refinement: τ2 with τ1 held, τ1 with τ2 held, τ2 again (golden section between neighbours).
-  const double step = (hi - lo) / 12.0;
-  auto around = [&](double v, double other) {
-    std::vector<double> out;
-    for (int j = -2; j <= 2; ++j) {
-      const double x = v + 0.5 * step * j;
-      if (std::fabs(x - other) > 0.2 && x >= lo && x <= hi) out.push_back(x);
-    }
-    return out;
-  };
-  // From a refit's start: τ2 then τ1 once each, with fewer golden steps.
-  const int rounds = start != nullptr ? 2 : 3;
-  const int golden = start != nullptr ? 6 : 8;
-  for (int round = 0; round < rounds; ++round) {
-    const bool second = round != 1;
-    LowPassLoad(cx, std::exp(second ? l1 : l2), second ? &lp1 : &lp2);
-    const auto gr = around(second ? l2 : l1, second ? l1 : l2);
-    if (gr.size() < 3) continue;
-    (second ? l2 : l1) = MinimizeOnGrid(
-        second ? std::function<double(double)>(sse2) : std::function<double(double)>(sse1), gr,
-        golden, nullptr);
-  }
-  if (l2 < l1) std::swap(l1, l2);
-  LowPassLoad(cx, std::exp(l1), &lp1);
-  const double sl2 =
-      uncertainty ? CurvatureSigma(sse2, l2, 0.02) : std::numeric_limits<double>::quiet_NaN();
-  LowPassLoad(cx, std::exp(l2), &lp2);
-  const double sl1 =
-      uncertainty ? CurvatureSigma(sse1, l1, 0.02) : std::numeric_limits<double>::quiet_NaN();
-  LowPassLoad(cx, std::exp(l1), &lp1);
+  double sl1 = 0.0;
+  double sl2 = 0.0;
+  SearchPair(cx, target, log_tau1, lo, hi, start, uncertainty, &l1, &l2, &sl1, &sl2);
   // Two exponentials closer than a factor 3 in τ are not resolved by the data (their fractions
   // trade against each other, often with opposite signs: seen on ftsim's creep with drift).
   if (l2 - l1 < std::log(3.0)) return false;
+  // Both variants' fits over every row in one streamed pass of the two lags.
+  const double t12[2] = {std::exp(l1), std::exp(l2)};
+  ChannelSums sums[2] = {ChannelSums(cx, 2), ChannelSums(cx, 3)};
+  ForLaggedLoad(cx, t12, 2, [&](int i, int c, const double* lag) {
+    if (!cx.train[static_cast<std::size_t>(i)]) return;
+    const double x[3] = {lag[0], lag[1], cx.load(i, c)};
+    sums[0].Add(c, x, target(i, c));
+    sums[1].Add(c, x, target(i, c));
+  });
   bool won = false;
   for (bool gamma : {false, true}) {
     const int p = cx.nc * (gamma ? 3 : 2) + 2;
@@ -242,7 +231,7 @@ bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double b
     e.name = "creep";
     e.variant = gamma ? "two-time-constant creep with a gain term" : "two-time-constant creep";
     e.n_params = p;
-    const ChannelFit f = FitTwo(cx, target, lp1, lp2, gamma, nullptr, 1);
+    const ChannelFit f = sums[gamma ? 1 : 0].Solve(cx);
     e.train_sse_w = f.sse_w;
     const double bic = f.sse_w + p * Penalty(cx);
     if (bic >= best_bic) continue;
@@ -257,9 +246,8 @@ bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double b
     }
     if (std::min(amp[0], amp[1]) < 0.01 * std::max(amp[0], amp[1])) continue;
     best_bic = bic;
-    best->pred = Mat();  // replaced after the loop, over lp1: one n × N prediction at a time
-    const double t1 = std::exp(l1);
-    const double t2 = std::exp(l2);
+    const double t1 = t12[0];
+    const double t2 = t12[1];
     e.params["tau1_s"] = t1;
     e.sigma["tau1_s"] = JsonNum(t1 * sl1);
     e.params["tau2_s"] = t2;
@@ -273,9 +261,17 @@ bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double b
     *best = std::move(e);
     won = true;
   }
-  if (won) {  // over lp1: one n × N buffer less
-    PredictTwo(cx, *best_f, lp1, lp2, *best_gamma, &lp1);
-    best->pred = std::move(lp1);
+  if (won) {  // streamed (PredictChannels' sums): one n × N prediction
+    const ChannelFit& f = *best_f;
+    const bool gamma = *best_gamma;
+    best->pred.resize(cx.n, cx.nc);
+    ForLaggedLoad(cx, t12, 2, [&](int i, int c, const double* lag) {
+      double v = 0.0;
+      v += f.beta(0, c) * lag[0];
+      v += f.beta(1, c) * lag[1];
+      if (gamma) v += f.beta(2, c) * cx.load(i, c);
+      best->pred(i, c) = v;
+    });
   }
   return won;
 }

@@ -262,5 +262,55 @@ TEST(DiagLowPass, VectorKernelsAgreeWithLibm) {
   EXPECT_LT(worst_trig, 5e-16);
 }
 
+/// A long gappy record (several stream windows): seven GappyRecord clocks end to end, restarts
+/// also at a window's first row and the row before it.
+Record LongRecord() {
+  const Record one = GappyRecord();
+  Record rec;
+  double offset = 0.0;
+  for (int k = 0; k < 7; ++k) {
+    for (std::size_t i = 0; i < one.t.size(); ++i) {
+      rec.t.push_back(one.t[i] + offset);
+      rec.restart.push_back(k > 0 && i == 0 ? 0 : one.restart[i]);
+    }
+    offset = rec.t.back() + 0.01;
+  }
+  const std::size_t w = FirstOrderLowPassStream::kRows;
+  rec.restart[w] = 1;
+  rec.restart[2 * w + 1] = 1;
+  AddInputs(&rec);
+  return rec;
+}
+
+TEST(DiagLowPass, FirstOrderStreamGivesTheWholeColumnsBitForBit) {
+  const Record rec = LongRecord();
+  const std::size_t w = FirstOrderLowPassStream::kRows;
+  for (std::size_t n : {std::size_t{1}, std::size_t{2}, w, w + 1, w + 2, rec.t.size()}) {
+    for (double tau : {0.003, 0.3, 1000.0}) {
+      std::vector<std::vector<double>> whole(3, std::vector<double>(n));
+      const double* in[3] = {rec.x[0].data(), rec.x[1].data(), rec.x[2].data()};
+      double* out[3] = {whole[0].data(), whole[1].data(), whole[2].data()};
+      FirstOrderLowPassColumns(rec.t.data(), n, tau, in, out, 3, rec.restart.data());
+      FirstOrderLowPassStream s(rec.t.data(), n, tau, in, 3, rec.restart.data());
+      std::size_t seen = 0;
+      int windows = 0;
+      while (s.Next()) {
+        ASSERT_EQ(s.begin(), seen);
+        ++windows;
+        for (std::size_t j = 0; j < s.size(); ++j, ++seen) {
+          for (std::size_t c = 0; c < 3; ++c) {
+            ASSERT_EQ(s.col(c)[j], whole[c][seen])
+                << "n " << n << " tau " << tau << " row " << seen;
+          }
+        }
+      }
+      EXPECT_EQ(seen, n);
+      // The first window has w + 1 rows (row 0 and a full window), the others w.
+      EXPECT_EQ(windows, static_cast<int>(std::max<std::size_t>(1, (n - 1 + w - 1) / w))) << n;
+      EXPECT_FALSE(s.Next());
+    }
+  }
+}
+
 }  // namespace
 }  // namespace ftstack::diag
