@@ -43,24 +43,33 @@ Mat Remainder(const Mat& target, const Scored& start) {
 /// its prediction), then A on target − B. Every fit starts from the effect's previous one
 /// (FitNear; B's first from b_near, its fit to what A0 leaves). The first pass's fits skip the
 /// parameters' uncertainties: only the second pass's fits are kept (and reported).
+/// Memory: each remainder is formed in the memory of the prediction it removes (target − p in
+/// place), so a fit holds one n × N remainder and no other prediction. The last B's prediction is
+/// restored from its remainder afterwards, target − (target − p): p to within an ulp of the
+/// target.
 bool FitPair(const Context& cx, const Mat& target, const EffectSpec& a, const EffectSpec& b,
              const EffectFit& a0, Mat a0_rest, const EffectFit* b_near, EffectFit* fa,
              EffectFit* fb) {
   const EffectFit* first = &a0;
   for (int it = 0; it < 2; ++it) {
-    fb->pred = Mat();  // memory: the previous B is replaced; only `first` is used now
-    Mat rest = it == 0 ? std::move(a0_rest) : Mat(target - first->pred);
-    // Memory: the previous A is refitted below (near its parameters); its prediction lives on
-    // in `rest` until B is fitted.
-    if (first == fa) fa->pred = Mat();
+    fb->pred = Mat();  // the previous B is replaced; only `first` is used now
+    Mat rest;
+    if (it == 0) {
+      rest = std::move(a0_rest);
+    } else {  // the previous A is refitted below (near its parameters)
+      fa->pred = target - fa->pred;
+      rest = std::move(fa->pred);
+    }
     auto nb = FitNear(b, cx, rest, it == 0 ? b_near : fb, it == 1);
     rest = Mat();
     if (!nb) return false;
     *fb = std::move(*nb);
-    auto na = FitNear(a, cx, target - fb->pred, first, it == 1);
+    fb->pred = target - fb->pred;  // now A's remainder
+    auto na = FitNear(a, cx, fb->pred, first, it == 1);
     if (!na) return false;
     *fa = std::move(*na);
     first = fa;
+    if (it == 1) fb->pred = target - fb->pred;
   }
   return true;
 }
@@ -316,27 +325,53 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Sco
   }
   std::mutex mu;
   std::size_t done = 0;
+  // Memory: a start's prediction is released once its last pair is done (the best single's only
+  // when a pair has won: else it may be claimed alone), and the leading pair's predictions are
+  // held in single precision until the stage ends (6e-8 relative, far below any recording's
+  // noise), as the other starts are.
+  std::vector<std::size_t> left(top.size(), 0);
+  for (const auto& [t, y] : pairs) ++left[t];
+  Eigen::MatrixXf pa_f;
+  Eigen::MatrixXf pb_f;
+  const auto release = [&](std::size_t t) {
+    if (top[t] == 0 && !have_pair) return;
+    singles[top[t]].fit.pred = Mat();
+    singles[top[t]].pred_f = Eigen::MatrixXf();
+  };
   ParallelFor(pairs.size(), ResolveThreads(options.threads), [&](std::size_t k) {
     const auto [t, y] = pairs[k];
     auto p = TryPair(cx, options, singles[top[t]], &partners[t][y], base, best.score);
     const std::lock_guard<std::mutex> lock(mu);
     Progress(options, 0.85 + 0.13 * static_cast<double>(++done) / static_cast<double>(pairs.size()),
              "pairs: backfits");
-    if (!p || !p->won) return;
+    --left[t];
     // The best qualifying pair wins; of equal scores the earlier start and better partner (as a
     // sequential search would keep).
     const std::size_t order = t * kPairPartners + y;
-    if (p->score > pair_score || (have_pair && p->score == pair_score && order < win_order)) {
+    if (p && p->won &&
+        (p->score > pair_score || (have_pair && p->score == pair_score && order < win_order))) {
       pair_score = p->score;
       win_order = order;
+      pa_f = p->fa.pred.cast<float>();
+      pb_f = p->fb.pred.cast<float>();
+      p->fa.pred = Mat();
+      p->fb.pred = Mat();
       *pa = std::move(p->fa);
       *pb = std::move(p->fb);
       have_pair = true;
     }
+    p.reset();
+    for (std::size_t u = 0; u < top.size(); ++u) {
+      if (left[u] == 0) release(u);
+    }
   });
-  // Memory: the starts other than the best single are not used again.
   for (std::size_t x : top) {
     if (x != 0) singles[x].pred_f = Eigen::MatrixXf();
+  }
+  if (have_pair) {
+    pa->pred = pa_f.cast<double>();
+    pa_f = Eigen::MatrixXf();
+    pb->pred = pb_f.cast<double>();
   }
   return have_pair;
 }
