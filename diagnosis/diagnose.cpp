@@ -27,10 +27,17 @@ double ChiSquareZ(double x, double nu) {
   return (std::cbrt(x / nu) - (1.0 - a)) / std::sqrt(a);
 }
 
-Vec ChannelRms(const Mat& m) {
-  Vec v(m.cols());
-  for (Eigen::Index c = 0; c < m.cols(); ++c)
-    v(c) = std::sqrt(m.col(c).squaredNorm() / static_cast<double>(m.rows()));
+/// RMS per channel of a − b (b nullptr: of a), accumulated in double.
+Vec ChannelRms(const Series& a, const Series* b = nullptr) {
+  Vec v(a.cols());
+  for (Eigen::Index c = 0; c < a.cols(); ++c) {
+    double s = 0.0;
+    for (Eigen::Index i = 0; i < a.rows(); ++i) {
+      const double e = static_cast<double>(a(i, c)) - (b != nullptr ? (*b)(i, c) : 0.0f);
+      s += e * e;
+    }
+    v(c) = std::sqrt(s / static_cast<double>(a.rows()));
+  }
   return v;
 }
 
@@ -48,7 +55,7 @@ void LocateChannels(Report& r, int m, int blocks) {
       const double mean = s / (i1 - i0);
       xlow += mean * mean * (i1 - i0) * cx.weight(c);
     }
-    for (int i = 0; i < cx.n; ++i) xfull += cx.resid(i, c) * cx.resid(i, c) * cx.weight(c);
+    for (int i = 0; i < cx.n; ++i) xfull += static_cast<double>(cx.resid(i, c)) * cx.resid(i, c) * cx.weight(c);
     const double zlow = ChiSquareZ(xlow, blocks);
     const double zfull = ChiSquareZ(xfull, cx.n);
     if (zlow > 6.0 || (zfull > 6.0 && xfull / cx.n > 1.05)) r.mismatch_channels.push_back(c);
@@ -70,7 +77,7 @@ void LocateWindows(Report& r, int m, int blocks) {
       double s = 0.0;
       for (int i = i0; i < i1; ++i) {
         s += cx.resid(i, c);
-        xs += cx.resid(i, c) * cx.resid(i, c) * cx.weight(c);
+        xs += static_cast<double>(cx.resid(i, c)) * cx.resid(i, c) * cx.weight(c);
       }
       xm += s * s / (i1 - i0) * cx.weight(c);
     }
@@ -117,7 +124,7 @@ void LocateLoadRegion(Report& r) {
   double mean_ex = 0.0;
   for (int i = 0; i < cx.n; ++i) {
     double e = 0.0;
-    for (int c : r.mismatch_channels) e += cx.resid(i, c) * cx.resid(i, c) * cx.weight(c) - 1.0;
+    for (int c : r.mismatch_channels) e += static_cast<double>(cx.resid(i, c)) * cx.resid(i, c) * cx.weight(c) - 1.0;
     excess[static_cast<std::size_t>(i)] = e / nf;
     mean_ex += e / nf;
   }
@@ -252,7 +259,7 @@ std::vector<Confounding> DropUnidentifiedPartner(const Context& cx, double z_cla
                                                  std::vector<std::string>* dropped) {
   std::vector<Confounding> partner_conf;
   if (claimed->size() != 2 || IsTimeBased((*claimed)[0].name)) return partner_conf;
-  const Mat rest = cx.resid - (*claimed)[0].pred;
+  const Series rest = cx.resid - (*claimed)[0].pred;
   partner_conf.push_back(CheckConfounders(cx, rest, (*claimed)[1], z_claim));
   const auto& with = partner_conf.back().with;
   if (std::find(with.begin(), with.end(), "hold_offsets") != with.end() ||
@@ -271,7 +278,8 @@ void ReportSpectrum(Report& r) {
   const std::size_t seg = WelchSegment(rows);
   if (rows >= seg && seg >= 32) {
     for (int c = 0; c < cx.nc; ++c) {
-      const Spectrum s = Welch(cx.resid.col(c).data(), rows, cx.rate_hz, seg);
+      const Vec col = cx.resid.col(c).cast<double>();
+      const Spectrum s = Welch(col.data(), rows, cx.rate_hz, seg);
       if (r.spectrum_power.empty()) {
         r.spectrum_hz = s.freq_hz;
         r.spectrum_power.assign(s.power.size(), 0.0);
@@ -294,7 +302,7 @@ void RefineThermal(const Context& cx, std::vector<EffectFit>* claimed_effects) {
   for (std::size_t k = 0; k < claimed.size(); ++k) {
     const bool thermal = claimed[k].name == "thermal_zero_drift";
     if (!thermal && !(claimed[k].name == "zero_drift" && !cx.dtemp.empty())) continue;
-    Mat rest = cx.resid;
+    Series rest = cx.resid;
     for (std::size_t o = 0; o < claimed.size(); ++o) {
       if (o != k) rest -= claimed[o].pred;
     }
@@ -311,25 +319,31 @@ void RefineThermal(const Context& cx, std::vector<EffectFit>* claimed_effects) {
 void RecordClaims(Report& r, const DiagnoseOptions& options, std::vector<EffectFit>& claimed,
                   const std::vector<Confounding>& partner_conf) {
   const Context& cx = r.cx;
-  Mat cum = Mat::Zero(cx.n, cx.nc);
+  Series cum;  // the claimed effects so far (memory: no n × N buffer for the first's target)
   for (std::size_t k = 0; k < claimed.size(); ++k) {
     EffectFit& f = claimed[k];
     ClaimedEffect ce;
-    ce.hold_rms_before = HoldRms(cx, cx.resid, &cum);
-    cum += f.pred;
+    ce.hold_rms_before = HoldRms(cx, cx.resid, k == 0 ? nullptr : &cum);
+    if (k == 0) {
+      cum = f.pred;
+    } else {
+      cum += f.pred;
+    }
     ce.hold_rms_after = HoldRms(cx, cx.resid, &cum);
-    ce.rms_after = ChannelRms(cx.resid - cum);
+    ce.rms_after = ChannelRms(cx.resid, &cum);
     // Each effect is tested against its confounders on what the other claimed effects leave.
-    const Confounding conf =
-        k == 1 && !partner_conf.empty()
-            ? partner_conf.front()
-            : CheckConfounders(cx, cx.resid - (cum - f.pred), f, options.z_claim);
+    const auto check = [&] {
+      if (k == 0) return CheckConfounders(cx, cx.resid, f, options.z_claim);
+      const Series others_left = cx.resid - (cum - f.pred);
+      return CheckConfounders(cx, others_left, f, options.z_claim);
+    };
+    const Confounding conf = k == 1 && !partner_conf.empty() ? partner_conf.front() : check();
     ce.confounded_with = conf.with;
     ce.confounding = conf.words;
     ce.fit = std::move(f);
     r.effects.push_back(std::move(ce));
   }
-  r.model = cum;
+  r.model = cum.size() > 0 ? std::move(cum) : Series(Series::Zero(cx.n, cx.nc));
   r.verdict = "undetermined";
   for (const auto& e : r.effects) {
     if (e.confounded_with.empty()) {
@@ -340,11 +354,11 @@ void RecordClaims(Report& r, const DiagnoseOptions& options, std::vector<EffectF
   // The noise reported is re-estimated once the claimed effects are removed (broadband effects
   // such as ringing or skew on fast edges lift the spectrum's median a little).
   for (int c = 0; c < cx.nc; ++c) {
-    const Vec rest = cx.resid.col(c) - cum.col(c);
+    const Vec rest = cx.resid.col(c).cast<double>() - r.model.col(c).cast<double>();
     r.noise_rms(c) = std::min(r.noise_rms(c),
                               RobustNoise(rest.data(), static_cast<std::size_t>(cx.n), cx.rate_hz));
   }
-  r.hold_rms_after = HoldRms(cx, cx.resid, &cum);
+  r.hold_rms_after = HoldRms(cx, cx.resid, &r.model);
 }
 
 }  // namespace
@@ -406,7 +420,7 @@ Report DiagnoseWith(Context context, const DiagnoseOptions& options) {
   std::vector<Scored> singles = FitSingles(r, options, base);
   DebugTime("stage", "singles", t0);
   if (singles.empty() || !singles.front().eligible) {
-    r.model = Mat::Zero(cx.n, cx.nc);  // allocated only now: nothing claimed
+    r.model = Series::Zero(cx.n, cx.nc);  // allocated only now: nothing claimed
     Progress(options, 1.0, "done");
     return r;
   }

@@ -62,7 +62,7 @@ struct Report {
   std::vector<std::string> dropped;
   double hold_rms_before = 0.0;
   double hold_rms_after = 0.0;
-  Eigen::MatrixXd model;               ///< n × N: the claimed effects' total prediction
+  Series model;                        ///< n × N: the claimed effects' total prediction
   std::vector<double> spectrum_hz;     ///< residual spectrum, whitened and averaged over channels
   std::vector<double> spectrum_power;  ///< (white noise → 1)
 };

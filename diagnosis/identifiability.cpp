@@ -16,20 +16,22 @@ using Mat = Eigen::MatrixXd;
 
 /// Offsets per channel and group from the training rows' mean of `target`; groups without a
 /// training row predict 0.
-Mat GroupOffsets(const Context& cx, const Mat& target, const std::vector<int>& group, int groups) {
+Series GroupOffsets(const Context& cx, const Series& target, const std::vector<int>& group,
+                    int groups) {
   Mat sum = Mat::Zero(groups, cx.nc);
   std::vector<double> count(static_cast<std::size_t>(groups), 0.0);
   for (int i = 0; i < cx.n; ++i) {
     if (cx.train[static_cast<std::size_t>(i)] == 0) continue;
     const int g = group[static_cast<std::size_t>(i)];
-    sum.row(g) += target.row(i);
+    sum.row(g) += target.row(i).cast<double>();
     count[static_cast<std::size_t>(g)] += 1.0;
   }
-  Mat pred(cx.n, cx.nc);
+  Series pred(cx.n, cx.nc);
   for (int i = 0; i < cx.n; ++i) {
     const int g = group[static_cast<std::size_t>(i)];
     const double k = count[static_cast<std::size_t>(g)];
-    pred.row(i) = k > 0 ? Eigen::RowVectorXd(sum.row(g) / k) : Eigen::RowVectorXd::Zero(cx.nc);
+    pred.row(i) = k > 0 ? Eigen::RowVectorXf((sum.row(g) / k).cast<float>())
+                        : Eigen::RowVectorXf::Zero(cx.nc);
   }
   return pred;
 }
@@ -40,7 +42,7 @@ constexpr int kLoadTerms = 28;
 
 /// Per channel, target ≈ a quadratic polynomial of the reference wrench (each component scaled by
 /// its peak), fitted on the training rows: a smooth function of the load, ramps included.
-Mat LoadPolynomial(const Context& cx, const Mat& target) {
+Series LoadPolynomial(const Context& cx, const Series& target) {
   const auto& w = cx.data->wrench;
   Eigen::Matrix<double, 6, 1> scale;
   for (int k = 0; k < 6; ++k) scale(k) = std::max(w.col(k).cwiseAbs().maxCoeff(), 1e-300);
@@ -53,7 +55,7 @@ Mat LoadPolynomial(const Context& cx, const Mat& target) {
       for (int l = k; l < 6; ++l) x[j++] = u[k] * u[l];
     }
   };
-  Mat pred(cx.n, cx.nc);
+  Series pred(cx.n, cx.nc);
   double x[kLoadTerms];
   for (int c = 0; c < cx.nc; ++c) {
     NormalEq ne(kLoadTerms);
@@ -65,7 +67,7 @@ Mat LoadPolynomial(const Context& cx, const Mat& target) {
     const Eigen::VectorXd beta = ne.Solve().beta;
     for (int i = 0; i < cx.n; ++i) {
       terms(i, x);
-      pred(i, c) = Eigen::Map<const Eigen::VectorXd>(x, kLoadTerms).dot(beta);
+      pred(i, c) = static_cast<float>(Eigen::Map<const Eigen::VectorXd>(x, kLoadTerms).dot(beta));
     }
   }
   return pred;
@@ -73,7 +75,8 @@ Mat LoadPolynomial(const Context& cx, const Mat& target) {
 
 /// Held-out improvement of `pred` on `target` and its significance (in noise standard deviations
 /// of Σ 2·r·p over the held-out rows).
-void Improvement(const Context& cx, const Mat& target, const Mat& pred, double* delta, double* z) {
+void Improvement(const Context& cx, const Series& target, const Series& pred, double* delta,
+                 double* z) {
   const Sums s0 = Score(cx, target, nullptr);
   const Sums s1 = Score(cx, target, &pred);
   *delta = s0.hold_sse - s1.hold_sse;
@@ -214,7 +217,7 @@ std::vector<int> ConfounderGroups(const Context& cx, const std::string& name, in
   return g;
 }
 
-Confounding CheckConfounders(const Context& cx, const Mat& target, const EffectFit& fit,
+Confounding CheckConfounders(const Context& cx, const Series& target, const EffectFit& fit,
                              double z_claim) {
   Confounding out;
   // Hysteresis depends on the load's history: where every load is held once (static poses, no
@@ -235,34 +238,44 @@ Confounding CheckConfounders(const Context& cx, const Mat& target, const EffectF
   // Identified when the joint model beats the confounder alone (below), or when the confounder
   // alone, penalised for its parameters as the ranking does (Δχ² − p·ln n_hold), scores clearly
   // below the effect: a simpler explanation is not confounded by a far richer one.
-  auto beyond = [&](const std::function<Mat(const Mat&)>& confounder, int confounder_params,
-                    double* z_rest) {
-    const Mat alone = confounder(target);
-    const double score_conf =
-        base_sse - Score(cx, target, &alone).hold_sse - confounder_params * log_hold;
+  // Memory: one n × N work buffer for the backfit's remainders; the confounder alone is formed
+  // twice (its score first, its difference to the joint model at the end) instead of held.
+  auto beyond = [&](const std::function<Series(const Series&)>& confounder,
+                    int confounder_params, double* z_rest) {
+    const Sums s_alone = [&] {
+      const Series alone = confounder(target);
+      return Score(cx, target, &alone);
+    }();
+    const double score_conf = base_sse - s_alone.hold_sse - confounder_params * log_hold;
     *z_rest = 0.0;
     if (score_conf < score_effect) return true;
-    Mat eff = fit.pred;
-    Mat conf;  // assigned in the first iteration
+    Series eff;  // the effect's refit (empty: the effect's own prediction, fit.pred)
+    bool eff_zero = false;
+    Series conf;  // assigned in the first iteration
+    Series work;
     for (int iter = 0; iter < 3; ++iter) {
-      conf = confounder(target - eff);
-      const auto refit = spec->fit(cx, target - conf);
+      work = target - (eff.size() > 0 ? eff : fit.pred);
+      eff = Series();
+      conf = confounder(work);
+      work = target - conf;
+      auto refit = spec->fit(cx, work);
       if (!refit) {
-        eff.setZero();
+        eff_zero = true;
         break;
       }
-      eff = refit->pred;
+      eff = std::move(refit->pred);
     }
-    const Mat joint = conf + eff;
-    const Sums s_alone = Score(cx, target, &alone);
-    const Sums s_joint = Score(cx, target, &joint);
-    // Score(cx, target, &(joint − alone)).hold_pp without the n × N difference matrix.
+    work = Series();
+    if (eff_zero) eff = Series::Zero(cx.n, cx.nc);
+    const Sums s_joint = ScoreSum(cx, target, conf, eff);
+    const Series alone = confounder(target);
+    // Score(cx, target, &(joint − alone)).hold_pp without an n × N difference matrix.
     double spread = 0.0;
     for (int c = 0; c < cx.nc; ++c) {
       double pp = 0.0;
       for (int i = 0; i < cx.n; ++i) {
         if (cx.train[static_cast<std::size_t>(i)]) continue;
-        const double p = joint(i, c) - alone(i, c);
+        const double p = static_cast<double>(conf(i, c)) + eff(i, c) - alone(i, c);
         pp += p * p;
       }
       spread += pp * cx.weight(c);
@@ -278,7 +291,7 @@ Confounding CheckConfounders(const Context& cx, const Mat& target, const EffectF
     const std::vector<int> g = ConfounderGroups(cx, name, &groups);
     if (g.empty()) continue;
     double z_rest = 0.0;
-    const auto offsets = [&](const Mat& y) { return GroupOffsets(cx, y, g, groups); };
+    const auto offsets = [&](const Series& y) { return GroupOffsets(cx, y, g, groups); };
     const bool identified = beyond(offsets, groups * cx.nc, &z_rest);
     if (DebugOn()) {
       std::fprintf(stderr, "confounder %s (%d groups) for %s: z_rest %.1f -> %s\n", name, groups,
@@ -292,7 +305,8 @@ Confounding CheckConfounders(const Context& cx, const Mat& target, const EffectF
   // A smooth function of the load, ramps included (where holds are short or absent).
   double z_poly = 0.0;
   if (d.has_wrench() && !history && cx.n > 20 * kLoadTerms &&
-      !beyond([&](const Mat& y) { return LoadPolynomial(cx, y); }, kLoadTerms * cx.nc, &z_poly)) {
+      !beyond([&](const Series& y) { return LoadPolynomial(cx, y); }, kLoadTerms * cx.nc,
+              &z_poly)) {
     out.with.push_back("load_polynomial");
     words.push_back(ConfounderWords("load_polynomial", kLoadTerms) + BeyondWords(z_poly, z_alone));
   }
@@ -300,9 +314,9 @@ Confounding CheckConfounders(const Context& cx, const Mat& target, const EffectF
     const double rho = SpearmanWithTime(d.temp_c);
     const EffectSpec* drift = FindEffect("zero_drift");
     if (std::fabs(rho) > 0.95 && drift != nullptr) {
-      const auto in_time = [&](const Mat& y) {
-        const auto f = drift->fit(cx, y);
-        return f ? f->pred : Mat(Mat::Zero(cx.n, cx.nc));
+      const auto in_time = [&](const Series& y) {
+        auto f = drift->fit(cx, y);
+        return f ? std::move(f->pred) : Series(Series::Zero(cx.n, cx.nc));
       };
       double z_rest = 0.0;
       const auto probe = drift->fit(cx, target);

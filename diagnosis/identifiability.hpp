@@ -35,7 +35,7 @@ struct Confounding {
 ///    smooth function of the load, ramps included (not for hysteresis);
 ///  - zero_drift, for thermal effects when the temperature is monotone in time (|Spearman ρ| >
 ///    0.95).
-[[nodiscard]] Confounding CheckConfounders(const Context& cx, const Eigen::MatrixXd& target,
+[[nodiscard]] Confounding CheckConfounders(const Context& cx, const Series& target,
                                            const EffectFit& fit, double z_claim);
 
 /// Group of every row for a confounder ("segment_offsets", "load_function"); empty when the

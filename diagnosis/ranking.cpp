@@ -14,13 +14,12 @@
 namespace ftstack::diag {
 namespace {
 
-using Mat = Eigen::MatrixXd;
 
 double HoldPenalty(const Context& cx) {
   return std::log(std::max(2.0, static_cast<double>(cx.n_hold) * cx.nc));
 }
 
-Scored ScoreFit(const Context& cx, const Mat& target, EffectFit fit, double base_hold,
+Scored ScoreFit(const Context& cx, const Series& target, EffectFit fit, double base_hold,
                 double z_claim) {
   Scored s;
   const Sums sums = Score(cx, target, &fit.pred);
@@ -33,11 +32,8 @@ Scored ScoreFit(const Context& cx, const Mat& target, EffectFit fit, double base
   return s;
 }
 
-/// target − the start's prediction (held in double or single precision).
-Mat Remainder(const Mat& target, const Scored& start) {
-  if (start.fit.pred.size() > 0) return target - start.fit.pred;
-  return target - start.pred_f.cast<double>();
-}
+/// target − the start's prediction.
+Series Remainder(const Series& target, const Scored& start) { return target - start.fit.pred; }
 
 /// Backfits two effects, twice: B on target − A (A first fitted alone: a0, with a0_rest = target −
 /// its prediction), then A on target − B. Every fit starts from the effect's previous one
@@ -47,13 +43,13 @@ Mat Remainder(const Mat& target, const Scored& start) {
 /// place), so a fit holds one n × N remainder and no other prediction. The last B's prediction is
 /// restored from its remainder afterwards, target − (target − p): p to within an ulp of the
 /// target.
-bool FitPair(const Context& cx, const Mat& target, const EffectSpec& a, const EffectSpec& b,
-             const EffectFit& a0, Mat a0_rest, const EffectFit* b_near, EffectFit* fa,
+bool FitPair(const Context& cx, const Series& target, const EffectSpec& a, const EffectSpec& b,
+             const EffectFit& a0, Series a0_rest, const EffectFit* b_near, EffectFit* fa,
              EffectFit* fb) {
   const EffectFit* first = &a0;
   for (int it = 0; it < 2; ++it) {
-    fb->pred = Mat();  // the previous B is replaced; only `first` is used now
-    Mat rest;
+    fb->pred = Series();  // the previous B is replaced; only `first` is used now
+    Series rest;
     if (it == 0) {
       rest = std::move(a0_rest);
     } else {  // the previous A is refitted below (near its parameters)
@@ -61,7 +57,7 @@ bool FitPair(const Context& cx, const Mat& target, const EffectSpec& a, const Ef
       rest = std::move(fa->pred);
     }
     auto nb = FitNear(b, cx, rest, it == 0 ? b_near : fb, it == 1);
-    rest = Mat();
+    rest = Series();
     if (!nb) return false;
     *fb = std::move(*nb);
     fb->pred = target - fb->pred;  // now A's remainder
@@ -84,10 +80,7 @@ std::vector<std::size_t> CostOrder(const std::vector<EffectSpec>& effects) {
 }
 
 /// Keeps the predictions of the `keep` best eligible fits in `all` and releases the others'
-/// (memory: n × N each); of those kept, the best (ties: the earliest in `all`) in double
-/// precision, the others in single precision (half the memory; they only start a pair's backfit).
-/// The best so far always arrived last with its double prediction, so the result does not depend
-/// on the order the fits arrived in.
+/// (memory: n × N each); the result does not depend on the order the fits arrived in.
 void KeepBestPredictions(std::vector<std::optional<Scored>>* all, std::size_t keep) {
   std::vector<Scored*> kept;
   for (auto& q : *all) {
@@ -96,16 +89,8 @@ void KeepBestPredictions(std::vector<std::optional<Scored>>* all, std::size_t ke
   const auto by_score = [](const Scored* u, const Scored* v) { return u->score < v->score; };
   while (kept.size() > keep) {
     auto lowest = std::min_element(kept.begin(), kept.end(), by_score);
-    (*lowest)->fit.pred = Mat();
-    (*lowest)->pred_f = Eigen::MatrixXf();
+    (*lowest)->fit.pred = Series();
     kept.erase(lowest);
-  }
-  if (kept.empty()) return;
-  const Scored* best = *std::max_element(kept.begin(), kept.end(), by_score);
-  for (Scored* q : kept) {
-    if (q == best || q->fit.pred.size() == 0) continue;
-    q->pred_f = q->fit.pred.cast<float>();
-    q->fit.pred = Mat();
   }
 }
 
@@ -152,7 +137,7 @@ std::vector<std::vector<Partner>> FitPartners(const Context& cx, const DiagnoseO
   // remainder, not one per running fit).
   for (std::size_t t = 0; t < top.size(); ++t) {
     const Scored& first = singles[top[t]];
-    const Mat rest = Remainder(cx.resid, first);
+    const Series rest = Remainder(cx.resid, first);
     ParallelFor(todo[t].size(), ResolveThreads(options.threads), [&](std::size_t k) {
       const EffectSpec& spec = effects[todo[t][k]];
       const auto t0 = std::chrono::steady_clock::now();
@@ -163,7 +148,7 @@ std::vector<std::vector<Partner>> FitPartners(const Context& cx, const DiagnoseO
       if (fb) sb = ScoreFit(cx, rest, std::move(*fb), first.hold_sse, options.z_claim);
       const std::lock_guard<std::mutex> lock(mu);
       if (sb && sb->eligible) {
-        sb->fit.pred = Mat();
+        sb->fit.pred = Series();
         partners[t].push_back({{sb->score, spec.name}, std::move(sb->fit)});
       }
       Progress(options, 0.65 + 0.2 * static_cast<double>(++done) / static_cast<double>(total),
@@ -206,7 +191,8 @@ std::optional<PairResult> TryPair(const Context& cx, const DiagnoseOptions& opti
   for (int c = 0; c < cx.nc; ++c) {
     for (int i = 0; i < cx.n; ++i) {
       if (cx.train[static_cast<std::size_t>(i)]) continue;
-      const double diff = (p.fa.pred(i, c) + p.fb.pred(i, c)) - first.Prediction(i, c);
+      const double diff = (static_cast<double>(p.fa.pred(i, c)) + p.fb.pred(i, c)) -
+                          static_cast<double>(first.fit.pred(i, c));
       dd += diff * diff * cx.weight(c);
     }
   }
@@ -225,12 +211,13 @@ std::optional<PairResult> TryPair(const Context& cx, const DiagnoseOptions& opti
 
 }  // namespace
 
-double HoldRms(const Context& cx, const Mat& target, const Mat* pred) {
+double HoldRms(const Context& cx, const Series& target, const Series* pred) {
   double s = 0.0;
   for (int c = 0; c < cx.nc; ++c) {
     for (int i = 0; i < cx.n; ++i) {
       if (cx.train[static_cast<std::size_t>(i)]) continue;
-      const double e = target(i, c) - (pred != nullptr ? (*pred)(i, c) : 0.0);
+      const double e =
+          static_cast<double>(target(i, c)) - (pred != nullptr ? (*pred)(i, c) : 0.0);
       s += e * e;
     }
   }
@@ -262,7 +249,7 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
       s->hold_rms_after = HoldRms(cx, cx.resid, &s->fit.pred);
       // Memory (n × N per prediction): only the kPairStarts best eligible singles are used again
       // (the claim and the pair starts); every other prediction is released at once.
-      if (!s->eligible) s->fit.pred = Mat();
+      if (!s->eligible) s->fit.pred = Series();
     }
     const std::lock_guard<std::mutex> lock(mu);
     slot[j] = std::move(s);
@@ -274,17 +261,9 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
   for (auto& q : slot) {
     if (q) singles.push_back(std::move(*q));
   }
-  // Stable: of equal scores the earlier effect first, as KeepBestPredictions chooses its best.
+  // Stable: of equal scores the earlier effect first.
   std::stable_sort(singles.begin(), singles.end(),
                    [](const Scored& a, const Scored& b) { return a.score > b.score; });
-  // The best single (it may be claimed alone) holds its prediction in double precision; the other
-  // pair starts in single precision (6e-8 relative, far below the noise of any recording: they
-  // only start a pair's backfit). KeepBestPredictions keeps it so; this is only a guard.
-  if (!singles.empty() && singles.front().fit.pred.size() == 0 &&
-      singles.front().pred_f.size() > 0) {
-    singles.front().fit.pred = singles.front().pred_f.cast<double>();
-    singles.front().pred_f = Eigen::MatrixXf();
-  }
   for (const auto& s : singles) {
     CandidateScore c;
     c.name = s.fit.name;
@@ -326,17 +305,11 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Sco
   std::mutex mu;
   std::size_t done = 0;
   // Memory: a start's prediction is released once its last pair is done (the best single's only
-  // when a pair has won: else it may be claimed alone), and the leading pair's predictions are
-  // held in single precision until the stage ends (6e-8 relative, far below any recording's
-  // noise), as the other starts are.
+  // when a pair has won: else it may be claimed alone).
   std::vector<std::size_t> left(top.size(), 0);
   for (const auto& [t, y] : pairs) ++left[t];
-  Eigen::MatrixXf pa_f;
-  Eigen::MatrixXf pb_f;
   const auto release = [&](std::size_t t) {
-    if (top[t] == 0 && !have_pair) return;
-    singles[top[t]].fit.pred = Mat();
-    singles[top[t]].pred_f = Eigen::MatrixXf();
+    if (top[t] != 0 || have_pair) singles[top[t]].fit.pred = Series();
   };
   ParallelFor(pairs.size(), ResolveThreads(options.threads), [&](std::size_t k) {
     const auto [t, y] = pairs[k];
@@ -352,10 +325,6 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Sco
         (p->score > pair_score || (have_pair && p->score == pair_score && order < win_order))) {
       pair_score = p->score;
       win_order = order;
-      pa_f = p->fa.pred.cast<float>();
-      pb_f = p->fb.pred.cast<float>();
-      p->fa.pred = Mat();
-      p->fb.pred = Mat();
       *pa = std::move(p->fa);
       *pb = std::move(p->fb);
       have_pair = true;
@@ -366,12 +335,7 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Sco
     }
   });
   for (std::size_t x : top) {
-    if (x != 0) singles[x].pred_f = Eigen::MatrixXf();
-  }
-  if (have_pair) {
-    pa->pred = pa_f.cast<double>();
-    pa_f = Eigen::MatrixXf();
-    pb->pred = pb_f.cast<double>();
+    if (x != 0) singles[x].fit.pred = Series();
   }
   return have_pair;
 }

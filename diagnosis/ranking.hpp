@@ -20,16 +20,9 @@ struct Scored {
   double score = 0.0;
   bool eligible = false;
   double hold_rms_after = 0.0;  ///< held-out RMS after removing the prediction
-  /// A pair start's prediction in single precision, when fit.pred was released to save memory
-  /// (every start but the best single: StartPrediction); empty otherwise.
-  Eigen::MatrixXf pred_f;
 
-  /// Whether the prediction is held (fit.pred or pred_f).
-  [[nodiscard]] bool HasPrediction() const { return fit.pred.size() > 0 || pred_f.size() > 0; }
-  /// The prediction at row i, channel c, mV/V.
-  [[nodiscard]] double Prediction(int i, int c) const {
-    return fit.pred.size() > 0 ? fit.pred(i, c) : static_cast<double>(pred_f(i, c));
-  }
+  /// Whether the prediction is held (only the pair starts keep theirs: memory).
+  [[nodiscard]] bool HasPrediction() const { return fit.pred.size() > 0; }
 };
 
 /// Pairs start from at most this many of the best eligible singles (BestPair).
@@ -38,7 +31,7 @@ inline constexpr std::size_t kPairStarts = 3;
 inline constexpr std::size_t kPairPartners = 3;
 
 /// Held-out RMS of target − pred (pred nullptr: of target), all channels, mV/V.
-double HoldRms(const Context& cx, const Eigen::MatrixXd& target, const Eigen::MatrixXd* pred);
+double HoldRms(const Context& cx, const Series& target, const Series* pred);
 /// Reports progress through options.progress when set.
 void Progress(const DiagnoseOptions& o, double f, const char* what);
 

@@ -48,12 +48,14 @@ void RingingRows(const Context& cx, double f_hz, double zeta, const std::vector<
   for (int c : chans) h->col(c).segment(i0, m) -= cx.load.col(c).segment(i0, m);
 }
 
-std::vector<int> StrongestTwo(const Context& cx, const Mat& r) {
+std::vector<int> StrongestTwo(const Context& cx, const Series& r) {
   std::vector<int> order(static_cast<std::size_t>(cx.nc));
-  for (int c = 0; c < cx.nc; ++c) order[static_cast<std::size_t>(c)] = c;
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return r.col(a).squaredNorm() * cx.weight(a) > r.col(b).squaredNorm() * cx.weight(b);
-  });
+  Vec e(cx.nc);
+  for (int c = 0; c < cx.nc; ++c) {
+    order[static_cast<std::size_t>(c)] = c;
+    e(c) = r.col(c).cast<double>().squaredNorm() * cx.weight(c);
+  }
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return e(a) > e(b); });
   order.resize(static_cast<std::size_t>(std::min(2, cx.nc)));
   return order;
 }
@@ -78,7 +80,7 @@ Vec PutChannelCoef(const Context& cx, const ChannelFit& f, int j, const char* ke
   return v;
 }
 
-double SearchSse(const Context& cx, const Mat& target, const Mat& feature, bool compact) {
+double SearchSse(const Context& cx, const Series& target, const Mat& feature, bool compact) {
   // FitChannels with one feature, unrolled: the sums of NormalEq::Add with unit weight and the
   // arithmetic of NormalEq::Solve for p = 1 (Jacobi scaling, 1e-12 on the scaled diagonal), so the
   // value is the same to the last bit, without a per-row call or a covariance per channel.
@@ -87,15 +89,16 @@ double SearchSse(const Context& cx, const Mat& target, const Mat& feature, bool 
   double sse_w = 0.0;
   for (int c = 0; c < cx.nc; ++c) {
     const double* x = feature.col(c).data();
-    const double* y = target.col(c).data();
+    const float* y = target.col(c).data();
     double sxx = 0.0;
     double sxy = 0.0;
     double syy = 0.0;
     for (int i = 0, r = 0; i < cx.n; i += st, r += step) {
       if (!cx.train[static_cast<std::size_t>(i)]) continue;
-      sxy += x[r] * y[i];
+      const double yi = y[i];
+      sxy += x[r] * yi;
       sxx += x[r] * x[r];
-      syy += y[i] * y[i];
+      syy += yi * yi;
     }
     const double d = sxx > 0 ? 1.0 / std::sqrt(sxx) : 1.0;
     const double scaled = d * sxx * d + 1e-12;
@@ -147,11 +150,11 @@ ChannelFit ChannelSums::Solve(const Context& cx) const {
 }
 
 /// Channel whose prediction carries the largest whitened energy.
-int DominantChannel(const Context& cx, const Mat& pred) {
+int DominantChannel(const Context& cx, const Series& pred) {
   int best = 0;
   double be = -1.0;
   for (int c = 0; c < cx.nc; ++c) {
-    const double e = pred.col(c).squaredNorm() * cx.weight(c);
+    const double e = pred.col(c).cast<double>().squaredNorm() * cx.weight(c);
     if (e > be) {
       be = e;
       best = c;
@@ -161,9 +164,9 @@ int DominantChannel(const Context& cx, const Mat& pred) {
 }
 
 /// Channels carrying at least `share` of the prediction's whitened energy.
-std::vector<int> ActiveChannels(const Context& cx, const Mat& pred, double share) {
+std::vector<int> ActiveChannels(const Context& cx, const Series& pred, double share) {
   Vec e(cx.nc);
-  for (int c = 0; c < cx.nc; ++c) e(c) = pred.col(c).squaredNorm() * cx.weight(c);
+  for (int c = 0; c < cx.nc; ++c) e(c) = pred.col(c).cast<double>().squaredNorm() * cx.weight(c);
   std::vector<int> out;
   const double tot = e.sum();
   for (int c = 0; c < cx.nc; ++c) {
@@ -174,11 +177,11 @@ std::vector<int> ActiveChannels(const Context& cx, const Mat& pred, double share
 
 /// Channels whose single coefficient is significant (|β|/σ > 5) and carries ≥ 5 % of the energy
 /// explained across channels.
-std::vector<int> SignificantChannels(const Context& cx, const ChannelFit& f, const Mat& pred,
+std::vector<int> SignificantChannels(const Context& cx, const ChannelFit& f, const Series& pred,
                                      int j) {
   std::vector<int> out;
   Vec e(cx.nc);
-  for (int c = 0; c < cx.nc; ++c) e(c) = pred.col(c).squaredNorm() * cx.weight(c);
+  for (int c = 0; c < cx.nc; ++c) e(c) = pred.col(c).cast<double>().squaredNorm() * cx.weight(c);
   const double tot = e.sum();
   for (int c = 0; c < cx.nc; ++c) {
     const double s = ParamSigma(cx, f, c, j);
@@ -202,8 +205,8 @@ nlohmann::json IntList(const std::vector<int>& ch) {
   return a;
 }
 
-double RowCorr(const Context& cx, const Mat& target, const Mat& pred, int c) {
-  return Correlation(target.col(c).data(), pred.col(c).data(), static_cast<std::size_t>(cx.n));
+double RowCorr(const Context& cx, const Series& target, const Series& pred, int c) {
+  return Correlation(ColD(target, c).data(), ColD(pred, c).data(), static_cast<std::size_t>(cx.n));
 }
 
 HatBasis MakeHat(const Context& cx, int k) {
@@ -214,7 +217,7 @@ HatBasis MakeHat(const Context& cx, int k) {
   return b;
 }
 
-std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Mat& r) {
+std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Series& r) {
   const auto rows = static_cast<std::size_t>(cx.n);
   const std::size_t seg = WelchSegment(rows);
   std::vector<std::pair<double, double>> peaks;
@@ -222,7 +225,7 @@ std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Ma
   std::vector<double> total;
   std::vector<double> freq;
   for (int c = 0; c < cx.nc; ++c) {
-    const Vec col = r.col(c);
+    const Vec col = ColD(r, c);
     const Spectrum s = Welch(col.data(), rows, cx.rate_hz, seg);
     if (total.empty()) {
       total.assign(s.power.size(), 0.0);

@@ -25,6 +25,8 @@ std::string Fmt(const char* f, ...) __attribute__((format(printf, 1, 2)));
 
 using Mat = Eigen::MatrixXd;
 using Vec = Eigen::VectorXd;
+/// A Series' column c as doubles (for the numerics that take double arrays).
+inline Vec ColD(const Series& s, int c) { return s.col(c).cast<double>(); }
 
 inline double Ln(double x) { return std::log(std::max(x, 1.0)); }
 
@@ -40,7 +42,7 @@ struct ChannelFit {
 
 /// Per-channel least squares target_c ≈ Σ_j beta_jc · feat(i, c)_j on training rows; fills pred.
 template <class F>
-ChannelFit FitChannels(const Context& cx, const Mat& target, int p, F feat, Mat* pred,
+ChannelFit FitChannels(const Context& cx, const Series& target, int p, F feat, Series* pred,
                        const std::vector<int>* only = nullptr, int stride = 1) {
   ChannelFit out;
   out.beta = Mat::Zero(p, cx.nc);
@@ -54,7 +56,7 @@ ChannelFit FitChannels(const Context& cx, const Mat& target, int p, F feat, Mat*
       if (stride > 1) continue;  // searches only compare the active channels
       double s = 0.0;
       for (int i = 0; i < cx.n; ++i) {
-        if (cx.train[static_cast<std::size_t>(i)]) s += target(i, c) * target(i, c);
+        if (cx.train[static_cast<std::size_t>(i)]) s += static_cast<double>(target(i, c)) * target(i, c);
       }
       out.sse(c) = s;
       out.sse_w += s * cx.weight(c);
@@ -76,7 +78,7 @@ ChannelFit FitChannels(const Context& cx, const Mat& target, int p, F feat, Mat*
         feat(i, c, x.data());
         double v = 0.0;
         for (int j = 0; j < p; ++j) v += r.beta(j) * x[static_cast<std::size_t>(j)];
-        (*pred)(i, c) = v;
+        (*pred)(i, c) = static_cast<float>(v);
       }
     }
   }
@@ -85,10 +87,8 @@ ChannelFit FitChannels(const Context& cx, const Mat& target, int p, F feat, Mat*
 
 /// pred(i, c) = Σ_j f.beta(j, c) · feat(i, c)_j on every row and channel: the prediction
 /// FitChannels fills (same sums in the same order), made only once a fit is kept (memory: n × N).
-/// *pred may be a feature buffer that feat reads at (i, c) only (it is read before it is written):
-/// the prediction then replaces that buffer instead of taking one of its own.
 template <class F>
-void PredictChannels(const Context& cx, const ChannelFit& f, int p, F feat, Mat* pred) {
+void PredictChannels(const Context& cx, const ChannelFit& f, int p, F feat, Series* pred) {
   std::vector<double> x(static_cast<std::size_t>(p));
   if (pred->rows() != cx.n || pred->cols() != cx.nc) pred->resize(cx.n, cx.nc);  // all written
   for (int c = 0; c < cx.nc; ++c) {
@@ -96,7 +96,7 @@ void PredictChannels(const Context& cx, const ChannelFit& f, int p, F feat, Mat*
       feat(i, c, x.data());
       double v = 0.0;
       for (int j = 0; j < p; ++j) v += f.beta(j, c) * x[static_cast<std::size_t>(j)];
-      (*pred)(i, c) = v;
+      (*pred)(i, c) = static_cast<float>(v);
     }
   }
 }
@@ -112,16 +112,16 @@ nlohmann::json VecJson(const Vec& v);
 Vec PutChannelCoef(const Context& cx, const ChannelFit& f, int j, const char* key, EffectFit* e);
 /// A search that starts near an earlier fit of the same effect when given one (RefitFn's
 /// contract), else searches in full; `uncertainty` as RefitFn's.
-using NearSearchFn = std::optional<EffectFit> (*)(const Context& cx, const Mat& target,
+using NearSearchFn = std::optional<EffectFit> (*)(const Context& cx, const Series& target,
                                                   const EffectFit* near, bool uncertainty);
 /// The FitFn of an effect whose fit is one NearSearchFn: the full search, with uncertainties.
 template <NearSearchFn Search>
-std::optional<EffectFit> FitBy(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitBy(const Context& cx, const Series& target) {
   return Search(cx, target, nullptr, true);
 }
 /// Its RefitFn: the search near an earlier fit.
 template <NearSearchFn Search>
-std::optional<EffectFit> RefitBy(const Context& cx, const Mat& target, const EffectFit& near,
+std::optional<EffectFit> RefitBy(const Context& cx, const Series& target, const EffectFit& near,
                                  bool uncertainty) {
   return Search(cx, target, &near, uncertainty);
 }
@@ -130,7 +130,7 @@ const std::uint8_t* Restarts(const Context& cx);
 /// Whitened training SSE of a one-coefficient-per-channel fit of `feature`, on every
 /// search_stride-th row and scaled back to the full count: the objective of parameter searches.
 /// `feature` is n × N, or compact (`compact`: its row r is row r·search_stride, StrideRows).
-double SearchSse(const Context& cx, const Mat& target, const Mat& feature, bool compact = false);
+double SearchSse(const Context& cx, const Series& target, const Mat& feature, bool compact = false);
 /// Rows 0, st, 2·st, … below cx.n for st = cx.search_stride: the rows a search reads, and the rows
 /// of a compact search buffer (row i is at i / st).
 std::vector<int> StrideRows(const Context& cx);
@@ -195,18 +195,18 @@ inline std::vector<int> AllChannels(const Context& cx) {
 void RingingRows(const Context& cx, double f_hz, double zeta, const std::vector<int>& chans, int i0,
                  int m, Mat* h);
 /// The two channels carrying the most whitened energy of r (where ringing searches look).
-std::vector<int> StrongestTwo(const Context& cx, const Mat& r);
+std::vector<int> StrongestTwo(const Context& cx, const Series& r);
 /// Channel whose prediction carries the largest whitened energy.
-int DominantChannel(const Context& cx, const Mat& pred);
+int DominantChannel(const Context& cx, const Series& pred);
 /// Channels carrying at least `share` of the prediction's whitened energy.
-std::vector<int> ActiveChannels(const Context& cx, const Mat& pred, double share = 0.02);
+std::vector<int> ActiveChannels(const Context& cx, const Series& pred, double share = 0.02);
 /// Channels whose single coefficient is significant (|β|/σ > 5) and carries ≥ 5 % of the energy
 /// explained across channels.
-std::vector<int> SignificantChannels(const Context& cx, const ChannelFit& f, const Mat& pred,
+std::vector<int> SignificantChannels(const Context& cx, const ChannelFit& f, const Series& pred,
                                      int j);
 std::string ChannelList(const std::vector<int>& ch);
 nlohmann::json IntList(const std::vector<int>& ch);
-double RowCorr(const Context& cx, const Mat& target, const Mat& pred, int c);
+double RowCorr(const Context& cx, const Series& target, const Series& pred, int c);
 
 // Hat (linear B-spline) basis in time with k intervals: row i → (index, fraction).
 struct HatBasis {
@@ -227,22 +227,22 @@ HatBasis MakeHat(const Context& cx, int k);
 
 /// Lines of r's Welch spectra, whitened and summed over channels: local maxima (from the 4th bin)
 /// over 4 × the median level, strongest first, as (level / median level, frequency in Hz).
-std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Mat& r);
+std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Series& r);
 
 // The effect models (one family per file of diagnosis/effects/).
-std::optional<EffectFit> FitZeroOffset(const Context& cx, const Mat& target);
-std::optional<EffectFit> FitZeroDrift(const Context& cx, const Mat& target);
-std::optional<EffectFit> FitThermalZeroPlain(const Context& cx, const Mat& target);
-std::optional<EffectFit> FitThermalSpan(const Context& cx, const Mat& target);
-std::optional<EffectFit> FitExcitation(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitZeroOffset(const Context& cx, const Series& target);
+std::optional<EffectFit> FitZeroDrift(const Context& cx, const Series& target);
+std::optional<EffectFit> FitThermalZeroPlain(const Context& cx, const Series& target);
+std::optional<EffectFit> FitThermalSpan(const Context& cx, const Series& target);
+std::optional<EffectFit> FitExcitation(const Context& cx, const Series& target);
 /// excitation_drift refitted near an earlier fit (RefitFn): near's knot count and its neighbours.
-std::optional<EffectFit> RefitExcitation(const Context& cx, const Mat& target,
+std::optional<EffectFit> RefitExcitation(const Context& cx, const Series& target,
                                          const EffectFit& near, bool uncertainty);
 /// creep: the one-τ search on the full log grid (near == nullptr) or in a window of ±0.5 in log τ
 /// around near's τ (τ1 when near is two-τ; the full range when the optimum lands on the window's
 /// edge), then the two-τ variant: searched in full alone, from near's pair when near is two-τ,
 /// not at all when near is one-τ (effects/creep.cpp).
-std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const EffectFit* near,
+std::optional<EffectFit> CreepSearch(const Context& cx, const Series& target, const EffectFit* near,
                                      bool uncertainty);
 /// creep with two time constants τ1 < τ2 (effects/creep_family.cpp): τ2 searched with τ1 at the
 /// one-τ optimum `log_tau1`, then τ1 and τ2 refined in turn; replaces *best (and fills tau,
@@ -250,7 +250,7 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const
 /// below `best_bic`. Returns whether it did.
 /// `start` (log τ1, log τ2), when given, replaces the coarse pair search and one refinement round
 /// (a refit near an earlier two-τ fit).
-bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double best_bic,
+bool FitCreepTwo(const Context& cx, const Series& target, double log_tau1, double best_bic,
                  EffectFit* best, std::vector<double>* tau, std::vector<double>* tau_sigma,
                  ChannelFit* best_f, bool* best_gamma, const double* start = nullptr,
                  bool uncertainty = true);
@@ -259,24 +259,24 @@ bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double b
 void CreepOimlR60(const Context& cx, const std::vector<double>& tau,
                   const std::vector<double>& tau_sigma, const ChannelFit& f, bool gamma,
                   EffectFit* e);
-std::optional<EffectFit> FitGainError(const Context& cx, const Mat& target);
-std::optional<EffectFit> FitBridgeNonlinearity(const Context& cx, const Mat& target);
-std::optional<EffectFit> FitGeometric(const Context& cx, const Mat& target);
-std::optional<EffectFit> FitLoadStiffening(const Context& cx, const Mat& target);
-std::optional<EffectFit> FitMisalignment(const Context& cx, const Mat& target);
-std::optional<EffectFit> FitTimeSkew(const Context& cx, const Mat& target);
-std::optional<EffectFit> FitSaturation(const Context& cx, const Mat& target);
-std::optional<EffectFit> FitOverloadShift(const Context& cx, const Mat& target);
-std::optional<EffectFit> FitMains(const Context& cx, const Mat& target);
+std::optional<EffectFit> FitGainError(const Context& cx, const Series& target);
+std::optional<EffectFit> FitBridgeNonlinearity(const Context& cx, const Series& target);
+std::optional<EffectFit> FitGeometric(const Context& cx, const Series& target);
+std::optional<EffectFit> FitLoadStiffening(const Context& cx, const Series& target);
+std::optional<EffectFit> FitMisalignment(const Context& cx, const Series& target);
+std::optional<EffectFit> FitTimeSkew(const Context& cx, const Series& target);
+std::optional<EffectFit> FitSaturation(const Context& cx, const Series& target);
+std::optional<EffectFit> FitOverloadShift(const Context& cx, const Series& target);
+std::optional<EffectFit> FitMains(const Context& cx, const Series& target);
 /// Adds harmonics 2..5 of the fitted mains fundamental f0 to *e (effects/mains_family.cpp): each
 /// at h·f0 or, above Nyquist, at its alias, kept when it lowers the training SSE by more than the
 /// BIC penalty of its 2 coefficients per channel; refits pred jointly with the fundamental and
 /// puts h<k>_amplitude_mvv (σ) and h<k>_seen_at_hz. Returns a clause for the evidence.
-std::string AddMainsHarmonics(const Context& cx, const Mat& target, double f0, EffectFit* e);
+std::string AddMainsHarmonics(const Context& cx, const Series& target, double f0, EffectFit* e);
 /// resonance: a coarse grid at the residual's lines (a log grid without any) then golden
 /// refinements of (f, ζ), and the second-mode search (near == nullptr); or the refinements only,
 /// from near's mode(s), a second mode only when near has one (effects/timing.cpp).
-std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
+std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target,
                                          const EffectFit* near, bool uncertainty);
 /// The two-mode variant of a one-mode resonance fit *e at (f1_hz, zeta1) (effects/
 /// resonance_family.cpp): mode 2 searched at the lines of the residual spectrum, both refined in
@@ -285,7 +285,7 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
 /// carries ≥ 1 % of the ringing's whitened energy. Returns a clause for the evidence.
 /// `start` (log f2, log ζ2), when given, replaces the search at the residual's lines (a refit);
 /// e->search_state gets (log f, log ζ) of mode 1 then mode 2 when the second mode is kept.
-std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz, double zeta1,
+std::string AddResonanceMode(const Context& cx, const Series& target, double f1_hz, double zeta1,
                              EffectFit* e, const double* start = nullptr, bool uncertainty = true);
 
 }  // namespace ftstack::diag::fx

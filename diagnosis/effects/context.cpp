@@ -31,7 +31,8 @@ void FindSpectralLines(Context& cx) {
 namespace {
 
 /// The context from the residual and the sim's outputs (n × N each, mV/V): `sim` becomes the load.
-Context Build(const DiagData& d, Mat resid, Mat sim, double block_s, const Eigen::VectorXd* sigma) {
+Context Build(const DiagData& d, Series resid, Mat sim, double block_s,
+              const Eigen::VectorXd* sigma) {
   Context cx;
   cx.data = &d;
   cx.n = static_cast<int>(d.rows());
@@ -49,7 +50,7 @@ Context Build(const DiagData& d, Mat resid, Mat sim, double block_s, const Eigen
   cx.sigma.resize(cx.nc);
   cx.weight.resize(cx.nc);
   for (int c = 0; c < cx.nc; ++c) {
-    double s = RobustNoise(cx.resid.col(c).data(), static_cast<std::size_t>(cx.n), cx.rate_hz);
+    double s = RobustNoise(ColD(cx.resid, c).data(), static_cast<std::size_t>(cx.n), cx.rate_hz);
     // Floor: a tiny fraction of the channel's signal scale, so identical files do not divide by 0.
     const double scale = std::max(1e-9, sim.col(c).cwiseAbs().maxCoeff() * 1e-9);
     s = std::max(s, scale);
@@ -129,14 +130,15 @@ Context Build(const DiagData& d, Mat resid, Mat sim, double block_s, const Eigen
 }  // namespace
 
 Context MakeContext(const DiagData& d, double block_s, const Eigen::VectorXd* sigma) {
-  return Build(d, d.real_mvv - d.sim_mvv, d.sim_mvv, block_s, sigma);
+  return Build(d, (d.real_mvv - d.sim_mvv).cast<float>(), d.sim_mvv, block_s, sigma);
 }
 
 Context MakeContext(DiagData* d, double block_s, const Eigen::VectorXd* sigma) {
   d->released_channels = d->channels();
-  Mat resid = std::move(d->real_mvv);
-  resid -= d->sim_mvv;
-  Mat sim = std::move(d->sim_mvv);  // both moved-from matrices are left empty
+  // Real − sim in double, rounded once; the real bridges are released as soon as it is formed.
+  Series resid = (d->real_mvv - d->sim_mvv).cast<float>();
+  d->real_mvv = Mat();
+  Mat sim = std::move(d->sim_mvv);  // both matrices are left empty
   return Build(*d, std::move(resid), std::move(sim), block_s, sigma);
 }
 
@@ -152,7 +154,7 @@ namespace {
 
 /// The whitened sums with prediction pred(i, c).
 template <class P>
-Sums ScoreWith(const Context& cx, const Eigen::MatrixXd& target, P pred) {
+Sums ScoreWith(const Context& cx, const Series& target, P pred) {
   Sums s;
   for (int c = 0; c < cx.nc; ++c) {
     double tr = 0.0;
@@ -160,7 +162,7 @@ Sums ScoreWith(const Context& cx, const Eigen::MatrixXd& target, P pred) {
     double pp = 0.0;
     for (int i = 0; i < cx.n; ++i) {
       const double p = pred(i, c);
-      const double e = target(i, c) - p;
+      const double e = static_cast<double>(target(i, c)) - p;
       if (cx.train[static_cast<std::size_t>(i)]) {
         tr += e * e;
       } else {
@@ -177,14 +179,15 @@ Sums ScoreWith(const Context& cx, const Eigen::MatrixXd& target, P pred) {
 
 }  // namespace
 
-Sums Score(const Context& cx, const Eigen::MatrixXd& target, const Eigen::MatrixXd* pred) {
+Sums Score(const Context& cx, const Series& target, const Series* pred) {
   if (pred == nullptr) return ScoreWith(cx, target, [](int, int) { return 0.0; });
-  return ScoreWith(cx, target, [pred](int i, int c) { return (*pred)(i, c); });
+  return ScoreWith(cx, target, [pred](int i, int c) { return static_cast<double>((*pred)(i, c)); });
 }
 
-Sums ScoreSum(const Context& cx, const Eigen::MatrixXd& target, const Eigen::MatrixXd& a,
-              const Eigen::MatrixXd& b) {
-  return ScoreWith(cx, target, [&](int i, int c) { return a(i, c) + b(i, c); });
+Sums ScoreSum(const Context& cx, const Series& target, const Series& a, const Series& b) {
+  return ScoreWith(cx, target, [&](int i, int c) {
+    return static_cast<double>(a(i, c)) + static_cast<double>(b(i, c));
+  });
 }
 
 }  // namespace ftstack::diag

@@ -37,7 +37,7 @@ double WindowOrGrid(const std::function<double(double)>& f, double start,
 }
 
 /// The standard's figures, channels and evidence of a finished creep fit (one or two τ).
-void FinishCreep(const Context& cx, const Mat& target, bool two, const std::vector<double>& tau,
+void FinishCreep(const Context& cx, const Series& target, bool two, const std::vector<double>& tau,
                  const std::vector<double>& tau_sigma, const ChannelFit& f, bool gamma,
                  EffectFit* e) {
   CreepOimlR60(cx, tau, tau_sigma, f, gamma, e);
@@ -63,7 +63,7 @@ void FinishCreep(const Context& cx, const Mat& target, bool two, const std::vect
 
 }  // namespace
 
-std::optional<EffectFit> CreepSearch(const Context& cx, const Mat& target, const EffectFit* near,
+std::optional<EffectFit> CreepSearch(const Context& cx, const Series& target, const EffectFit* near,
                                      bool uncertainty) {
   EffectFit best;
   ChannelFit best_f;

@@ -15,7 +15,7 @@ namespace {
 /// Per-channel fit of target ≈ a1·lp1 + a2·lp2 on every search_stride-th training row, lp1 and
 /// lp2 compact (row i at i / search_stride: LowPassLoadRows on StrideRows); whitened SSE scaled
 /// to the full count.
-double SearchTwo(const Context& cx, const Mat& target, const Mat& lp1, const Mat& lp2) {
+double SearchTwo(const Context& cx, const Series& target, const Mat& lp1, const Mat& lp2) {
   const int st = cx.search_stride;
   return FitChannels(
              cx, target, 2,
@@ -31,7 +31,7 @@ double SearchTwo(const Context& cx, const Mat& target, const Mat& lp1, const Mat
 /// Coarse 2-D search of (log τ1 < log τ2) over pairs of a 13-point log grid on [lo, hi]: every grid
 /// τ filtered once and only its strided training rows kept (at most ~20 000), so every pair costs
 /// a 2 × 2 solve per channel on those rows.
-void CoarsePair(const Context& cx, const Mat& target, double lo, double hi, double* l1,
+void CoarsePair(const Context& cx, const Series& target, double lo, double hi, double* l1,
                 double* l2) {
   // At most ~20 000 rows per grid column: the coarse pair only has to land in the right basin.
   const int st = std::max(cx.search_stride, static_cast<int>(cx.n_train / 20000));
@@ -45,7 +45,8 @@ void CoarsePair(const Context& cx, const Mat& target, double lo, double hi, doub
   std::vector<Mat> g(grid.size());
   for (std::size_t j = 0; j < grid.size(); ++j) LowPassLoadRows(cx, std::exp(grid[j]), rows, &g[j]);
   Mat y(m, cx.nc);
-  for (Eigen::Index r = 0; r < m; ++r) y.row(r) = target.row(rows[static_cast<std::size_t>(r)]);
+  for (Eigen::Index r = 0; r < m; ++r)
+    y.row(r) = target.row(rows[static_cast<std::size_t>(r)]).cast<double>();
   double coarse = std::numeric_limits<double>::infinity();
   for (std::size_t j1 = 0; j1 < grid.size(); ++j1) {
     for (std::size_t j2 = j1 + 1; j2 < grid.size(); ++j2) {
@@ -74,7 +75,7 @@ void CoarsePair(const Context& cx, const Mat& target, double lo, double hi, doub
 /// The time constants of the two-τ model, (log τ1 < log τ2) in [lo, hi]: CoarsePair (or `start`,
 /// a refit's pair) then golden refinements of each in turn; *sl1, *sl2 their 1-σ in log τ (NaN
 /// without `uncertainty`).
-void SearchPair(const Context& cx, const Mat& target, double log_tau1, double lo, double hi,
+void SearchPair(const Context& cx, const Series& target, double log_tau1, double lo, double hi,
                 const double* start, bool uncertainty, double* l1_out, double* l2_out, double* sl1,
                 double* sl2) {
   // The searches keep the lagged loads only at the rows they read (compact, StrideRows); the
@@ -198,7 +199,7 @@ void CreepOimlR60(const Context& cx, const std::vector<double>& tau,
   e->standard["oiml_r60"] = o;
 }
 
-bool FitCreepTwo(const Context& cx, const Mat& target, double log_tau1, double best_bic,
+bool FitCreepTwo(const Context& cx, const Series& target, double log_tau1, double best_bic,
                  EffectFit* best, std::vector<double>* tau, std::vector<double>* tau_sigma,
                  ChannelFit* best_f, bool* best_gamma, const double* start, bool uncertainty) {
   const double duration = cx.data->t_s.back() - cx.data->t_s.front();

@@ -73,7 +73,7 @@ struct Runs {
   int stride = 1;
 };
 
-Runs MakeRuns(const Context& cx, const Mat& target, int stride) {
+Runs MakeRuns(const Context& cx, const Series& target, int stride) {
   const Mat& w = cx.data->wrench;
   Runs r;
   r.stride = stride;
@@ -153,9 +153,9 @@ AxisFit Solve(const Context& cx, const Runs& runs, AxisOperators ops) {
   return out;
 }
 
-Mat Predict(const Context& cx, const Runs& runs, AxisOperators ops, const Eigen::VectorXd& beta) {
+Series Predict(const Context& cx, const Runs& runs, AxisOperators ops, const Eigen::VectorXd& beta) {
   const int p = ops.p();
-  Mat pred(cx.n, cx.nc);
+  Series pred(cx.n, cx.nc);
   std::vector<double> z(static_cast<std::size_t>(p));
   Eigen::VectorXd dw(6);
   ops.Reset();
@@ -169,7 +169,7 @@ Mat Predict(const Context& cx, const Runs& runs, AxisOperators ops, const Eigen:
       dw(ops.axes[static_cast<std::size_t>(f / ops.per_axis)]) +=
           beta(f) * z[static_cast<std::size_t>(f)];
     const Eigen::RowVectorXd row = (cx.sens * dw).transpose();
-    for (int i = i0; i < i1; ++i) pred.row(i) = row;
+    for (int i = i0; i < i1; ++i) pred.row(i) = row.cast<float>();
   }
   return pred;
 }
@@ -213,7 +213,7 @@ AxisOperators AxisRelays(const DiagData& d, const std::vector<int>& axes) {
 
 }  // namespace
 
-std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Series& target) {
   const DiagData& d = *cx.data;
   if (!d.has_wrench() || cx.sens.cols() != 6) return std::nullopt;
   Eigen::VectorXd range(6);
@@ -312,15 +312,15 @@ std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Mat& target)
   e.sigma["loop_half_height"] = half_sigma;
   if (!use_pi) e.params["travel_fraction"] = best_frac;
   for (int c = 0; c < cx.nc; ++c) {
-    if (e.pred.col(c).squaredNorm() * cx.weight(c) > 0.01 * cx.n) e.channels.push_back(c);
+    if (e.pred.col(c).cast<double>().squaredNorm() * cx.weight(c) > 0.01 * cx.n) e.channels.push_back(c);
   }
   int bc = 0;
   for (int c = 1; c < cx.nc; ++c) {
-    if (e.pred.col(c).squaredNorm() * cx.weight(c) > e.pred.col(bc).squaredNorm() * cx.weight(bc))
+    if (e.pred.col(c).cast<double>().squaredNorm() * cx.weight(c) > e.pred.col(bc).cast<double>().squaredNorm() * cx.weight(bc))
       bc = c;
   }
   if (e.channels.empty()) e.channels.push_back(bc);
-  const Eigen::VectorXd col = e.pred.col(bc);
+  const Eigen::VectorXd col = e.pred.col(bc).cast<double>();
   char buf[240];
   std::snprintf(buf, sizeof buf,
                 "at the same load b%d reads up to %.3g mV/V differently depending on the load's "

@@ -12,7 +12,7 @@ namespace ftstack::diag {
 
 using namespace fx;  // NOLINT(google-build-using-namespace): the effects' private helpers
 
-std::optional<EffectFit> FitHysteresisOperator(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitHysteresisOperator(const Context& cx, const Series& target) {
   // Two rate-independent operators on each bridge's own load history: Dahl (exponential approach
   // after a reversal) and play/backlash (linear approach, then flat); width searched for each.
   Mat z(cx.n, cx.nc);

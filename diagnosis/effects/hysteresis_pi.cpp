@@ -85,11 +85,11 @@ std::optional<EffectFit> LowerBic(const Context& cx, std::optional<EffectFit> a,
   return b;
 }
 
-std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Eigen::MatrixXd& target);
+std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Series& target);
 
 }  // namespace
 
-std::optional<EffectFit> FitHysteresisFamily(const Context& cx, const Eigen::MatrixXd& target) {
+std::optional<EffectFit> FitHysteresisFamily(const Context& cx, const Series& target) {
   // In the load path (operators on the wrench axes, seen through the sensitivity) or in each
   // bridge (one operator, or a Preisach sum of relays): the lowest training BIC.
   auto best = LowerBic(cx, FitHysteresisAxes(cx, target), FitHysteresisOperator(cx, target));
@@ -97,7 +97,7 @@ std::optional<EffectFit> FitHysteresisFamily(const Context& cx, const Eigen::Mat
   return LowerBic(cx, best, FitHysteresisPreisach(cx, target));
 }
 
-std::optional<EffectFit> RefitHysteresis(const Context& cx, const Eigen::MatrixXd& target,
+std::optional<EffectFit> RefitHysteresis(const Context& cx, const Series& target,
                                          const EffectFit& near, bool /*uncertainty*/) {
   // The sub-family near's fit came from, searched again (its σ are cheap: always computed).
   if (near.variant.find("wrench axis") != std::string::npos) return FitHysteresisAxes(cx, target);
@@ -109,7 +109,7 @@ std::optional<EffectFit> RefitHysteresis(const Context& cx, const Eigen::MatrixX
 
 namespace {
 
-std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Eigen::MatrixXd& target) {
+std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Series& target) {
   const auto n = static_cast<std::size_t>(cx.n);
   EffectFit e;
   e.name = "hysteresis";
@@ -117,7 +117,7 @@ std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Eigen::M
       "Preisach: weighted sum of 28 relays (thresholds on 8 quantiles of the "
       "bridge's load) on each bridge's load";
   e.n_params = cx.nc * kRelays;  // relay weights (a relay is 0 until its state is known)
-  e.pred = Eigen::MatrixXd::Zero(cx.n, cx.nc);
+  e.pred = Series::Zero(cx.n, cx.nc);
   nlohmann::json weights = nlohmann::json::array();
   nlohmann::json sigmas = nlohmann::json::array();
   double sse_w = 0.0;
@@ -165,16 +165,16 @@ std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Eigen::M
   e.sigma["loop_half_height_mvv"] = sigmas;
   int best_c = 0;
   for (int c = 1; c < cx.nc; ++c) {
-    if (e.pred.col(c).squaredNorm() * cx.weight(c) >
-        e.pred.col(best_c).squaredNorm() * cx.weight(best_c)) {
+    if (e.pred.col(c).cast<double>().squaredNorm() * cx.weight(c) >
+        e.pred.col(best_c).cast<double>().squaredNorm() * cx.weight(best_c)) {
       best_c = c;
     }
   }
   for (int c = 0; c < cx.nc; ++c) {
-    if (e.pred.col(c).squaredNorm() * cx.weight(c) > 0.01 * cx.n) e.channels.push_back(c);
+    if (e.pred.col(c).cast<double>().squaredNorm() * cx.weight(c) > 0.01 * cx.n) e.channels.push_back(c);
   }
   if (e.channels.empty()) e.channels.push_back(best_c);
-  const Eigen::VectorXd col = e.pred.col(best_c);
+  const Eigen::VectorXd col = e.pred.col(best_c).cast<double>();
   char buf[200];
   std::snprintf(buf, sizeof buf,
                 "at the same load b%d reads up to %.3g mV/V differently depending on the load's "

@@ -16,12 +16,12 @@ double Alias(double f, double rate) {
 
 }  // namespace
 
-std::string AddMainsHarmonics(const Context& cx, const Mat& target, double f0, EffectFit* e) {
+std::string AddMainsHarmonics(const Context& cx, const Series& target, double f0, EffectFit* e) {
   const auto& d = *cx.data;
   const double nyq = 0.5 * cx.rate_hz;
   const double duration = d.t_s.back() - d.t_s.front();
   const double resolution = 2.0 / std::max(duration, 1.0);  // lines closer than this coincide
-  auto fit = [&](const std::vector<double>& fs, Mat* pred, int stride) {
+  auto fit = [&](const std::vector<double>& fs, Series* pred, int stride) {
     return FitChannels(
         cx, target, 2 * static_cast<int>(fs.size()),
         [&](int i, int, double* x) {

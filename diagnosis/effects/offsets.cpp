@@ -11,7 +11,7 @@
 
 namespace ftstack::diag::fx {
 
-std::optional<EffectFit> FitZeroOffset(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitZeroOffset(const Context& cx, const Series& target) {
   EffectFit e;
   e.name = "zero_offset";
   const auto f = FitChannels(
@@ -28,7 +28,7 @@ std::optional<EffectFit> FitZeroOffset(const Context& cx, const Mat& target) {
 }
 
 // Smooth functions of time per channel (hat splines), knots chosen by BIC on training rows.
-std::optional<EffectFit> FitZeroDrift(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitZeroDrift(const Context& cx, const Series& target) {
   const double duration = cx.data->t_s.back() - cx.data->t_s.front();
   // Per channel hat-spline fit with k intervals on every st-th training row.
   auto fit_k = [&](int k, int st, std::vector<Vec>* beta) {
@@ -98,7 +98,7 @@ std::optional<EffectFit> FitZeroDrift(const Context& cx, const Mat& target) {
   std::string temp_note;
   if (!cx.dtemp.empty()) {
     const double rt =
-        Correlation(target.col(c).data(), cx.dtemp.data(), static_cast<std::size_t>(cx.n));
+        Correlation(ColD(target, c).data(), cx.dtemp.data(), static_cast<std::size_t>(cx.n));
     temp_note = Fmt("; temperature explains less (r = %.2f)", rt);
   }
   best.evidence =
@@ -109,7 +109,7 @@ std::optional<EffectFit> FitZeroDrift(const Context& cx, const Mat& target) {
   return best;
 }
 
-std::optional<EffectFit> FitThermalSpan(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitThermalSpan(const Context& cx, const Series& target) {
   if (cx.dtemp.empty()) return std::nullopt;
   // Variant A: common coefficient, r = k·ΔT·L + γ·L; variant B: per channel.
   EffectFit e;
@@ -124,7 +124,7 @@ std::optional<EffectFit> FitThermalSpan(const Context& cx, const Mat& target) {
     }
   }
   const auto rc = ne.Solve();
-  Mat pa(cx.n, cx.nc);
+  Series pa(cx.n, cx.nc);
   for (int c = 0; c < cx.nc; ++c) {
     for (int i = 0; i < cx.n; ++i) {
       pa(i, c) = (rc.beta(0) * cx.dtemp[static_cast<std::size_t>(i)] + rc.beta(1)) * cx.load(i, c);
@@ -132,7 +132,7 @@ std::optional<EffectFit> FitThermalSpan(const Context& cx, const Mat& target) {
   }
   const double dof = std::max(1.0, static_cast<double>(cx.n_train * cx.nc) - 2.0);
   const double ka_sigma = std::sqrt(rc.cov_unit(0, 0) * rc.sse / dof);
-  Mat pb;
+  Series pb;
   const auto fb = FitChannels(
       cx, target, 2,
       [&](int i, int c, double* x) {
@@ -186,7 +186,7 @@ constexpr int kExcitationIntervals[] = {1, 2, 3, 4, 6, 8, 12, 16, 24, 32};
 
 /// excitation_drift with a hat spline of k intervals for k in `ks` (stopping after two rises of
 /// the training BIC in a row): the lowest-BIC fit.
-std::optional<EffectFit> ExcitationSearch(const Context& cx, const Mat& target,
+std::optional<EffectFit> ExcitationSearch(const Context& cx, const Series& target,
                                           const std::vector<int>& ks) {
   const auto& d = *cx.data;
   const double duration = d.t_s.back() - d.t_s.front();
@@ -226,7 +226,7 @@ std::optional<EffectFit> ExcitationSearch(const Context& cx, const Mat& target,
       e.name = "excitation_drift";
       e.n_params = p;
       e.train_sse_w = r.sse;
-      best.pred = Mat();  // replaced by e below: one n × N prediction at a time
+      best.pred = Series();  // replaced by e below: one n × N prediction at a time
       e.pred.resize(cx.n, cx.nc);
       Vec factor(cx.n);
       for (int i = 0; i < cx.n; ++i) {
@@ -254,13 +254,13 @@ std::optional<EffectFit> ExcitationSearch(const Context& cx, const Mat& target,
 
 }  // namespace
 
-std::optional<EffectFit> FitExcitation(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitExcitation(const Context& cx, const Series& target) {
   return ExcitationSearch(
       cx, target,
       std::vector<int>(std::begin(kExcitationIntervals), std::end(kExcitationIntervals)));
 }
 
-std::optional<EffectFit> RefitExcitation(const Context& cx, const Mat& target,
+std::optional<EffectFit> RefitExcitation(const Context& cx, const Series& target,
                                          const EffectFit& near, bool /*uncertainty*/) {
   // The knot count of near and its two neighbours in the list.
   const int k_near = near.params.value("knots", 0) - 1;
@@ -274,7 +274,7 @@ std::optional<EffectFit> RefitExcitation(const Context& cx, const Mat& target,
   return ExcitationSearch(cx, target, ks);
 }
 
-std::optional<EffectFit> FitThermalZeroPlain(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitThermalZeroPlain(const Context& cx, const Series& target) {
   return FitThermalZeroOn(cx, target, cx.dtemp);
 }
 
@@ -284,7 +284,7 @@ namespace ftstack::diag {
 
 using namespace fx;  // NOLINT(google-build-using-namespace): the effects' private helpers
 
-std::optional<EffectFit> FitThermalZeroOn(const Context& cx, const Mat& target,
+std::optional<EffectFit> FitThermalZeroOn(const Context& cx, const Series& target,
                                           const std::vector<double>& dtemp) {
   if (dtemp.empty()) return std::nullopt;
   EffectFit e;
@@ -302,7 +302,7 @@ std::optional<EffectFit> FitThermalZeroOn(const Context& cx, const Mat& target,
   e.channels = ActiveChannels(cx, e.pred);
   const int c = DominantChannel(cx, e.pred);
   // Compare with a straight line in time (same parameter count).
-  Mat lin;
+  Series lin;
   FitChannels(
       cx, target, 2,
       [&](int i, int, double* x) {

@@ -10,7 +10,7 @@
 
 namespace ftstack::diag::fx {
 
-std::optional<EffectFit> FitSaturation(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitSaturation(const Context& cx, const Series& target) {
   // Real = sim + residual; a clipping limit shows up as the extremes of the real outputs.
   double hi = -std::numeric_limits<double>::infinity();
   double lo = std::numeric_limits<double>::infinity();
@@ -28,7 +28,7 @@ std::optional<EffectFit> FitSaturation(const Context& cx, const Mat& target) {
   }
   // Clipping needs the sim to go beyond what the real file ever reads.
   if (sim_hi <= hi && sim_lo >= lo) return std::nullopt;
-  auto predict = [&](double l, double h, Mat* out) {
+  auto predict = [&](double l, double h, Series* out) {
     double sse = 0.0;
     for (int c = 0; c < cx.nc; ++c) {
       double acc = 0.0;
@@ -86,7 +86,7 @@ std::optional<EffectFit> FitSaturation(const Context& cx, const Mat& target) {
   return e;
 }
 
-std::optional<EffectFit> FitOverloadShift(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitOverloadShift(const Context& cx, const Series& target) {
   const auto& d = *cx.data;
   std::vector<int> rows;
   for (int i = 0; i < cx.n; ++i) {

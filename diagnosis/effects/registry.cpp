@@ -35,7 +35,7 @@ const std::vector<EffectSpec>& Effects() {
   return kEffects;
 }
 
-std::optional<EffectFit> FitNear(const EffectSpec& spec, const Context& cx, const Mat& target,
+std::optional<EffectFit> FitNear(const EffectSpec& spec, const Context& cx, const Series& target,
                                  const EffectFit* near, bool uncertainty) {
   if (spec.refit != nullptr && near != nullptr && near->name == spec.name) {
     return spec.refit(cx, target, *near, uncertainty);

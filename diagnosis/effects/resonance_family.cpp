@@ -23,7 +23,7 @@ void Ringing(const Context& cx, double f_hz, double zeta, const std::vector<int>
 bool Apart(double fa_hz, double fb_hz) { return std::fabs(std::log(fa_hz / fb_hz)) > 0.14; }
 
 /// Lines of the residual r (SpectralLines), strongest first, at most 3, none within 15 % of f1_hz.
-std::vector<double> ResidualLines(const Context& cx, const Mat& r, double f1_hz) {
+std::vector<double> ResidualLines(const Context& cx, const Series& r, double f1_hz) {
   std::vector<double> out;
   for (const auto& [level, f_hz] : SpectralLines(cx, r)) {
     if (out.size() < 3 && Apart(f_hz, f1_hz)) out.push_back(f_hz);
@@ -69,13 +69,13 @@ int PutModes(const Context& cx, const ChannelFit& cf, const double* lf, const do
 
 }  // namespace
 
-std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz, double zeta1,
+std::string AddResonanceMode(const Context& cx, const Series& target, double f1_hz, double zeta1,
                              EffectFit* e, const double* start, bool uncertainty) {
   const double nyq_hz = 0.5 * cx.rate_hz;
   std::vector<double> lines;  // the residual's lines (none needed from a refit's start)
   std::vector<int> coarse;
   {
-    const Mat resid = target - e->pred;  // memory: released before the ringing buffers
+    const Series resid = target - e->pred;  // memory: released before the ringing buffers
     if (start == nullptr && (lines = ResidualLines(cx, resid, f1_hz)).empty()) return "";
     coarse = StrongestTwo(cx, resid);
   }
@@ -89,7 +89,7 @@ std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz,
     x[0] = h1(i, c);
     x[1] = h2(i, c);
   };
-  auto fit = [&](const std::vector<int>& chans, Mat* pred, int stride) {
+  auto fit = [&](const std::vector<int>& chans, Series* pred, int stride) {
     return FitChannels(cx, target, 2, modes, pred, &chans, stride);
   };
   // Whitened training SSE with mode m at (f, ζ) and the other mode's ringing held.
@@ -179,9 +179,8 @@ std::string AddResonanceMode(const Context& cx, const Mat& target, double f1_hz,
   e->variant = "two modes";
   e->n_params = p;
   e->train_sse_w = cf.sse_w;
-  e->pred = Mat();
-  PredictChannels(cx, cf, 2, modes, &h1);  // over h1: one n × N buffer less
-  e->pred = std::move(h1);
+  e->pred = Series();  // the one-mode prediction is replaced
+  PredictChannels(cx, cf, 2, modes, &e->pred);
   e->search_state = {lf[0], lz[0], lf[1], lz[1]};
   return Fmt(
       "; a second mode at %.2f Hz (damping ratio %.3f) from the residual spectrum, kept: "

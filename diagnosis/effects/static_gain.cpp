@@ -13,10 +13,10 @@ namespace ftstack::diag::fx {
 
 // One coefficient per channel on a feature of the channel's load; significant channels only.
 template <class F>
-std::optional<EffectFit> SelectedChannelFit(const Context& cx, const Mat& target, F feat,
+std::optional<EffectFit> SelectedChannelFit(const Context& cx, const Series& target, F feat,
                                             const char* name, const char* coef_name,
                                             std::vector<int>* chosen, ChannelFit* fit) {
-  Mat pred;
+  Series pred;
   const auto all = FitChannels(cx, target, 1, feat, &pred);
   std::vector<int> sel = SignificantChannels(cx, all, pred, 0);
   if (sel.empty()) {
@@ -42,7 +42,7 @@ std::optional<EffectFit> SelectedChannelFit(const Context& cx, const Mat& target
   return e;
 }
 
-std::optional<EffectFit> FitGainError(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitGainError(const Context& cx, const Series& target) {
   std::vector<int> sel;
   ChannelFit f;
   auto e = SelectedChannelFit(
@@ -59,7 +59,7 @@ std::optional<EffectFit> FitGainError(const Context& cx, const Mat& target) {
   return e;
 }
 
-std::optional<EffectFit> FitBridgeNonlinearity(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitBridgeNonlinearity(const Context& cx, const Series& target) {
   std::vector<int> sel;
   ChannelFit f;
   auto e = SelectedChannelFit(
@@ -78,10 +78,10 @@ std::optional<EffectFit> FitBridgeNonlinearity(const Context& cx, const Mat& tar
   return e;
 }
 
-std::optional<EffectFit> FitGeometric(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitGeometric(const Context& cx, const Series& target) {
   EffectFit e;
   e.name = "geometric_nonlinearity";
-  Mat pa;
+  Series pa;
   const auto fa = FitChannels(
       cx, target, 1,
       [&](int i, int c, double* x) {
@@ -90,7 +90,7 @@ std::optional<EffectFit> FitGeometric(const Context& cx, const Mat& target) {
       },
       &pa);
   double bic_b = std::numeric_limits<double>::infinity();
-  Mat pb;
+  Series pb;
   Vec kb;
   Vec kbs;
   if (cx.data->has_wrench()) {
@@ -156,7 +156,7 @@ std::optional<EffectFit> FitGeometric(const Context& cx, const Mat& target) {
   return e;
 }
 
-std::optional<EffectFit> FitLoadStiffening(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitLoadStiffening(const Context& cx, const Series& target) {
   if (!cx.data->has_wrench()) return std::nullopt;
   const auto& w = cx.data->wrench;
   const int ks[4] = {0, 1, 3, 4};
@@ -175,7 +175,7 @@ std::optional<EffectFit> FitLoadStiffening(const Context& cx, const Mat& target)
   }
   const auto ra = ne.Solve();
   // Variant B: free coefficients of Fz·w_k per channel.
-  Mat pb;
+  Series pb;
   const auto fb = FitChannels(
       cx, target, 4,
       [&](int i, int, double* xx) {
@@ -226,7 +226,7 @@ std::optional<EffectFit> FitLoadStiffening(const Context& cx, const Mat& target)
   return e;
 }
 
-std::optional<EffectFit> FitMisalignment(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitMisalignment(const Context& cx, const Series& target) {
   if (!cx.data->has_wrench()) return std::nullopt;
   const auto& w = cx.data->wrench;
   // Sensor frame rotated by +θ about an axis: it reads Rᵀ·F and Rᵀ·M, so the change of the wrench

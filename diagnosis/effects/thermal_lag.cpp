@@ -10,7 +10,7 @@
 
 namespace ftstack::diag {
 
-std::optional<EffectFit> FitThermalZeroLagged(const Context& cx, const Eigen::MatrixXd& target) {
+std::optional<EffectFit> FitThermalZeroLagged(const Context& cx, const Series& target) {
   if (cx.dtemp.empty()) return std::nullopt;
   const auto& t = cx.data->t_s;
   const double duration = t.back() - t.front();

@@ -10,9 +10,9 @@
 
 namespace ftstack::diag::fx {
 
-std::optional<EffectFit> FitTimeSkew(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitTimeSkew(const Context& cx, const Series& target) {
   const auto& d = *cx.data;
-  auto predict = [&](double delay, Mat* out) {
+  auto predict = [&](double delay, Series* out) {
     double sse = 0.0;
     const int st = out == nullptr ? cx.search_stride : 1;
     for (int c = 0; c < cx.nc; ++c) {
@@ -25,7 +25,7 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Mat& target) {
                                          d.t_s[static_cast<std::size_t>(i)] - delay, cx.uniform,
                                          static_cast<std::size_t>(i)) -
                          s[i];
-        if (out != nullptr) (*out)(i, c) = v;
+        if (out != nullptr) (*out)(i, c) = static_cast<float>(v);
         if (tr) acc += (target(i, c) - v) * (target(i, c) - v);
       }
       sse += acc * cx.weight(c) * st;
@@ -70,14 +70,14 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Mat& target) {
   return e;
 }
 
-std::optional<EffectFit> FitMains(const Context& cx, const Mat& target) {
+std::optional<EffectFit> FitMains(const Context& cx, const Series& target) {
   if (cx.peak_hz.empty()) return std::nullopt;
   const auto& d = *cx.data;
   // cos and sin of the phase once per row for every channel (the same values FitChannels would
   // otherwise compute per row and channel).
   std::vector<double> cs(static_cast<std::size_t>(cx.n));
   std::vector<double> sn(static_cast<std::size_t>(cx.n));
-  auto fit_at = [&](double f, Mat* out, ChannelFit* cf) {
+  auto fit_at = [&](double f, Series* out, ChannelFit* cf) {
     const double w = 2.0 * M_PI * f;
     for (std::size_t i = 0; i < cs.size(); ++i) {
       const double ph = w * d.t_s[i];
@@ -193,7 +193,7 @@ std::pair<int, int> CoarseWindow(const Context& cx, const std::vector<int>& chan
 
 /// Whitened training SSE of a one-coefficient fit of target to h per channel of `chans`, on rows
 /// [w0, w1) (the coarse stage of a windowed ringing search).
-double WindowSse(const Context& cx, const Mat& target, const Mat& h, const std::vector<int>& chans,
+double WindowSse(const Context& cx, const Series& target, const Mat& h, const std::vector<int>& chans,
                  int w0, int w1) {
   double s = 0.0;
   for (int c : chans) {
@@ -202,9 +202,10 @@ double WindowSse(const Context& cx, const Mat& target, const Mat& h, const std::
     double yy = 0.0;
     for (int i = w0; i < w1; ++i) {
       if (!cx.train[static_cast<std::size_t>(i)]) continue;
+      const double y = target(i, c);
       hh += h(i, c) * h(i, c);
-      hy += h(i, c) * target(i, c);
-      yy += target(i, c) * target(i, c);
+      hy += h(i, c) * y;
+      yy += y * y;
     }
     s += std::max(0.0, yy - (hh > 0 ? hy * hy / hh : 0.0)) * cx.weight(c);
   }
@@ -213,7 +214,7 @@ double WindowSse(const Context& cx, const Mat& target, const Mat& h, const std::
 
 }  // namespace
 
-std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
+std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target,
                                          const EffectFit* near, bool uncertainty) {
   const double nyq = 0.5 * cx.rate_hz;
   Mat h(cx.n, cx.nc);
@@ -229,7 +230,8 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Mat& target,
   const auto in_range = [&](double f, double z) {
     return f > 0.05 && f < 0.98 * nyq && z > 1e-4 && z <= 2.0;
   };
-  auto sse_for = [&](double f, double z, const std::vector<int>& chans, Mat* out, ChannelFit* cf) {
+  auto sse_for = [&](double f, double z, const std::vector<int>& chans, Series* out,
+                     ChannelFit* cf) {
     if (!in_range(f, z)) return std::numeric_limits<double>::infinity();
     build(f, z, chans);
     if (windowed) return WindowSse(cx, target, h, chans, w0, w1);

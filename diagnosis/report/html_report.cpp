@@ -122,7 +122,7 @@ std::vector<double> Ticks(double lo, double hi, int want) {
 }
 
 /// Reduces a long line to min/max per pixel column, keeping order.
-void Reduce(const Series& s, double x0, double x1, int cols, std::vector<double>* rx,
+void Reduce(const PlotSeries& s, double x0, double x1, int cols, std::vector<double>* rx,
             std::vector<double>* ry) {
   if (s.x.size() <= static_cast<std::size_t>(cols) * 2 || s.points) {
     const std::size_t stride = s.points ? std::max<std::size_t>(1, s.x.size() / 4000) : 1;
@@ -174,7 +174,7 @@ void Reduce(const Series& s, double x0, double x1, int cols, std::vector<double>
 
 }  // namespace
 
-std::string SvgPlot(const PlotSpec& spec, const std::vector<Series>& series) {
+std::string SvgPlot(const PlotSpec& spec, const std::vector<PlotSeries>& series) {
   const int ml = 70;
   const int mr = 20;
   const int mt = 28;
@@ -310,15 +310,15 @@ std::string HtmlPlots(const DiagData& data, const Report& r) {
   const std::vector<int> pick =
       r.mismatch_channels.empty() ? std::vector<int>{} : r.mismatch_channels;
   for (int k = 0; k < cx.nc; ++k) {
-    const double e = (cx.resid.col(k).squaredNorm()) * cx.weight(k);
+    const double e = cx.resid.col(k).cast<double>().squaredNorm() * cx.weight(k);
     if (e > be) {
       be = e;
       c = k;
     }
   }
-  Series res{data.t_s, {}, "#888", "residual b" + std::to_string(c)};
-  Series model{data.t_s, {}, "#d22", "model"};
-  Series after{data.t_s, {}, "#26c", "after"};
+  PlotSeries res{data.t_s, {}, "#888", "residual b" + std::to_string(c)};
+  PlotSeries model{data.t_s, {}, "#d22", "model"};
+  PlotSeries after{data.t_s, {}, "#26c", "after"};
   res.y.resize(data.rows());
   model.y.resize(data.rows());
   after.y.resize(data.rows());
@@ -326,7 +326,7 @@ std::string HtmlPlots(const DiagData& data, const Report& r) {
     const auto ii = static_cast<Eigen::Index>(i);
     res.y[i] = cx.resid(ii, c);
     model.y[i] = r.model(ii, c);
-    after.y[i] = cx.resid(ii, c) - r.model(ii, c);
+    after.y[i] = static_cast<double>(cx.resid(ii, c)) - r.model(ii, c);
   }
   PlotSpec p1;
   p1.title = "Residual real − sim of b" + std::to_string(c) +
@@ -347,8 +347,8 @@ std::string HtmlPlots(const DiagData& data, const Report& r) {
         if (comp == kWrenchNames[j]) k = j;
       }
     }
-    Series sc{{}, res.y, "#888", "residual", true};
-    Series sm{{}, model.y, "#d22", "model", true};
+    PlotSeries sc{{}, res.y, "#888", "residual", true};
+    PlotSeries sm{{}, model.y, "#d22", "model", true};
     sc.x.resize(data.rows());
     for (std::size_t i = 0; i < data.rows(); ++i)
       sc.x[i] = data.wrench(static_cast<Eigen::Index>(i), k);
@@ -360,7 +360,7 @@ std::string HtmlPlots(const DiagData& data, const Report& r) {
     h += "<h2>Residual against load</h2>" + SvgPlot(p3, {sc, sm});
   }
   if (!r.spectrum_hz.empty()) {
-    Series sp{std::vector<double>(r.spectrum_hz.begin() + 1, r.spectrum_hz.end()),
+    PlotSeries sp{std::vector<double>(r.spectrum_hz.begin() + 1, r.spectrum_hz.end()),
               std::vector<double>(r.spectrum_power.begin() + 1, r.spectrum_power.end()), "#333",
               "residual PSD / noise"};
     PlotSpec p4;

@@ -9,7 +9,7 @@
 namespace ftstack::diag {
 
 /// One data series of a plot.
-struct Series {
+struct PlotSeries {
   std::vector<double> x;
   std::vector<double> y;
   std::string color;
@@ -29,7 +29,7 @@ struct PlotSpec {
 };
 
 /// An SVG line/scatter plot of the series (long series are reduced to min/max per pixel column).
-[[nodiscard]] std::string SvgPlot(const PlotSpec& spec, const std::vector<Series>& series);
+[[nodiscard]] std::string SvgPlot(const PlotSpec& spec, const std::vector<PlotSeries>& series);
 
 /// The report as one HTML document.
 [[nodiscard]] std::string HtmlReport(const DiagData& data, const Report& report);
