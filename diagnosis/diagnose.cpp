@@ -55,7 +55,8 @@ void LocateChannels(Report& r, int m, int blocks) {
       const double mean = s / (i1 - i0);
       xlow += mean * mean * (i1 - i0) * cx.weight(c);
     }
-    for (int i = 0; i < cx.n; ++i) xfull += static_cast<double>(cx.resid(i, c)) * cx.resid(i, c) * cx.weight(c);
+    for (int i = 0; i < cx.n; ++i)
+      xfull += static_cast<double>(cx.resid(i, c)) * cx.resid(i, c) * cx.weight(c);
     const double zlow = ChiSquareZ(xlow, blocks);
     const double zfull = ChiSquareZ(xfull, cx.n);
     if (zlow > 6.0 || (zfull > 6.0 && xfull / cx.n > 1.05)) r.mismatch_channels.push_back(c);
@@ -124,7 +125,8 @@ void LocateLoadRegion(Report& r) {
   double mean_ex = 0.0;
   for (int i = 0; i < cx.n; ++i) {
     double e = 0.0;
-    for (int c : r.mismatch_channels) e += static_cast<double>(cx.resid(i, c)) * cx.resid(i, c) * cx.weight(c) - 1.0;
+    for (int c : r.mismatch_channels)
+      e += static_cast<double>(cx.resid(i, c)) * cx.resid(i, c) * cx.weight(c) - 1.0;
     excess[static_cast<std::size_t>(i)] = e / nf;
     mean_ex += e / nf;
   }

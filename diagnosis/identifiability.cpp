@@ -217,6 +217,48 @@ std::vector<int> ConfounderGroups(const Context& cx, const std::string& name, in
   return g;
 }
 
+/// The joint model (the confounder fitted to what the effect leaves, the effect refitted to what
+/// the confounder leaves, 3 times from the effect's fit) against the confounder alone (s_alone):
+/// the held-out improvement *delta and its z. Memory: one n × N work buffer; the confounder alone
+/// is formed again for the spread instead of held.
+double JointBeyond(const Context& cx, const Series& target, const EffectFit& fit,
+                   const EffectSpec& spec, const std::function<Series(const Series&)>& confounder,
+                   const Sums& s_alone, double* delta) {
+  Series eff;  // the effect's refit (empty: the effect's own prediction, fit.pred)
+  bool eff_zero = false;
+  Series conf;  // assigned in the first iteration
+  Series work;
+  for (int iter = 0; iter < 3; ++iter) {
+    work = target - (eff.size() > 0 ? eff : fit.pred);
+    eff = Series();
+    conf = confounder(work);
+    work = target - conf;
+    auto refit = spec.fit(cx, work);
+    if (!refit) {
+      eff_zero = true;
+      break;
+    }
+    eff = std::move(refit->pred);
+  }
+  work = Series();
+  if (eff_zero) eff = Series::Zero(cx.n, cx.nc);
+  const Sums s_joint = ScoreSum(cx, target, conf, eff);
+  const Series alone = confounder(target);
+  // Score(cx, target, &(joint − alone)).hold_pp without an n × N difference matrix.
+  double spread = 0.0;
+  for (int c = 0; c < cx.nc; ++c) {
+    double pp = 0.0;
+    for (int i = 0; i < cx.n; ++i) {
+      if (cx.train[static_cast<std::size_t>(i)]) continue;
+      const double p = static_cast<double>(conf(i, c)) + eff(i, c) - alone(i, c);
+      pp += p * p;
+    }
+    spread += pp * cx.weight(c);
+  }
+  *delta = s_alone.hold_sse - s_joint.hold_sse;
+  return *delta / (2.0 * std::sqrt(std::max(spread, 1e-300)));
+}
+
 Confounding CheckConfounders(const Context& cx, const Series& target, const EffectFit& fit,
                              double z_claim) {
   Confounding out;
@@ -238,10 +280,9 @@ Confounding CheckConfounders(const Context& cx, const Series& target, const Effe
   // Identified when the joint model beats the confounder alone (below), or when the confounder
   // alone, penalised for its parameters as the ranking does (Δχ² − p·ln n_hold), scores clearly
   // below the effect: a simpler explanation is not confounded by a far richer one.
-  // Memory: one n × N work buffer for the backfit's remainders; the confounder alone is formed
-  // twice (its score first, its difference to the joint model at the end) instead of held.
-  auto beyond = [&](const std::function<Series(const Series&)>& confounder,
-                    int confounder_params, double* z_rest) {
+  // Memory: the confounder alone is scored here and formed again in JointBeyond, not held.
+  auto beyond = [&](const std::function<Series(const Series&)>& confounder, int confounder_params,
+                    double* z_rest) {
     const Sums s_alone = [&] {
       const Series alone = confounder(target);
       return Score(cx, target, &alone);
@@ -249,39 +290,8 @@ Confounding CheckConfounders(const Context& cx, const Series& target, const Effe
     const double score_conf = base_sse - s_alone.hold_sse - confounder_params * log_hold;
     *z_rest = 0.0;
     if (score_conf < score_effect) return true;
-    Series eff;  // the effect's refit (empty: the effect's own prediction, fit.pred)
-    bool eff_zero = false;
-    Series conf;  // assigned in the first iteration
-    Series work;
-    for (int iter = 0; iter < 3; ++iter) {
-      work = target - (eff.size() > 0 ? eff : fit.pred);
-      eff = Series();
-      conf = confounder(work);
-      work = target - conf;
-      auto refit = spec->fit(cx, work);
-      if (!refit) {
-        eff_zero = true;
-        break;
-      }
-      eff = std::move(refit->pred);
-    }
-    work = Series();
-    if (eff_zero) eff = Series::Zero(cx.n, cx.nc);
-    const Sums s_joint = ScoreSum(cx, target, conf, eff);
-    const Series alone = confounder(target);
-    // Score(cx, target, &(joint − alone)).hold_pp without an n × N difference matrix.
-    double spread = 0.0;
-    for (int c = 0; c < cx.nc; ++c) {
-      double pp = 0.0;
-      for (int i = 0; i < cx.n; ++i) {
-        if (cx.train[static_cast<std::size_t>(i)]) continue;
-        const double p = static_cast<double>(conf(i, c)) + eff(i, c) - alone(i, c);
-        pp += p * p;
-      }
-      spread += pp * cx.weight(c);
-    }
-    const double delta = s_alone.hold_sse - s_joint.hold_sse;
-    *z_rest = delta / (2.0 * std::sqrt(std::max(spread, 1e-300)));
+    double delta = 0.0;
+    *z_rest = JointBeyond(cx, target, fit, *spec, confounder, s_alone, &delta);
     return *z_rest > z_claim && delta > 0.0;
   };
   std::vector<std::string> words;

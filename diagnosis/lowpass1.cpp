@@ -226,7 +226,33 @@ void FirstOrderLowPassColumns(const double* t_s, std::size_t n, double tau_s,
   FirstOrderRows(t_s, 1, n, tau_s, x, y, 0, m, restart, &k);
 }
 
-static_assert(FirstOrderLowPassStream::kRows % kChunk == 0, "windows must start on chunk bounds");
+static_assert(LowPassWindows::kRows % kChunk == 0, "windows must start on chunk bounds");
+
+LowPassWindows::LowPassWindows(const double* t_s, std::size_t n, const double* const* x,
+                               std::size_t m, const std::uint8_t* restart)
+    : t_s_(t_s), n_(n), x_(x, x + m), restart_(restart), y_(m), buf_(m * (kRows + 2)) {
+  for (std::size_t c = 0; c < m; ++c) y_[c] = buf_.data() + c * (kRows + 2);
+}
+
+bool LowPassWindows::Next() {
+  if (next_ >= n_) return false;
+  const std::size_t m = x_.size();
+  // Slot 0 of a column holds row begin − 1 (the last output), slot s row begin − 1 + s.
+  if (next_ == 0) {
+    begin_ = 0;
+    for (std::size_t c = 0; c < m; ++c) y_[c][1] = x_[c][0];
+    Start();
+    next_ = 1;
+  } else {
+    begin_ = next_;
+    for (std::size_t c = 0; c < m; ++c) y_[c][0] = y_[c][size_];
+  }
+  const std::size_t end = std::min(n_, next_ + kRows);
+  FilterRows(next_, end, static_cast<std::ptrdiff_t>(begin_) - 1);
+  size_ = end - begin_;
+  next_ = end;
+  return true;
+}
 
 struct FirstOrderLowPassStream::Coefficients {
   FirstOrderChunk k;
@@ -235,37 +261,14 @@ struct FirstOrderLowPassStream::Coefficients {
 FirstOrderLowPassStream::FirstOrderLowPassStream(const double* t_s, std::size_t n, double tau_s,
                                                  const double* const* x, std::size_t m,
                                                  const std::uint8_t* restart)
-    : t_s_(t_s),
-      n_(n),
-      tau_s_(tau_s),
-      x_(x, x + m),
-      restart_(restart),
-      buf_(m * (kRows + 2)),
-      y_(m),
-      k_(std::make_unique<Coefficients>()) {
-  for (std::size_t c = 0; c < m; ++c) y_[c] = buf_.data() + c * (kRows + 2);
-}
+    : LowPassWindows(t_s, n, x, m, restart), tau_s_(tau_s), k_(std::make_unique<Coefficients>()) {}
 
 FirstOrderLowPassStream::~FirstOrderLowPassStream() = default;
 
-bool FirstOrderLowPassStream::Next() {
-  if (next_ >= n_) return false;
-  const std::size_t m = x_.size();
-  // Slot 0 of a column holds row begin − 1 (the filter's state), slot s row begin − 1 + s.
-  if (next_ == 0) {
-    begin_ = 0;
-    for (std::size_t c = 0; c < m; ++c) y_[c][1] = x_[c][0];
-    next_ = 1;
-  } else {
-    begin_ = next_;
-    for (std::size_t c = 0; c < m; ++c) y_[c][0] = y_[c][size_];
-  }
-  const std::size_t end = std::min(n_, next_ + kRows);
-  FirstOrderRows(t_s_, next_, end, tau_s_, x_.data(), y_.data(),
-                 static_cast<std::ptrdiff_t>(begin_) - 1, m, restart_, &k_->k);
-  size_ = end - begin_;
-  next_ = end;
-  return true;
+void FirstOrderLowPassStream::FilterRows(std::size_t i_begin, std::size_t i_end,
+                                         std::ptrdiff_t y_off) {
+  FirstOrderRows(t_s_, i_begin, i_end, tau_s_, x_.data(), y_.data(), y_off, x_.size(), restart_,
+                 &k_->k);
 }
 
 }  // namespace ftstack::diag

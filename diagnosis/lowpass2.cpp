@@ -253,11 +253,13 @@ void SecondOrderCoefficients(const SecondOrderShape& sh, const double* t_s, std:
   }
 }
 
-/// The recursion over the rows of a chunk for B columns at once (their states in registers).
+/// The recursion over the rows of a chunk for B columns at once (their states in registers); row
+/// i of column b is y[b][i − y_off].
 template <int B>
 void SecondOrderBlock(const SecondOrderChunk& k, double lag, std::size_t i0, std::size_t len,
-                      const double* const* x, double* const* y, double* pos_io, double* vel_io,
-                      const std::uint8_t* restart) {
+                      const double* const* x, double* const* y, std::ptrdiff_t y_off,
+                      double* pos_io, double* vel_io, const std::uint8_t* restart) {
+  const auto at = [&](std::size_t i) { return static_cast<std::ptrdiff_t>(i) - y_off; };
   double pos[B];
   double vel[B];
   double xp[B];
@@ -270,7 +272,7 @@ void SecondOrderBlock(const SecondOrderChunk& k, double lag, std::size_t i0, std
     const std::size_t i = i0 + j;
     if (restart != nullptr && restart[i] != 0) {  // a new recording: at rest at its first input
       for (int b = 0; b < B; ++b) {
-        y[b][i] = pos[b] = xp[b] = x[b][i];
+        y[b][at(i)] = pos[b] = xp[b] = x[b][i];
         vel[b] = 0.0;
       }
       continue;
@@ -289,12 +291,38 @@ void SecondOrderBlock(const SecondOrderChunk& k, double lag, std::size_t i0, std
       pos[b] = xi - lag * slope + p00 * e0 + p01 * e1;
       vel[b] = slope + p10 * e0 + p11 * e1;
       xp[b] = xi;
-      y[b][i] = pos[b];
+      y[b][at(i)] = pos[b];
     }
   }
   for (int b = 0; b < B; ++b) {
     pos_io[b] = pos[b];
     vel_io[b] = vel[b];
+  }
+}
+
+/// Rows [i_begin, i_end) (i_begin − 1 a multiple of kChunk) of m columns from the states pos, vel
+/// (row i_begin − 1), row i of column c at y[c][i − y_off].
+// Flattened: every helper inlined, which the compiler does not do on its own here and which is
+// measurably faster (the loops are then compiled with what the caller knows).
+FTSTACK_LOWPASS_TARGETS [[gnu::flatten]] void SecondOrderRows(
+    const SecondOrderShape& sh, double lag, const double* t_s, std::size_t i_begin,
+    std::size_t i_end, const double* const* x, double* const* y, std::ptrdiff_t y_off,
+    std::size_t m, const std::uint8_t* restart, double* pos, double* vel, SecondOrderChunk* k) {
+  for (std::size_t i0 = i_begin; i0 < i_end; i0 += kChunk) {
+    const std::size_t len = std::min(kChunk, i_end - i0);
+    SecondOrderCoefficients(sh, t_s, i0, len, k);
+    // Four columns at a time (their states in registers), then the rest together.
+    std::size_t c = 0;
+    for (; c + 4 <= m; c += 4) {
+      SecondOrderBlock<4>(*k, lag, i0, len, x + c, y + c, y_off, pos + c, vel + c, restart);
+    }
+    const std::size_t r = m - c;
+    if (r == 3)
+      SecondOrderBlock<3>(*k, lag, i0, len, x + c, y + c, y_off, pos + c, vel + c, restart);
+    if (r == 2)
+      SecondOrderBlock<2>(*k, lag, i0, len, x + c, y + c, y_off, pos + c, vel + c, restart);
+    if (r == 1)
+      SecondOrderBlock<1>(*k, lag, i0, len, x + c, y + c, y_off, pos + c, vel + c, restart);
   }
 }
 
@@ -305,11 +333,9 @@ void SecondOrderLowPass(const double* t_s, const double* x, std::size_t n, doubl
   SecondOrderLowPassColumns(t_s, n, freq_hz, damping_ratio, &x, &y, 1);
 }
 
-// Flattened: every helper inlined, which the compiler does not do on its own here and which is
-// measurably faster (the loops are then compiled with what the caller knows).
-FTSTACK_LOWPASS_TARGETS [[gnu::flatten]] void SecondOrderLowPassColumns(
-    const double* t_s, std::size_t n, double freq_hz, double damping_ratio, const double* const* x,
-    double* const* y, std::size_t m, const std::uint8_t* restart) {
+void SecondOrderLowPassColumns(const double* t_s, std::size_t n, double freq_hz,
+                               double damping_ratio, const double* const* x, double* const* y,
+                               std::size_t m, const std::uint8_t* restart) {
   if (n == 0 || m == 0) return;
   const SecondOrderShape sh = MakeShape(2.0 * M_PI * freq_hz, damping_ratio);
   const double lag = 2.0 * damping_ratio / sh.w;  // the steady lag of y behind a ramp, s
@@ -317,18 +343,40 @@ FTSTACK_LOWPASS_TARGETS [[gnu::flatten]] void SecondOrderLowPassColumns(
   std::vector<double> vel(m, 0.0);
   for (std::size_t c = 0; c < m; ++c) y[c][0] = pos[c] = x[c][0];
   SecondOrderChunk k;
-  for (std::size_t i0 = 1; i0 < n; i0 += kChunk) {
-    const std::size_t len = std::min(kChunk, n - i0);
-    SecondOrderCoefficients(sh, t_s, i0, len, &k);
-    // Four columns at a time (their states in registers), then the rest together.
-    std::size_t c = 0;
-    for (; c + 4 <= m; c += 4) {
-      SecondOrderBlock<4>(k, lag, i0, len, x + c, y + c, &pos[c], &vel[c], restart);
-    }
-    if (m - c == 3) SecondOrderBlock<3>(k, lag, i0, len, x + c, y + c, &pos[c], &vel[c], restart);
-    if (m - c == 2) SecondOrderBlock<2>(k, lag, i0, len, x + c, y + c, &pos[c], &vel[c], restart);
-    if (m - c == 1) SecondOrderBlock<1>(k, lag, i0, len, x + c, y + c, &pos[c], &vel[c], restart);
+  SecondOrderRows(sh, lag, t_s, 1, n, x, y, 0, m, restart, pos.data(), vel.data(), &k);
+}
+
+struct SecondOrderLowPassStream::State {
+  SecondOrderShape sh;
+  double lag;
+  std::vector<double> pos;
+  std::vector<double> vel;
+  SecondOrderChunk k;
+};
+
+SecondOrderLowPassStream::SecondOrderLowPassStream(const double* t_s, std::size_t n, double freq_hz,
+                                                   double damping_ratio, const double* const* x,
+                                                   std::size_t m, const std::uint8_t* restart)
+    : LowPassWindows(t_s, n, x, m, restart), st_(std::make_unique<State>()) {
+  st_->sh = MakeShape(2.0 * M_PI * freq_hz, damping_ratio);
+  st_->lag = 2.0 * damping_ratio / st_->sh.w;
+  st_->pos.assign(m, 0.0);
+  st_->vel.assign(m, 0.0);
+}
+
+SecondOrderLowPassStream::~SecondOrderLowPassStream() = default;
+
+void SecondOrderLowPassStream::Start() {
+  for (std::size_t c = 0; c < x_.size(); ++c) {
+    st_->pos[c] = x_[c][0];
+    st_->vel[c] = 0.0;
   }
+}
+
+void SecondOrderLowPassStream::FilterRows(std::size_t i_begin, std::size_t i_end,
+                                          std::ptrdiff_t y_off) {
+  SecondOrderRows(st_->sh, st_->lag, t_s_, i_begin, i_end, x_.data(), y_.data(), y_off, x_.size(),
+                  restart_, st_->pos.data(), st_->vel.data(), &st_->k);
 }
 
 }  // namespace ftstack::diag

@@ -14,7 +14,6 @@
 namespace ftstack::diag {
 namespace {
 
-
 double HoldPenalty(const Context& cx) {
   return std::log(std::max(2.0, static_cast<double>(cx.n_hold) * cx.nc));
 }
@@ -216,8 +215,7 @@ double HoldRms(const Context& cx, const Series& target, const Series* pred) {
   for (int c = 0; c < cx.nc; ++c) {
     for (int i = 0; i < cx.n; ++i) {
       if (cx.train[static_cast<std::size_t>(i)]) continue;
-      const double e =
-          static_cast<double>(target(i, c)) - (pred != nullptr ? (*pred)(i, c) : 0.0);
+      const double e = static_cast<double>(target(i, c)) - (pred != nullptr ? (*pred)(i, c) : 0.0);
       s += e * e;
     }
   }

@@ -58,19 +58,18 @@ void FirstOrderLowPass(const double* t_s, const double* x, std::size_t n, double
 void FirstOrderLowPassColumns(const double* t_s, std::size_t n, double tau_s,
                               const double* const* x, double* const* y, std::size_t m,
                               const std::uint8_t* restart = nullptr);
-/// FirstOrderLowPassColumns row window by row window, for consumers that read every row once
-/// (memory: kRows rows per column instead of n; the same bits as the whole columns):
+/// A filter's output over the rows window by window, for consumers that read every row once
+/// (memory: kRows rows per column instead of n; the same bits as the filter's whole columns):
 ///   FirstOrderLowPassStream s(t, n, tau, x, m, restart);
-///   while (s.Next()) for (i = s.begin(); i < s.begin() + s.size(); ++i) … s.col(c)[i − s.begin()]
-class FirstOrderLowPassStream {
+///   while (s.Next()) for (j = 0; j < s.size(); ++j) … s.col(c)[j] is row s.begin() + j …
+class LowPassWindows {
  public:
-  /// Rows per window after the first (which has one more: row 0).
+  /// Rows per window after the first (which has one more: row 0); a multiple of the filters'
+  /// coefficient chunks, so that the windows compute the coefficients over the same rows.
   static constexpr std::size_t kRows = 4096;
-  FirstOrderLowPassStream(const double* t_s, std::size_t n, double tau_s, const double* const* x,
-                          std::size_t m, const std::uint8_t* restart = nullptr);
-  ~FirstOrderLowPassStream();
-  FirstOrderLowPassStream(const FirstOrderLowPassStream&) = delete;
-  FirstOrderLowPassStream& operator=(const FirstOrderLowPassStream&) = delete;
+  virtual ~LowPassWindows() = default;
+  LowPassWindows(const LowPassWindows&) = delete;
+  LowPassWindows& operator=(const LowPassWindows&) = delete;
   /// Filters the next window of rows; false after the last.
   [[nodiscard]] bool Next();
   /// First row of the current window, and its number of rows.
@@ -79,19 +78,39 @@ class FirstOrderLowPassStream {
   /// Column c's output over the window: col(c)[j] is row begin() + j.
   [[nodiscard]] const double* col(std::size_t c) const { return y_[c] + 1; }
 
- private:
-  struct Coefficients;
+ protected:
+  LowPassWindows(const double* t_s, std::size_t n, const double* const* x, std::size_t m,
+                 const std::uint8_t* restart);
+  /// Rows [i_begin, i_end) (i_begin ≥ 1) into y()[c][i − y_off]; row i_begin − 1 is at
+  /// y()[c][i_begin − 1 − y_off] (the output's last row, slot 0 of the window).
+  virtual void FilterRows(std::size_t i_begin, std::size_t i_end, std::ptrdiff_t y_off) = 0;
+  /// The filter starts at rest at row 0 (its output there, x[c][0], is written already).
+  virtual void Start() {}
   const double* t_s_;
   std::size_t n_;
-  double tau_s_;
   std::vector<const double*> x_;
   const std::uint8_t* restart_;
-  std::vector<double> buf_;
   std::vector<double*> y_;
-  std::unique_ptr<Coefficients> k_;
+
+ private:
+  std::vector<double> buf_;
   std::size_t next_ = 0;
   std::size_t begin_ = 0;
   std::size_t size_ = 0;
+};
+
+/// FirstOrderLowPassColumns window by window (LowPassWindows).
+class FirstOrderLowPassStream : public LowPassWindows {
+ public:
+  FirstOrderLowPassStream(const double* t_s, std::size_t n, double tau_s, const double* const* x,
+                          std::size_t m, const std::uint8_t* restart = nullptr);
+  ~FirstOrderLowPassStream() override;
+
+ private:
+  void FilterRows(std::size_t i_begin, std::size_t i_end, std::ptrdiff_t y_off) override;
+  struct Coefficients;
+  double tau_s_;
+  std::unique_ptr<Coefficients> k_;
 };
 
 /// Second-order low pass ÿ + 2ζω ẏ + ω² y = ω² x (ω = 2π·freq_hz), unit DC gain, exact for inputs
@@ -104,6 +123,21 @@ void SecondOrderLowPass(const double* t_s, const double* x, std::size_t n, doubl
 void SecondOrderLowPassColumns(const double* t_s, std::size_t n, double freq_hz,
                                double damping_ratio, const double* const* x, double* const* y,
                                std::size_t m, const std::uint8_t* restart = nullptr);
+/// SecondOrderLowPassColumns window by window (LowPassWindows).
+class SecondOrderLowPassStream : public LowPassWindows {
+ public:
+  SecondOrderLowPassStream(const double* t_s, std::size_t n, double freq_hz, double damping_ratio,
+                           const double* const* x, std::size_t m,
+                           const std::uint8_t* restart = nullptr);
+  ~SecondOrderLowPassStream() override;
+
+ private:
+  void FilterRows(std::size_t i_begin, std::size_t i_end, std::ptrdiff_t y_off) override;
+  void Start() override;
+  struct State;
+  std::unique_ptr<State> st_;
+};
+
 /// Rate-independent first-order hysteresis operator (Dahl type) of x with characteristic travel
 /// width: z moves toward sign(dx) by 1 − exp(−|dx|/width) per step; starts at 0. Output in [−1, 1].
 void DahlOperator(const double* x, std::size_t n, double width, double* z);

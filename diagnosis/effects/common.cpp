@@ -33,19 +33,26 @@ double CurvatureSigma(const std::function<double(double)>& f, double x, double h
   return d2 > 0 ? std::sqrt(2.0 / d2) : std::numeric_limits<double>::quiet_NaN();
 }
 
-void RingingRows(const Context& cx, double f_hz, double zeta, const std::vector<int>& chans, int i0,
-                 int m, Mat* h) {
-  const auto& d = *cx.data;
+void RingingAt(const Context& cx, double f_hz, double zeta, const std::vector<int>& chans, int i0,
+               int m, int step, Mat* out) {
   std::vector<const double*> in;
-  std::vector<double*> out;
-  for (int c : chans) {
-    in.push_back(cx.load.col(c).data() + i0);  // LP[sim] − sim = LP[load] − load
-    out.push_back(h->col(c).data() + i0);
-  }
+  for (int c : chans) in.push_back(cx.load.col(c).data() + i0);  // LP[sim] − sim = LP[load] − load
   const std::uint8_t* restart = Restarts(cx);
-  SecondOrderLowPassColumns(d.t_s.data() + i0, static_cast<std::size_t>(m), f_hz, zeta, in.data(),
-                            out.data(), in.size(), restart != nullptr ? restart + i0 : nullptr);
-  for (int c : chans) h->col(c).segment(i0, m) -= cx.load.col(c).segment(i0, m);
+  out->resize((m + step - 1) / step, static_cast<Eigen::Index>(chans.size()));
+  SecondOrderLowPassStream s(cx.data->t_s.data() + i0, static_cast<std::size_t>(m), f_hz, zeta,
+                             in.data(), in.size(), restart != nullptr ? restart + i0 : nullptr);
+  const auto st = static_cast<std::size_t>(step);
+  while (s.Next()) {
+    std::size_t j = (st - s.begin() % st) % st;  // the window's first kept row
+    for (; j < s.size(); j += st) {
+      const std::size_t rel = s.begin() + j;
+      const auto r = static_cast<Eigen::Index>(rel / st);
+      for (std::size_t k = 0; k < chans.size(); ++k) {
+        (*out)(r, static_cast<Eigen::Index>(k)) =
+            s.col(k)[j] - cx.load(i0 + static_cast<int>(rel), chans[k]);
+      }
+    }
+  }
 }
 
 std::vector<int> StrongestTwo(const Context& cx, const Series& r) {
@@ -116,8 +123,7 @@ std::vector<int> StrideRows(const Context& cx) {
 }
 
 void LowPassLoadRows(const Context& cx, double tau, const std::vector<int>& rows, Mat* out) {
-  std::vector<const double*> in;
-  for (int c = 0; c < cx.nc; ++c) in.push_back(cx.load.col(c).data());
+  const std::vector<const double*> in = LoadColumns(cx);
   out->resize(static_cast<Eigen::Index>(rows.size()), cx.nc);
   FirstOrderLowPassStream s(cx.data->t_s.data(), static_cast<std::size_t>(cx.n), tau, in.data(),
                             in.size(), Restarts(cx));

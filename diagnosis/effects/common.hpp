@@ -56,7 +56,8 @@ ChannelFit FitChannels(const Context& cx, const Series& target, int p, F feat, S
       if (stride > 1) continue;  // searches only compare the active channels
       double s = 0.0;
       for (int i = 0; i < cx.n; ++i) {
-        if (cx.train[static_cast<std::size_t>(i)]) s += static_cast<double>(target(i, c)) * target(i, c);
+        if (cx.train[static_cast<std::size_t>(i)])
+          s += static_cast<double>(target(i, c)) * target(i, c);
       }
       out.sse(c) = s;
       out.sse_w += s * cx.weight(c);
@@ -139,36 +140,70 @@ std::vector<int> StrideRows(const Context& cx);
 /// as the whole filter).
 void LowPassLoadRows(const Context& cx, double tau, const std::vector<int>& rows, Mat* out);
 
-/// Streams the first-order lags of the load LP_τ[load] (restarting per segment) for the k time
-/// constants taus[0..k) over every row: visit(i, c, lag) with lag[q] the lag of τ_q at row i,
-/// channel c; per channel the rows come in increasing order (memory: windows of rows, not n × N).
+/// Visits equally long streams over the context's rows (one column per channel) row by row:
+/// visit(i, c, v) with v[q] stream q's value at row i, channel c; per channel the rows come in
+/// increasing order (memory: windows of rows, not n × N).
 template <class F>
-void ForLaggedLoad(const Context& cx, const double* taus, int k, F visit) {
+void ForStreams(const Context& cx, const std::vector<std::unique_ptr<LowPassWindows>>& s, F visit) {
+  std::vector<double> v(s.size());
+  for (;;) {
+    bool more = true;
+    for (const auto& q : s) more = q->Next() && more;  // every stream has the same windows
+    if (!more) return;
+    const std::size_t b = s.front()->begin();
+    for (int c = 0; c < cx.nc; ++c) {
+      for (std::size_t j = 0; j < s.front()->size(); ++j) {
+        for (std::size_t q = 0; q < s.size(); ++q) v[q] = s[q]->col(static_cast<std::size_t>(c))[j];
+        visit(static_cast<int>(b + j), c, v.data());
+      }
+    }
+  }
+}
+
+/// The load's columns (the filters' inputs).
+inline std::vector<const double*> LoadColumns(const Context& cx) {
   std::vector<const double*> in;
   for (int c = 0; c < cx.nc; ++c) in.push_back(cx.load.col(c).data());
-  std::vector<std::unique_ptr<FirstOrderLowPassStream>> s;
+  return in;
+}
+
+/// Streams the first-order lags of the load LP_τ[load] (restarting per segment) for the k time
+/// constants taus[0..k) over every row: visit(i, c, lag) with lag[q] the lag of τ_q (ForStreams).
+template <class F>
+void ForLaggedLoad(const Context& cx, const double* taus, int k, F visit) {
+  const std::vector<const double*> in = LoadColumns(cx);
+  std::vector<std::unique_ptr<LowPassWindows>> s;
   for (int q = 0; q < k; ++q) {
     s.push_back(std::make_unique<FirstOrderLowPassStream>(cx.data->t_s.data(),
                                                           static_cast<std::size_t>(cx.n), taus[q],
                                                           in.data(), in.size(), Restarts(cx)));
   }
-  std::vector<double> lag(static_cast<std::size_t>(k));
-  for (;;) {
-    bool more = true;
-    for (auto& q : s) more = q->Next() && more;  // every stream has the same windows
-    if (!more) return;
-    const std::size_t b = s.front()->begin();
-    for (int c = 0; c < cx.nc; ++c) {
-      for (std::size_t j = 0; j < s.front()->size(); ++j) {
-        for (int q = 0; q < k; ++q) {
-          lag[static_cast<std::size_t>(q)] =
-              s[static_cast<std::size_t>(q)]->col(static_cast<std::size_t>(c))[j];
-        }
-        visit(static_cast<int>(b + j), c, lag.data());
-      }
-    }
-  }
+  ForStreams(cx, s, visit);
 }
+
+/// Streams the ringing H_{f,ζ}[load] − load of every channel for the k modes (f_hz[q], zeta[q])
+/// over every row (restarting at rest per segment): visit(i, c, h) with h[q] mode q's ringing.
+template <class F>
+void ForRinging(const Context& cx, const double* f_hz, const double* zeta, int k, F visit) {
+  const std::vector<const double*> in = LoadColumns(cx);
+  std::vector<std::unique_ptr<LowPassWindows>> s;
+  for (int q = 0; q < k; ++q) {
+    s.push_back(std::make_unique<SecondOrderLowPassStream>(
+        cx.data->t_s.data(), static_cast<std::size_t>(cx.n), f_hz[q], zeta[q], in.data(), in.size(),
+        Restarts(cx)));
+  }
+  std::vector<double> h(static_cast<std::size_t>(k));
+  ForStreams(cx, s, [&](int i, int c, const double* v) {
+    for (int q = 0; q < k; ++q) h[static_cast<std::size_t>(q)] = v[q] - cx.load(i, c);
+    visit(i, c, h.data());
+  });
+}
+
+/// The ringing of the channels `chans` over rows [i0, i0 + m) (at rest at row i0, restarting per
+/// segment), kept at rows i0, i0 + step, …: out(r, k) is row i0 + r·step of channel chans[k]
+/// (memory: (m / step) × chans, not n × N; the values ForRinging gives when i0 = 0).
+void RingingAt(const Context& cx, double f_hz, double zeta, const std::vector<int>& chans, int i0,
+               int m, int step, Mat* out);
 
 /// FitChannels' normal equations for features that arrive row window by row window (streamed
 /// filters, FirstOrderLowPassStream): Add rows of one channel in increasing order, then Solve. The
@@ -189,11 +224,6 @@ inline std::vector<int> AllChannels(const Context& cx) {
   for (int c = 0; c < cx.nc; ++c) all[static_cast<std::size_t>(c)] = c;
   return all;
 }
-/// h(i, c) = H_{f,ζ}[sim_c](i) − sim_c(i) for rows i0 … i0 + m − 1 and the channels `chans`: the
-/// exact second-order low pass on the actual dt of every row, at rest at row i0 and restarting
-/// at rest at every segment (a resonance's ringing).
-void RingingRows(const Context& cx, double f_hz, double zeta, const std::vector<int>& chans, int i0,
-                 int m, Mat* h);
 /// The two channels carrying the most whitened energy of r (where ringing searches look).
 std::vector<int> StrongestTwo(const Context& cx, const Series& r);
 /// Channel whose prediction carries the largest whitened energy.

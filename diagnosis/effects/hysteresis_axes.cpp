@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "diagnosis/effects.hpp"
+#include "diagnosis/effects/common.hpp"
 #include "diagnosis/signal.hpp"
 #include "measurement/wrench.hpp"
 
@@ -153,7 +154,8 @@ AxisFit Solve(const Context& cx, const Runs& runs, AxisOperators ops) {
   return out;
 }
 
-Series Predict(const Context& cx, const Runs& runs, AxisOperators ops, const Eigen::VectorXd& beta) {
+Series Predict(const Context& cx, const Runs& runs, AxisOperators ops,
+               const Eigen::VectorXd& beta) {
   const int p = ops.p();
   Series pred(cx.n, cx.nc);
   std::vector<double> z(static_cast<std::size_t>(p));
@@ -311,13 +313,11 @@ std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Series& targ
   e.params["loop_half_height"] = half;  // N for forces, N·m for moments
   e.sigma["loop_half_height"] = half_sigma;
   if (!use_pi) e.params["travel_fraction"] = best_frac;
+  const int bc = fx::DominantChannel(cx, e.pred);
   for (int c = 0; c < cx.nc; ++c) {
-    if (e.pred.col(c).cast<double>().squaredNorm() * cx.weight(c) > 0.01 * cx.n) e.channels.push_back(c);
-  }
-  int bc = 0;
-  for (int c = 1; c < cx.nc; ++c) {
-    if (e.pred.col(c).cast<double>().squaredNorm() * cx.weight(c) > e.pred.col(bc).cast<double>().squaredNorm() * cx.weight(bc))
-      bc = c;
+    if (e.pred.col(c).cast<double>().squaredNorm() * cx.weight(c) > 0.01 * cx.n) {
+      e.channels.push_back(c);
+    }
   }
   if (e.channels.empty()) e.channels.push_back(bc);
   const Eigen::VectorXd col = e.pred.col(bc).cast<double>();

@@ -171,7 +171,8 @@ std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Series& 
     }
   }
   for (int c = 0; c < cx.nc; ++c) {
-    if (e.pred.col(c).cast<double>().squaredNorm() * cx.weight(c) > 0.01 * cx.n) e.channels.push_back(c);
+    if (e.pred.col(c).cast<double>().squaredNorm() * cx.weight(c) > 0.01 * cx.n)
+      e.channels.push_back(c);
   }
   if (e.channels.empty()) e.channels.push_back(best_c);
   const Eigen::VectorXd col = e.pred.col(best_c).cast<double>();

@@ -192,19 +192,22 @@ std::pair<int, int> CoarseWindow(const Context& cx, const std::vector<int>& chan
 }
 
 /// Whitened training SSE of a one-coefficient fit of target to h per channel of `chans`, on rows
-/// [w0, w1) (the coarse stage of a windowed ringing search).
-double WindowSse(const Context& cx, const Series& target, const Mat& h, const std::vector<int>& chans,
-                 int w0, int w1) {
+/// [w0, w1) (the coarse stage of a windowed ringing search); h(i − w0, k) is channel chans[k].
+double WindowSse(const Context& cx, const Series& target, const Mat& h,
+                 const std::vector<int>& chans, int w0, int w1) {
   double s = 0.0;
-  for (int c : chans) {
+  for (std::size_t k = 0; k < chans.size(); ++k) {
+    const int c = chans[k];
+    const double* hk = h.col(static_cast<Eigen::Index>(k)).data();
     double hh = 0.0;
     double hy = 0.0;
     double yy = 0.0;
     for (int i = w0; i < w1; ++i) {
       if (!cx.train[static_cast<std::size_t>(i)]) continue;
       const double y = target(i, c);
-      hh += h(i, c) * h(i, c);
-      hy += h(i, c) * y;
+      const double hv = hk[i - w0];
+      hh += hv * hv;
+      hy += hv * y;
       yy += y * y;
     }
     s += std::max(0.0, yy - (hh > 0 ? hy * hy / hh : 0.0)) * cx.weight(c);
@@ -212,33 +215,55 @@ double WindowSse(const Context& cx, const Series& target, const Mat& h, const st
   return s;
 }
 
+/// The one-mode ringing at (f, ζ) fitted on every channel and row, streamed (no n × N buffer): the
+/// channel fit in *cf, the prediction in *pred; returns the whitened training SSE.
+double FitRingingAll(const Context& cx, const Series& target, double f, double z, ChannelFit* cf,
+                     Series* pred) {
+  ChannelSums sums(cx, 1);
+  ForRinging(cx, &f, &z, 1, [&](int i, int c, const double* hv) {
+    if (cx.train[static_cast<std::size_t>(i)]) sums.Add(c, hv, target(i, c));
+  });
+  *cf = sums.Solve(cx);
+  pred->resize(cx.n, cx.nc);
+  ForRinging(cx, &f, &z, 1, [&](int i, int c, const double* hv) {
+    double v = 0.0;
+    v += cf->beta(0, c) * hv[0];
+    (*pred)(i, c) = static_cast<float>(v);
+  });
+  return cf->sse_w;
+}
+
 }  // namespace
 
 std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target,
                                          const EffectFit* near, bool uncertainty) {
   const double nyq = 0.5 * cx.rate_hz;
-  Mat h(cx.n, cx.nc);
+  // The searches keep the ringing only where they read it (the window's rows, or every st-th row,
+  // of their channels); the final fit streams it over every row (memory: no n × N buffer).
+  Mat h;
   // Coarse search on the two channels with the most residual energy, on all rows or (long records)
   // the window with the most load-step energy.
   const std::vector<int> coarse = StrongestTwo(cx, target);
   const auto [w0, w1] = CoarseWindow(cx, coarse);
   bool windowed = false;
-  auto build = [&](double f, double z, const std::vector<int>& chans) {
-    RingingRows(cx, f, z, chans, windowed ? w0 : 0, windowed ? w1 - w0 : cx.n, &h);
-  };
   int st = cx.search_stride;
   const auto in_range = [&](double f, double z) {
     return f > 0.05 && f < 0.98 * nyq && z > 1e-4 && z <= 2.0;
   };
-  auto sse_for = [&](double f, double z, const std::vector<int>& chans, Series* out,
-                     ChannelFit* cf) {
+  auto sse_for = [&](double f, double z, const std::vector<int>& chans) {
     if (!in_range(f, z)) return std::numeric_limits<double>::infinity();
-    build(f, z, chans);
-    if (windowed) return WindowSse(cx, target, h, chans, w0, w1);
-    auto r = FitChannels(
-        cx, target, 1, [&](int i, int c, double* x) { x[0] = h(i, c); }, out, &chans,
-        out != nullptr || cf != nullptr ? 1 : st);
-    if (cf != nullptr) *cf = r;
+    if (windowed) {
+      RingingAt(cx, f, z, chans, w0, w1 - w0, 1, &h);
+      return WindowSse(cx, target, h, chans, w0, w1);
+    }
+    RingingAt(cx, f, z, chans, 0, cx.n, st, &h);
+    std::vector<int> col(static_cast<std::size_t>(cx.nc), 0);  // channel → column of h
+    for (std::size_t k = 0; k < chans.size(); ++k)
+      col[static_cast<std::size_t>(chans[k])] = static_cast<int>(k);
+    const auto r = FitChannels(
+        cx, target, 1,
+        [&](int i, int c, double* x) { x[0] = h(i / st, col[static_cast<std::size_t>(c)]); },
+        nullptr, &chans, st);
     double s = 0.0;
     for (int c : chans) s += r.sse(c) * cx.weight(c);
     return s;
@@ -259,7 +284,7 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target
   windowed = w1 - w0 < cx.n;  // the coarse grid and the first round
   for (double f : fgrid) {
     for (double z : zgrid) {
-      const double s = sse_for(f, z, coarse, nullptr, nullptr);
+      const double s = sse_for(f, z, coarse);
       if (s < bs) {
         bs = s;
         bf = f;
@@ -280,14 +305,12 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target
     }
     std::vector<double> g1;
     for (int j = -2; j <= 2; ++j) g1.push_back(lf + 0.04 * j / (round + 1));
-    lf = MinimizeOnGrid(
-        [&](double v) { return sse_for(std::exp(v), std::exp(lz), chans, nullptr, nullptr); }, g1,
-        7, nullptr);
+    lf = MinimizeOnGrid([&](double v) { return sse_for(std::exp(v), std::exp(lz), chans); }, g1, 7,
+                        nullptr);
     std::vector<double> g2;
     for (int j = -2; j <= 2; ++j) g2.push_back(lz + 0.3 * j / (round + 1));
-    lz = MinimizeOnGrid(
-        [&](double v) { return sse_for(std::exp(lf), std::exp(v), chans, nullptr, nullptr); }, g2,
-        7, nullptr);
+    lz = MinimizeOnGrid([&](double v) { return sse_for(std::exp(lf), std::exp(v), chans); }, g2, 7,
+                        nullptr);
   }
   EffectFit e;
   e.name = "resonance";
@@ -295,20 +318,18 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target
   ChannelFit cf;
   const double f = std::exp(lf);
   const double z = std::exp(lz);
-  e.train_sse_w = sse_for(f, z, all, &e.pred, &cf);
+  e.train_sse_w = FitRingingAll(cx, target, f, z, &cf, &e.pred);
   e.params["freq_hz"] = f;
   e.params["damping_ratio"] = z;
   e.params["damped_freq_hz"] = f * std::sqrt(std::max(0.0, 1.0 - z * z));
   if (uncertainty) {
     e.sigma["freq_hz"] = JsonNum(
-        f * CurvatureSigma([&](double v) { return sse_for(std::exp(v), z, all, nullptr, nullptr); },
-                           lf, 0.002));
+        f * CurvatureSigma([&](double v) { return sse_for(std::exp(v), z, all); }, lf, 0.002));
     e.sigma["damping_ratio"] = JsonNum(
-        z * CurvatureSigma([&](double v) { return sse_for(f, std::exp(v), all, nullptr, nullptr); },
-                           lz, 0.02));
+        z * CurvatureSigma([&](double v) { return sse_for(f, std::exp(v), all); }, lz, 0.02));
   }
   PutChannelCoef(cx, cf, 0, "participation", &e);
-  h = Mat();  // memory: the second mode's search has buffers of its own
+  h = Mat();
   e.variant = "one mode";
   e.search_state = {lf, lz};
   const bool near_two = warm && near->search_state.size() >= 4;

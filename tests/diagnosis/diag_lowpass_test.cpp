@@ -7,7 +7,9 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "diagnosis/lowpass_kernels.hpp"
@@ -275,42 +277,70 @@ Record LongRecord() {
     }
     offset = rec.t.back() + 0.01;
   }
-  const std::size_t w = FirstOrderLowPassStream::kRows;
+  const std::size_t w = LowPassWindows::kRows;
   rec.restart[w] = 1;
   rec.restart[2 * w + 1] = 1;
   AddInputs(&rec);
   return rec;
 }
 
-TEST(DiagLowPass, FirstOrderStreamGivesTheWholeColumnsBitForBit) {
-  const Record rec = LongRecord();
-  const std::size_t w = FirstOrderLowPassStream::kRows;
+/// Streams `make(n)` over the first n rows of LongRecord and compares every row with `whole` (the
+/// filter's whole columns) bit for bit, for n around the window bounds.
+template <class Whole, class Make>
+void ExpectStreamIsWhole(const Record& rec, Whole whole, Make make, const std::string& what) {
+  const std::size_t w = LowPassWindows::kRows;
   for (std::size_t n : {std::size_t{1}, std::size_t{2}, w, w + 1, w + 2, rec.t.size()}) {
-    for (double tau : {0.003, 0.3, 1000.0}) {
-      std::vector<std::vector<double>> whole(3, std::vector<double>(n));
-      const double* in[3] = {rec.x[0].data(), rec.x[1].data(), rec.x[2].data()};
-      double* out[3] = {whole[0].data(), whole[1].data(), whole[2].data()};
-      FirstOrderLowPassColumns(rec.t.data(), n, tau, in, out, 3, rec.restart.data());
-      FirstOrderLowPassStream s(rec.t.data(), n, tau, in, 3, rec.restart.data());
-      std::size_t seen = 0;
-      int windows = 0;
-      while (s.Next()) {
-        ASSERT_EQ(s.begin(), seen);
-        ++windows;
-        for (std::size_t j = 0; j < s.size(); ++j, ++seen) {
-          for (std::size_t c = 0; c < 3; ++c) {
-            ASSERT_EQ(s.col(c)[j], whole[c][seen])
-                << "n " << n << " tau " << tau << " row " << seen;
-          }
+    std::vector<std::vector<double>> ref(3, std::vector<double>(n));
+    const double* in[3] = {rec.x[0].data(), rec.x[1].data(), rec.x[2].data()};
+    double* out[3] = {ref[0].data(), ref[1].data(), ref[2].data()};
+    whole(n, in, out);
+    const auto s = make(n, in);
+    std::size_t seen = 0;
+    int windows = 0;
+    while (s->Next()) {
+      ASSERT_EQ(s->begin(), seen);
+      ++windows;
+      for (std::size_t j = 0; j < s->size(); ++j, ++seen) {
+        for (std::size_t c = 0; c < 3; ++c) {
+          ASSERT_EQ(s->col(c)[j], ref[c][seen]) << what << " n " << n << " row " << seen;
         }
       }
-      EXPECT_EQ(seen, n);
-      // The first window has w + 1 rows (row 0 and a full window), the others w.
-      EXPECT_EQ(windows, static_cast<int>(std::max<std::size_t>(1, (n - 1 + w - 1) / w))) << n;
-      EXPECT_FALSE(s.Next());
     }
+    EXPECT_EQ(seen, n);
+    // The first window has w + 1 rows (row 0 and a full window), the others w.
+    EXPECT_EQ(windows, static_cast<int>(std::max<std::size_t>(1, (n - 1 + w - 1) / w))) << n;
+    EXPECT_FALSE(s->Next());
   }
 }
 
+TEST(DiagLowPass, StreamsGiveTheWholeColumnsBitForBit) {
+  const Record rec = LongRecord();
+  const std::uint8_t* restart = rec.restart.data();
+  for (double tau : {0.003, 0.3, 1000.0}) {
+    ExpectStreamIsWhole(
+        rec,
+        [&](std::size_t n, const double* const* in, double* const* out) {
+          FirstOrderLowPassColumns(rec.t.data(), n, tau, in, out, 3, restart);
+        },
+        [&](std::size_t n, const double* const* in) {
+          return std::make_unique<FirstOrderLowPassStream>(rec.t.data(), n, tau, in, 3, restart);
+        },
+        "first order tau " + std::to_string(tau));
+  }
+  for (double zeta : {0.01, 1.0, 1.5}) {
+    for (double f : {0.5, 30.0}) {
+      ExpectStreamIsWhole(
+          rec,
+          [&](std::size_t n, const double* const* in, double* const* out) {
+            SecondOrderLowPassColumns(rec.t.data(), n, f, zeta, in, out, 3, restart);
+          },
+          [&](std::size_t n, const double* const* in) {
+            return std::make_unique<SecondOrderLowPassStream>(rec.t.data(), n, f, zeta, in, 3,
+                                                              restart);
+          },
+          "second order f " + std::to_string(f) + " zeta " + std::to_string(zeta));
+    }
+  }
+}
 }  // namespace
 }  // namespace ftstack::diag
