@@ -1,5 +1,6 @@
 // ftdiag's memory savings change nothing: the consuming context and diagnosis, the noise
-// replacement of the second pass and the column-releasing loader give what the plain paths give.
+// replacement of the second pass, the column-releasing loader, the searches' compact buffers and
+// the streamed fits give what the plain paths give.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -9,6 +10,8 @@
 #include <vector>
 
 #include "diagnosis/diagnose.hpp"
+#include "diagnosis/effects/common.hpp"
+#include "diagnosis/signal.hpp"
 #include "measurement/recording.hpp"
 #include "tests/diagnosis/diag_fixture.hpp"
 
@@ -35,9 +38,10 @@ void ExpectSameReport(const Report& a, const Report& b) {
 
 // Diagnose(DiagData*) takes the bridges' memory for the residual and the load. The reference is
 // the const path on an untouched copy: every score, parameter and prediction must be equal, the
-// residual must be real − sim (rounded once to single precision), and the data must keep its width without its matrices.
-// One of the two fixtures' diagnoses runs the noise-refined second pass, on the reused context
-// (SetNoise), in both paths (FTDIAG_DEBUG shows six contexts for the four diagnoses).
+// residual must be real − sim (rounded once to single precision), and the data must keep its width
+// without its matrices. One of the two fixtures' diagnoses runs the noise-refined second pass, on
+// the reused context (SetNoise), in both paths (FTDIAG_DEBUG shows six contexts for the four
+// diagnoses).
 TEST(DiagMemory, ConsumingDiagnosisGivesTheSameReport) {
   for (const char* effect : {"creep", "time_skew"}) {
     const auto fx = testing::MakeFixture({{effect, 8}}, 4, 200.0, kNoise, 4.0);
@@ -132,6 +136,100 @@ TEST(DiagMemory, LoaderReleasingColumnsReadsWhatFromRecordingsBuilds) {
     EXPECT_EQ(got.wrench.cols(), 6);
   }
   std::filesystem::remove_all(dir);
+}
+
+/// The creep fixture as if joined from three recordings (segments restart the filters).
+testing::Fixture SegmentedFixture() {
+  testing::Fixture f = testing::MakeFixture({{"creep", 8}}, 5, 200.0, kNoise, 4.0);
+  const std::size_t n = f.data.rows();
+  f.data.segment.assign(n, 0);
+  for (std::size_t i = n / 3; i < n; ++i) f.data.segment[i] = i < 2 * n / 3 ? 1 : 2;
+  return f;
+}
+
+// The searches' compact buffers hold exactly what the whole filters give at the rows they keep:
+// the lag of the load (LowPassLoadRows) and the ringing over a window starting at rest inside
+// the record (RingingAt), with segment restarts inside.
+TEST(DiagMemory, CompactSearchBuffersHoldTheWholeFiltersRows) {
+  const testing::Fixture f = SegmentedFixture();
+  const Context cx = MakeContext(f.data);
+  ASSERT_EQ(cx.segments, 3);
+  const auto n = static_cast<std::size_t>(cx.n);
+  const double* t = cx.data->t_s.data();
+  std::vector<std::vector<double>> whole(static_cast<std::size_t>(cx.nc), std::vector<double>(n));
+  std::vector<const double*> in;
+  std::vector<double*> out;
+  for (int c = 0; c < cx.nc; ++c) {
+    in.push_back(cx.load.col(c).data());
+    out.push_back(whole[static_cast<std::size_t>(c)].data());
+  }
+  std::vector<int> rows;
+  for (int i = 0; i < cx.n; i += 7) rows.push_back(i);
+  Eigen::MatrixXd lag;
+  fx::LowPassLoadRows(cx, 2.5, rows, &lag);
+  FirstOrderLowPassColumns(t, n, 2.5, in.data(), out.data(), in.size(), cx.restart.data());
+  ASSERT_EQ(lag.rows(), static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    for (int c = 0; c < cx.nc; ++c) {
+      ASSERT_EQ(lag(static_cast<Eigen::Index>(r), c), whole[static_cast<std::size_t>(c)][rows[r]]);
+    }
+  }
+  // Ringing of channels 4 and 1 over rows [i0, i0 + m), every 3rd row, at rest at i0.
+  const std::vector<int> chans{4, 1};
+  const int i0 = cx.n / 4 + 5;
+  const int m = cx.n / 2;
+  Eigen::MatrixXd h;
+  fx::RingingAt(cx, 7.0, 0.05, chans, i0, m, 3, &h);
+  ASSERT_EQ(h.rows(), (m + 2) / 3);
+  for (std::size_t k = 0; k < chans.size(); ++k) {
+    const double* x = cx.load.col(chans[k]).data() + i0;
+    std::vector<double> y(static_cast<std::size_t>(m));
+    double* yp = y.data();
+    SecondOrderLowPassColumns(t + i0, static_cast<std::size_t>(m), 7.0, 0.05, &x, &yp, 1,
+                              cx.restart.data() + i0);
+    for (int r = 0; r < h.rows(); ++r) {
+      ASSERT_EQ(h(r, static_cast<Eigen::Index>(k)), y[static_cast<std::size_t>(3 * r)] - x[3 * r])
+          << "row " << i0 + 3 * r;
+    }
+  }
+}
+
+// The streamed final fits sum what FitChannels sums, in its order: the same fit to the last bit,
+// on a feature streamed by ForLaggedLoad and on the whole filter's columns.
+TEST(DiagMemory, StreamedChannelSumsAreFitChannels) {
+  const testing::Fixture f = SegmentedFixture();
+  const Context cx = MakeContext(f.data);
+  const double tau = 4.0;
+  fx::ChannelSums sums(cx, 2);
+  fx::ForLaggedLoad(cx, &tau, 1, [&](int i, int c, const double* lag) {
+    if (!cx.train[static_cast<std::size_t>(i)]) return;
+    const double x[2] = {lag[0], cx.load(i, c)};
+    sums.Add(c, x, cx.resid(i, c));
+  });
+  const fx::ChannelFit got = sums.Solve(cx);
+  Eigen::MatrixXd lp(cx.n, cx.nc);
+  std::vector<const double*> in;
+  std::vector<double*> out;
+  for (int c = 0; c < cx.nc; ++c) {
+    in.push_back(cx.load.col(c).data());
+    out.push_back(lp.col(c).data());
+  }
+  FirstOrderLowPassColumns(cx.data->t_s.data(), static_cast<std::size_t>(cx.n), tau, in.data(),
+                           out.data(), in.size(), cx.restart.data());
+  const fx::ChannelFit ref = fx::FitChannels(
+      cx, cx.resid, 2,
+      [&](int i, int c, double* x) {
+        x[0] = lp(i, c);
+        x[1] = cx.load(i, c);
+      },
+      nullptr);
+  EXPECT_TRUE(got.beta == ref.beta);
+  EXPECT_TRUE(got.sse == ref.sse);
+  EXPECT_EQ(got.sse_w, ref.sse_w);
+  for (int c = 0; c < cx.nc; ++c) {
+    EXPECT_TRUE(got.cov[static_cast<std::size_t>(c)] == ref.cov[static_cast<std::size_t>(c)]);
+  }
+  EXPECT_GT(got.beta.row(0).cwiseAbs().maxCoeff(), 0.0);  // the creep fixture's lag is fitted
 }
 
 }  // namespace
