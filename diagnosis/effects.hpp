@@ -109,8 +109,7 @@ struct EffectSpec {
 
 /// thermal_zero_drift against a given temperature history dtemp (°C from 20 °C, one per row):
 /// r_c = a_c + k_c·dtemp (effects.cpp).
-[[nodiscard]] std::optional<EffectFit> FitThermalZeroOn(const Context& cx,
-                                                        const Series& target,
+[[nodiscard]] std::optional<EffectFit> FitThermalZeroOn(const Context& cx, const Series& target,
                                                         const std::vector<double>& dtemp);
 /// thermal_zero_drift with a first-order lag τ ≥ 0 between the thermometer and the gauges:
 /// dtemp is replaced by LP_τ[dtemp] (restarting per segment), τ found by grid + golden search on
@@ -124,18 +123,15 @@ struct EffectSpec {
 /// hysteresis in the load path: one operator (Dahl or play, width searched) or a
 /// Prandtl–Ishlinskii sum of plays of fixed widths on each reference wrench axis, mapped to the
 /// bridges by the sensitivity cx.sens (effects/hysteresis_axes.cpp).
-[[nodiscard]] std::optional<EffectFit> FitHysteresisAxes(const Context& cx,
-                                                         const Series& target);
+[[nodiscard]] std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Series& target);
 /// hysteresis of general rate-independent shape: the one-operator fit or a Preisach superposition
 /// of relays (thresholds on 8 quantiles of each bridge's load, weights fitted per bridge; this
 /// class contains Prandtl–Ishlinskii sums of play operators), whichever has the lower training
 /// BIC (effects/hysteresis_pi.cpp).
-[[nodiscard]] std::optional<EffectFit> FitHysteresisFamily(const Context& cx,
-                                                           const Series& target);
+[[nodiscard]] std::optional<EffectFit> FitHysteresisFamily(const Context& cx, const Series& target);
 /// hysteresis refitted near an earlier fit (RefitFn): only the sub-family (load-path operators,
 /// one operator per bridge, or Preisach per bridge) that fit came from.
-[[nodiscard]] std::optional<EffectFit> RefitHysteresis(const Context& cx,
-                                                       const Series& target,
+[[nodiscard]] std::optional<EffectFit> RefitHysteresis(const Context& cx, const Series& target,
                                                        const EffectFit& near, bool uncertainty);
 
 /// Whitened sums over train or hold-out rows.

@@ -361,8 +361,8 @@ std::string HtmlPlots(const DiagData& data, const Report& r) {
   }
   if (!r.spectrum_hz.empty()) {
     PlotSeries sp{std::vector<double>(r.spectrum_hz.begin() + 1, r.spectrum_hz.end()),
-              std::vector<double>(r.spectrum_power.begin() + 1, r.spectrum_power.end()), "#333",
-              "residual PSD / noise"};
+                  std::vector<double>(r.spectrum_power.begin() + 1, r.spectrum_power.end()), "#333",
+                  "residual PSD / noise"};
     PlotSpec p4;
     p4.title = "Residual spectrum (Welch), averaged over channels, noise floor = 1";
     p4.x_label = "frequency (Hz)";
