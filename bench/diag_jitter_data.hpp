@@ -38,7 +38,7 @@ inline diag::DiagData MakeJitterData(int rows, bool jitter) {
     }
     const Eigen::VectorXd b = s * w;
     creep += (0.01 * b - creep) * (1.0 - std::exp(-dt / 20.0));
-    d.wrench.row(i) = w.transpose();
+    d.wrench.row(i) = w.transpose().cast<float>();
     d.sim_mvv.row(i) = b.transpose();
     for (int c = 0; c < 8; ++c) d.real_mvv(i, c) = b(c) + creep(c) + 2e-4 * g(rng);
   }

@@ -79,11 +79,13 @@ Eigen::MatrixXd Bridges(const Recording& r, std::size_t n) {
   return m;
 }
 
-Eigen::MatrixXd WrenchOf(const Recording& r) {
-  Eigen::MatrixXd m(static_cast<Eigen::Index>(r.rows()), 6);
+Eigen::MatrixXf WrenchOf(const Recording& r) {
+  Eigen::MatrixXf m(static_cast<Eigen::Index>(r.rows()), 6);
   for (int k = 0; k < 6; ++k) {
     const auto& col = r.Column(WrenchColumns()[static_cast<std::size_t>(k)]);
-    for (std::size_t i = 0; i < col.size(); ++i) m(static_cast<Eigen::Index>(i), k) = col[i];
+    for (std::size_t i = 0; i < col.size(); ++i) {
+      m(static_cast<Eigen::Index>(i), k) = static_cast<float>(col[i]);
+    }
   }
   return m;
 }
@@ -243,8 +245,12 @@ DiagData LoadPredictedReal(const std::string& real_path, const std::string& mode
   d.segment = FindSegments(real);
   const auto n = static_cast<Eigen::Index>(d.t_s.size());
   d.sim_mvv.resize(n, static_cast<Eigen::Index>(nr));
+  const std::vector<double>* wc[6];
+  for (std::size_t k = 0; k < 6; ++k) wc[k] = &real.Column(WrenchColumns()[k]);
   for (Eigen::Index i = 0; i < n; ++i) {
-    const Wrench w = d.wrench.row(i).transpose();
+    Wrench w;  // from the file's columns (double), not the stored single-precision copy
+    for (std::size_t k = 0; k < 6; ++k)
+      w(static_cast<int>(k)) = (*wc[k])[static_cast<std::size_t>(i)];
     const double temp = d.temp_c.empty() ? 20.0 : d.temp_c[static_cast<std::size_t>(i)];
     Eigen::VectorXd b(static_cast<Eigen::Index>(nr));
     predict(w, temp, b.data());

@@ -24,7 +24,9 @@ class DiagInputError : public std::runtime_error {
 /// One aligned pair of recordings, column-major (row i is sample i).
 struct DiagData {
   std::vector<double> t_s;     ///< sample times, s, strictly increasing
-  Eigen::MatrixXd wrench;      ///< n × 6: Fx Fy Fz (N) Mx My Mz (N·m); 0 columns when absent
+  /// n × 6: Fx Fy Fz (N) Mx My Mz (N·m), 0 columns when absent; single precision (memory: the
+  /// rounding, 6e-8 of the value, is far below any reference rig's uncertainty).
+  Eigen::MatrixXf wrench;
   std::vector<double> temp_c;  ///< body temperature, °C; empty when the real file has none
   Eigen::MatrixXd sim_mvv;     ///< n × N predicted bridge outputs, mV/V
   Eigen::MatrixXd real_mvv;    ///< n × N measured bridge outputs, mV/V

@@ -45,7 +45,7 @@ constexpr int kLoadTerms = 28;
 Series LoadPolynomial(const Context& cx, const Series& target) {
   const auto& w = cx.data->wrench;
   Eigen::Matrix<double, 6, 1> scale;
-  for (int k = 0; k < 6; ++k) scale(k) = std::max(w.col(k).cwiseAbs().maxCoeff(), 1e-300);
+  for (int k = 0; k < 6; ++k) scale(k) = std::max<double>(w.col(k).cwiseAbs().maxCoeff(), 1e-300);
   auto terms = [&](int i, double* x) {
     int j = 0;
     x[j++] = 1.0;

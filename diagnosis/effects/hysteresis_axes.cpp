@@ -32,7 +32,7 @@ struct AxisOperators {
   [[nodiscard]] int p() const { return static_cast<int>(axes.size()) * per_axis; }
   void Reset() { state.assign(static_cast<std::size_t>(p()), 0.0); }
   /// Features of row i (restart: operators start again at rest at this row's load).
-  void Step(const Mat& w, int i, bool restart, double* z) {
+  void Step(const Eigen::MatrixXf& w, int i, bool restart, double* z) {
     for (std::size_t a = 0; a < axes.size(); ++a) {
       const double x = w(i, axes[a]);
       const double dx = i > 0 && !restart ? x - w(i - 1, axes[a]) : 0.0;
@@ -75,7 +75,7 @@ struct Runs {
 };
 
 Runs MakeRuns(const Context& cx, const Series& target, int stride) {
-  const Mat& w = cx.data->wrench;
+  const Eigen::MatrixXf& w = cx.data->wrench;
   Runs r;
   r.stride = stride;
   std::vector<double> acc;

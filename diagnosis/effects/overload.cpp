@@ -139,7 +139,8 @@ std::optional<EffectFit> FitOverloadShift(const Context& cx, const Series& targe
     int pk = 0;
     int pi = 0;
     double scale[6];
-    for (int k = 0; k < 6; ++k) scale[k] = std::max(d.wrench.col(k).cwiseAbs().maxCoeff(), 1e-12);
+    for (int k = 0; k < 6; ++k)
+      scale[k] = std::max<double>(d.wrench.col(k).cwiseAbs().maxCoeff(), 1e-12);
     for (int i = 0; i < cx.n && d.t_s[static_cast<std::size_t>(i)] <= onset + 2.0 * cx.block_s;
          ++i) {
       for (int k = 0; k < 6; ++k) {

@@ -97,7 +97,7 @@ std::optional<EffectFit> FitGeometric(const Context& cx, const Series& target) {
     // Per-axis cubic softening/stiffening: r = Σ_k κ_k·S_·k·w_k³ (w normalised by its peak).
     Vec scale(6);
     for (int k = 0; k < 6; ++k)
-      scale(k) = std::max(cx.data->wrench.col(k).cwiseAbs().maxCoeff(), 1e-12);
+      scale(k) = std::max<double>(cx.data->wrench.col(k).cwiseAbs().maxCoeff(), 1e-12);
     NormalEq ne(6);
     double x[6];
     for (int c = 0; c < cx.nc; ++c) {
@@ -161,7 +161,7 @@ std::optional<EffectFit> FitLoadStiffening(const Context& cx, const Series& targ
   const auto& w = cx.data->wrench;
   const int ks[4] = {0, 1, 3, 4};
   Vec scale(6);
-  for (int k = 0; k < 6; ++k) scale(k) = std::max(w.col(k).cwiseAbs().maxCoeff(), 1e-12);
+  for (int k = 0; k < 6; ++k) scale(k) = std::max<double>(w.col(k).cwiseAbs().maxCoeff(), 1e-12);
   // Variant A: physically structured, the sensitivity to w_k scales by (1 + κ_k·Fz/Fz_peak).
   NormalEq ne(4);
   double x[4];

@@ -126,7 +126,7 @@ inline Fixture MakeFixture(const std::vector<FixtureEffect>& effects, unsigned s
   for (int i = 0; i < n; ++i) {
     const double t = i / rate_hz;
     d.t_s[static_cast<std::size_t>(i)] = t;
-    d.wrench.row(i) = rig.At(t).transpose();
+    d.wrench.row(i) = rig.At(t).transpose().cast<float>();
     d.sim_mvv.row(i) = (s * rig.At(t)).transpose();
     d.temp_c[static_cast<std::size_t>(i)] = Temperature(t);
   }
@@ -213,7 +213,7 @@ inline Fixture MakeFixture(const std::vector<FixtureEffect>& effects, unsigned s
       fx.truth_channel = 1;
     } else if (nm == "geometric_nonlinearity") {
       for (int i = 0; i < n; ++i) {
-        Eigen::Matrix<double, 6, 1> w = d.wrench.row(i).transpose();
+        Eigen::Matrix<double, 6, 1> w = d.wrench.row(i).transpose().cast<double>();
         Eigen::Matrix<double, 6, 1> dw;
         for (int k = 0; k < 6; ++k) dw(k) = -w(k) * std::pow(w(k) / rated(k), 2);
         real.row(i) += (a / 0.6 / 0.73 * s * dw).transpose();
@@ -221,7 +221,7 @@ inline Fixture MakeFixture(const std::vector<FixtureEffect>& effects, unsigned s
     } else if (nm == "load_stiffening") {
       const double kap = a / 0.6 / 0.6;
       for (int i = 0; i < n; ++i) {
-        Eigen::Matrix<double, 6, 1> w = d.wrench.row(i).transpose();
+        Eigen::Matrix<double, 6, 1> w = d.wrench.row(i).transpose().cast<double>();
         Eigen::Matrix<double, 6, 1> dw = Eigen::Matrix<double, 6, 1>::Zero();
         for (int k : {0, 1, 3, 4}) dw(k) = kap * w(2) / rated(2) * w(k);
         real.row(i) += (s * dw).transpose();
@@ -233,7 +233,7 @@ inline Fixture MakeFixture(const std::vector<FixtureEffect>& effects, unsigned s
       const double c0 = std::cos(th);
       const double s0 = std::sin(th);
       for (int i = 0; i < n; ++i) {
-        Eigen::Matrix<double, 6, 1> w = d.wrench.row(i).transpose();
+        Eigen::Matrix<double, 6, 1> w = d.wrench.row(i).transpose().cast<double>();
         Eigen::Matrix<double, 6, 1> ws = w;
         ws(0) = c0 * w(0) + s0 * w(1);
         ws(1) = -s0 * w(0) + c0 * w(1);

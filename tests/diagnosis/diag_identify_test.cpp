@@ -68,7 +68,7 @@ DiagData Make(const Options& o, unsigned seed) {
   const auto n = static_cast<Eigen::Index>(d.t_s.size());
   d.sim_mvv = Eigen::Map<Eigen::MatrixXd>(sim.data(), 8, n).transpose();
   d.real_mvv = Eigen::Map<Eigen::MatrixXd>(real.data(), 8, n).transpose();
-  d.wrench = Eigen::Map<Eigen::MatrixXd>(wrench.data(), 6, n).transpose();
+  d.wrench = Eigen::Map<Eigen::MatrixXd>(wrench.data(), 6, n).transpose().cast<float>();
   return d;
 }
 
@@ -155,7 +155,7 @@ DiagData SmoothLoad(bool drift_control, unsigned seed) {
       if (drift_control && i % 50 == 0) w(a) = 50.0 * u(rng);
     }
     const Eigen::VectorXd b = s * w;
-    d.wrench.row(i) = w.transpose();
+    d.wrench.row(i) = w.transpose().cast<float>();
     d.sim_mvv.row(i) = b.transpose();
     for (int c = 0; c < 6; ++c) {
       const double extra = drift_control ? 0.03 * std::sin(t / 25.0)

@@ -58,7 +58,7 @@ DiagData LaggingThermometer(double lag_s, double duration_s, unsigned seed) {
     }
     d.t_s.push_back(t);
     d.temp_c.push_back(thermometer(t));
-    d.wrench.row(i) = w.transpose();
+    d.wrench.row(i) = w.transpose().cast<float>();
     const Eigen::VectorXd b = s * w;
     for (int c = 0; c < nc; ++c) {
       d.sim_mvv(i, c) = b(c);
@@ -190,7 +190,7 @@ DiagData PreisachHysteresis(unsigned seed, bool load_path = false) {
   const auto n = static_cast<Eigen::Index>(rows);
   d.sim_mvv = Eigen::Map<Eigen::MatrixXd>(sim.data(), nc, n).transpose();
   d.real_mvv = Eigen::Map<Eigen::MatrixXd>(real.data(), nc, n).transpose();
-  d.wrench = Eigen::Map<Eigen::MatrixXd>(wr.data(), 6, n).transpose();
+  d.wrench = Eigen::Map<Eigen::MatrixXd>(wr.data(), 6, n).transpose().cast<float>();
   return d;
 }
 
@@ -274,7 +274,7 @@ DiagData CreepLags(const std::vector<double>& tau_s, const std::vector<double>& 
       }
     }
     d.t_s.push_back(static_cast<double>(i) * dt);
-    d.wrench.row(i) = w.transpose();
+    d.wrench.row(i) = w.transpose().cast<float>();
     for (int c = 0; c < nc; ++c) {
       double creep = 0.0;
       for (std::size_t k = 0; k < tau_s.size(); ++k) creep += (*true_fraction)[k][c] * z[k][c];
@@ -412,7 +412,7 @@ DiagData MainsWithHarmonics(double f0, const std::vector<double>& amp_mvv, unsig
       for (int a = 0; a < 6; ++a) w(a) = 40.0 * u(rng);
     }
     d.t_s.push_back(t);
-    d.wrench.row(i) = w.transpose();
+    d.wrench.row(i) = w.transpose().cast<float>();
     const Eigen::VectorXd b = s * w;
     for (int c = 0; c < nc; ++c) {
       double hum = 0.0;
