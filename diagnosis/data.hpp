@@ -23,7 +23,7 @@ class DiagInputError : public std::runtime_error {
 
 /// One aligned pair of recordings, column-major (row i is sample i).
 struct DiagData {
-  std::vector<double> t_s;     ///< sample times, s, strictly increasing
+  std::vector<double> t_s;  ///< sample times, s, strictly increasing
   /// n × 6: Fx Fy Fz (N) Mx My Mz (N·m), 0 columns when absent; single precision (memory: the
   /// rounding, 6e-8 of the value, is far below any reference rig's uncertainty).
   Eigen::MatrixXf wrench;
