@@ -86,20 +86,21 @@ ChannelFit FitChannels(const Context& cx, const Series& target, int p, F feat, S
   return out;
 }
 
-/// pred(i, c) = Σ_j f.beta(j, c) · feat(i, c)_j on every row and channel: the prediction
-/// FitChannels fills (same sums in the same order), made only once a fit is kept (memory: n × N).
-template <class F>
-void PredictChannels(const Context& cx, const ChannelFit& f, int p, F feat, Series* pred) {
+/// The prediction of a fit whose features are streamed (ForLaggedLoad, ForRinging), made only once
+/// the fit is kept: rows(visit) runs the streams, calling visit(i, c, v) for every row and
+/// channel; feat(i, c, v, x) fills the p features; pred(i, c) = Σ_j f.beta(j, c) · x_j, the sums
+/// FitChannels forms, in its order (memory: no n × N feature buffer).
+template <class Rows, class F>
+void PredictStreamed(const Context& cx, const ChannelFit& f, int p, Rows rows, F feat,
+                     Series* pred) {
   std::vector<double> x(static_cast<std::size_t>(p));
-  if (pred->rows() != cx.n || pred->cols() != cx.nc) pred->resize(cx.n, cx.nc);  // all written
-  for (int c = 0; c < cx.nc; ++c) {
-    for (int i = 0; i < cx.n; ++i) {
-      feat(i, c, x.data());
-      double v = 0.0;
-      for (int j = 0; j < p; ++j) v += f.beta(j, c) * x[static_cast<std::size_t>(j)];
-      (*pred)(i, c) = static_cast<float>(v);
-    }
-  }
+  pred->resize(cx.n, cx.nc);
+  rows([&](int i, int c, const double* v) {
+    feat(i, c, v, x.data());
+    double s = 0.0;
+    for (int j = 0; j < p; ++j) s += f.beta(j, c) * x[static_cast<std::size_t>(j)];
+    (*pred)(i, c) = static_cast<float>(s);
+  });
 }
 
 /// σ of parameter j of channel c from its unit covariance and the channel's residual variance.

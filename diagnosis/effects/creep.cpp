@@ -144,14 +144,14 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Series& target, co
     best_gamma = gamma;
   }
   lp = Mat();
-  // The kept variant's prediction, streamed (PredictChannels' sums).
-  best.pred.resize(cx.n, cx.nc);
-  ForLaggedLoad(cx, &tau, 1, [&](int i, int c, const double* lag) {
-    double v = 0.0;
-    v += best_f.beta(0, c) * lag[0];
-    if (best_gamma) v += best_f.beta(1, c) * cx.load(i, c);
-    best.pred(i, c) = v;
-  });
+  // The kept variant's prediction, streamed.
+  PredictStreamed(
+      cx, best_f, best_gamma ? 2 : 1, [&](auto visit) { ForLaggedLoad(cx, &tau, 1, visit); },
+      [&](int i, int c, const double* lag, double* x) {
+        x[0] = lag[0];
+        if (best_gamma) x[1] = cx.load(i, c);
+      },
+      &best.pred);
   taus = {std::exp(lt)};
   tau_sigmas = {best.sigma["tau_s"].is_number() ? best.sigma["tau_s"].get<double>() : 0.0};
   // The two-τ variant: searched in full alone, not in a refit (a refit keeps the variant class its

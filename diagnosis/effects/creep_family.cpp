@@ -262,17 +262,16 @@ bool FitCreepTwo(const Context& cx, const Series& target, double log_tau1, doubl
     *best = std::move(e);
     won = true;
   }
-  if (won) {  // streamed (PredictChannels' sums): one n × N prediction
-    const ChannelFit& f = *best_f;
+  if (won) {  // streamed: one n × N prediction
     const bool gamma = *best_gamma;
-    best->pred.resize(cx.n, cx.nc);
-    ForLaggedLoad(cx, t12, 2, [&](int i, int c, const double* lag) {
-      double v = 0.0;
-      v += f.beta(0, c) * lag[0];
-      v += f.beta(1, c) * lag[1];
-      if (gamma) v += f.beta(2, c) * cx.load(i, c);
-      best->pred(i, c) = v;
-    });
+    PredictStreamed(
+        cx, *best_f, gamma ? 3 : 2, [&](auto visit) { ForLaggedLoad(cx, t12, 2, visit); },
+        [&](int i, int c, const double* lag, double* x) {
+          x[0] = lag[0];
+          x[1] = lag[1];
+          if (gamma) x[2] = cx.load(i, c);
+        },
+        &best->pred);
   }
   return won;
 }

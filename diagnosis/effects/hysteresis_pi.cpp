@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "diagnosis/effects.hpp"
+#include "diagnosis/effects/common.hpp"
 #include "diagnosis/signal.hpp"
 
 namespace ftstack::diag {
@@ -163,16 +164,11 @@ std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Series& 
   e.params["relay_levels"] = kLevels;
   e.params["loop_half_height_mvv"] = weights;
   e.sigma["loop_half_height_mvv"] = sigmas;
-  int best_c = 0;
-  for (int c = 1; c < cx.nc; ++c) {
-    if (e.pred.col(c).cast<double>().squaredNorm() * cx.weight(c) >
-        e.pred.col(best_c).cast<double>().squaredNorm() * cx.weight(best_c)) {
-      best_c = c;
-    }
-  }
+  const int best_c = fx::DominantChannel(cx, e.pred);
   for (int c = 0; c < cx.nc; ++c) {
-    if (e.pred.col(c).cast<double>().squaredNorm() * cx.weight(c) > 0.01 * cx.n)
+    if (e.pred.col(c).cast<double>().squaredNorm() * cx.weight(c) > 0.01 * cx.n) {
       e.channels.push_back(c);
+    }
   }
   if (e.channels.empty()) e.channels.push_back(best_c);
   const Eigen::VectorXd col = e.pred.col(best_c).cast<double>();

@@ -216,13 +216,13 @@ std::string AddResonanceMode(const Context& cx, const Series& target, double f1_
   e->n_params = p;
   e->train_sse_w = cf.sse_w;
   e->pred = Series();  // the one-mode prediction is replaced
-  e->pred.resize(cx.n, cx.nc);
-  ForRinging(cx, f12, z12, 2, [&](int i, int c, const double* hv) {
-    double v = 0.0;
-    v += cf.beta(0, c) * hv[0];
-    v += cf.beta(1, c) * hv[1];
-    e->pred(i, c) = static_cast<float>(v);
-  });
+  PredictStreamed(
+      cx, cf, 2, [&](auto visit) { ForRinging(cx, f12, z12, 2, visit); },
+      [](int, int, const double* hv, double* x) {
+        x[0] = hv[0];
+        x[1] = hv[1];
+      },
+      &e->pred);
   e->search_state = {lf[0], lz[0], lf[1], lz[1]};
   return Fmt(
       "; a second mode at %.2f Hz (damping ratio %.3f) from the residual spectrum, kept: "

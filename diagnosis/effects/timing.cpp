@@ -224,12 +224,9 @@ double FitRingingAll(const Context& cx, const Series& target, double f, double z
     if (cx.train[static_cast<std::size_t>(i)]) sums.Add(c, hv, target(i, c));
   });
   *cf = sums.Solve(cx);
-  pred->resize(cx.n, cx.nc);
-  ForRinging(cx, &f, &z, 1, [&](int i, int c, const double* hv) {
-    double v = 0.0;
-    v += cf->beta(0, c) * hv[0];
-    (*pred)(i, c) = static_cast<float>(v);
-  });
+  PredictStreamed(
+      cx, *cf, 1, [&](auto visit) { ForRinging(cx, &f, &z, 1, visit); },
+      [](int, int, const double* hv, double* x) { x[0] = hv[0]; }, pred);
   return cf->sse_w;
 }
 
