@@ -84,6 +84,13 @@ void Ftd::Start() {
   }
   map_ = std::make_unique<fw::RegisterMap>(*device_);
   servers_.Open(opt_, *map_);
+  if (!opt_.mqtt.empty()) {
+    const std::uint8_t slot = cfg.initial_slot;
+    mqtt_ = std::make_unique<MqttPublisher>(opt_, map_.get(),
+                                            DefaultDeviceId(opt_, slot, cfg.slots[slot].crc32));
+    mqtt_->Open();
+    map_->SetMqttCounters(&mqtt_->counters());
+  }
   if (!opt_.log.empty()) {
     log_.Open(opt_.log,
               {"source: ftd", "adc: " + opt_.adc, "rate_hz: " + std::to_string(opt_.rate_hz),
@@ -109,6 +116,10 @@ void Ftd::StartThreads() {
   std::fprintf(stderr, "ftd: %s%s\n", realtime_.c_str(),
                rt ? "" : " — samples may be late under load (late_samples counts them)");
   servers_.Spawn(&threads_, stop_);
+  if (mqtt_) {
+    threads_.emplace_back([this] { mqtt_->Run(stop_); });
+    pthread_setname_np(threads_.back().native_handle(), "ftd-mqtt");
+  }
 }
 
 void Ftd::BackOff(std::uint32_t pause_us) {
@@ -127,6 +138,7 @@ void Ftd::SamplingLoop() {
   const std::uint32_t period_us = device_->sample_period_us();
   std::uint32_t backoff_us = 0;
   RdtServer* const rdt = servers_.rdt();
+  MqttPublisher* const mqtt = mqtt_.get();
   while (!stop_.load(std::memory_order_relaxed)) {
     const std::uint64_t t0 = fw::MonotonicUs();
     const hal::Status s = device_->Step(&published);
@@ -152,6 +164,7 @@ void Ftd::SamplingLoop() {
     samples_.fetch_add(1, std::memory_order_relaxed);
     if (!published) continue;
     if (rdt != nullptr) rdt->Publish(device_->last_published());
+    if (mqtt != nullptr) mqtt->Push(device_->last_published());
     log_.Push(device_->last_published());
   }
 }
@@ -186,6 +199,8 @@ FtdStats Ftd::stats() const {
   s.adc_errors = adc_errors_.load(std::memory_order_relaxed);
   s.backoffs = backoffs_.load(std::memory_order_relaxed);
   s.realtime = realtime_;
+  fw::DeviceSample d{};
+  if (device_ && device_->ReadLatest(&d)) s.late_samples = d.late_samples;
   return s;
 }
 

@@ -14,6 +14,7 @@
 
 #include "daemon/backend.hpp"
 #include "daemon/calibration_set.hpp"
+#include "daemon/mqtt_publisher.hpp"
 #include "daemon/options.hpp"
 #include "daemon/sample_log.hpp"
 #include "daemon/servers.hpp"
@@ -32,11 +33,12 @@ struct FtdStats {
   std::uint64_t samples = 0;  ///< samples processed by the sampling thread
   double elapsed_s = 0;       ///< since Start
   std::uint64_t logged_rows = 0;
-  std::uint64_t log_dropped = 0;  ///< samples the logger could not keep up with
-  bool sampling_ended = false;    ///< replay finished or the ADC failed for good
-  std::uint64_t adc_errors = 0;   ///< failed sampling steps (timeouts, read errors)
-  std::uint64_t backoffs = 0;     ///< pauses after a step that failed at once (no busy loop)
-  std::string realtime;           ///< the sampling thread's scheduling and memory, one line
+  std::uint64_t log_dropped = 0;   ///< samples the logger could not keep up with
+  bool sampling_ended = false;     ///< replay finished or the ADC failed for good
+  std::uint64_t adc_errors = 0;    ///< failed sampling steps (timeouts, read errors)
+  std::uint64_t backoffs = 0;      ///< pauses after a step that failed at once (no busy loop)
+  std::uint32_t late_samples = 0;  ///< missed sampling deadlines (input registers 74–75)
+  std::string realtime;            ///< the sampling thread's scheduling and memory, one line
 };
 
 /// The running daemon. Start() spawns the threads; Stop() (or the destructor) joins them.
@@ -62,6 +64,8 @@ class Ftd {
   [[nodiscard]] const fw::ServerCounters* tcp_counters() const;
   /// The RDT server (nullptr without --rdt).
   [[nodiscard]] const RdtServer* rdt() const { return servers_.rdt(); }
+  /// The Sparkplug B publisher (nullptr without --mqtt).
+  [[nodiscard]] const MqttPublisher* mqtt() const { return mqtt_.get(); }
   /// One status line (no newline): sequence, wrench, status bits, sample rate, clients.
   [[nodiscard]] std::string StatusLine() const;
 
@@ -80,6 +84,7 @@ class Ftd {
   std::unique_ptr<fw::Device> device_;
   std::unique_ptr<fw::RegisterMap> map_;
   Servers servers_;
+  std::unique_ptr<MqttPublisher> mqtt_;
   SampleLog log_;
 
   std::atomic<bool> stop_{false};

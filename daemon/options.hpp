@@ -46,6 +46,18 @@ struct FtdOptions {
   /// (0: never) — a deterministic stand-in for a preempted sampler (--sim-stall EVERY:MS).
   unsigned sim_stall_every = 0;
   double sim_stall_ms = 0;
+  // Sparkplug B over MQTT (daemon/mqtt_publisher.hpp).
+  std::string mqtt;       ///< broker URL mqtt://HOST[:PORT] or mqtts://HOST[:PORT] ("" = none)
+  std::string mqtt_ca;    ///< CA certificate file (mqtts)
+  std::string mqtt_cert;  ///< client certificate file (mqtts, optional)
+  std::string mqtt_key;   ///< its private key file
+  std::string mqtt_credentials;  ///< file: user name on line 1, password on line 2 ("" = none)
+  std::string sparkplug_group = "ftstack";
+  std::string edge_node;     ///< "" = the host name
+  std::string device;        ///< "" = the calibration's serial (else "ft-" + its CRC in hex)
+  double mqtt_rate_hz = 10;  ///< wrench publications per second (means over each window)
+  unsigned mqtt_keepalive_s = 10;
+  bool mqtt_write_protect = false;  ///< refuse every command from the broker
 };
 
 /// Parses "HOST:PORT"; throws FtdError naming the bad part.

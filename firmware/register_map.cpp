@@ -124,8 +124,27 @@ bool RegisterMap::Unlocked() {
   return UnlockedLocked(device_.NowUs());
 }
 
+ModbusException RegisterMap::ReadMqttInput(std::uint16_t addr, std::uint16_t count,
+                                           std::uint16_t* out) const {
+  std::array<std::uint16_t, kInMqttCount> image{};
+  if (mqtt_ != nullptr) {
+    const auto at = [](std::uint16_t a) { return static_cast<std::size_t>(a - kInMqttFirst); };
+    image[at(kInMqttConnected)] =
+        static_cast<std::uint16_t>(mqtt_->connected.load(std::memory_order_relaxed));
+    PackU32(mqtt_->published.load(std::memory_order_relaxed), &image[at(kInMqttPublished)]);
+    PackU32(mqtt_->dropped.load(std::memory_order_relaxed), &image[at(kInMqttDropped)]);
+    PackU32(mqtt_->reconnects.load(std::memory_order_relaxed), &image[at(kInMqttReconnects)]);
+  }
+  for (std::uint16_t i = 0; i < count; ++i) out[i] = image[addr - kInMqttFirst + i];
+  return ModbusException::kNone;
+}
+
 ModbusException RegisterMap::ReadInput(std::uint16_t addr, std::uint16_t count,
                                        std::uint16_t* out) {
+  if (count != 0 && addr >= kInMqttFirst &&
+      static_cast<std::uint32_t>(addr) + count <= std::uint32_t{kInMqttFirst} + kInMqttCount) {
+    return ReadMqttInput(addr, count, out);
+  }
   if (count == 0 || static_cast<std::uint32_t>(addr) + count > kInputRegisterCount) {
     return ModbusException::kIllegalDataAddress;
   }

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <mutex>
 
@@ -37,6 +38,17 @@ enum InputRegister : std::uint16_t {
   kInReserved81 = 81,      ///< 81 … 84 reserved, read 0. Map v2
 };
 
+/// The MQTT block of input registers, 200–209 (map v3): a second range of the input table.
+enum MqttInputRegister : std::uint16_t {
+  kInMqttFirst = 200,
+  kInMqttConnected = 200,    ///< uint16, 1 while connected to the broker
+  kInMqttPublished = 201,    ///< uint32
+  kInMqttDropped = 203,      ///< uint32
+  kInMqttReconnects = 205,   ///< uint32
+  kInMqttReserved207 = 207,  ///< 207 … 209 reserved, read 0
+};
+inline constexpr std::uint16_t kInMqttCount = 10;
+
 /// Holding register addresses.
 enum HoldingRegister : std::uint16_t {
   kHoldCommand = 0,
@@ -69,6 +81,15 @@ enum class ModbusException : std::uint8_t {
   kDeviceFailure = 4,  ///< the latest sample could not be copied (writer starved the reader)
 };
 
+/// Counters of ftd's MQTT publisher (a daemon thread outside the firmware), served in input
+/// registers 200–209 once set with RegisterMap::SetMqttCounters; all 0 without MQTT.
+struct MqttCounters {
+  std::atomic<std::uint32_t> connected{0};   ///< 1 while a broker connection is up
+  std::atomic<std::uint32_t> published{0};   ///< messages handed to the broker, wraps
+  std::atomic<std::uint32_t> dropped{0};     ///< wrench windows never published, wraps
+  std::atomic<std::uint32_t> reconnects{0};  ///< connections after the first
+};
+
 /// 32-bit values over two registers, high word first (the map's "ABCD" order). Written here
 /// rather than with modbus_set_float_* (which does not round-trip in libmodbus 3.1.6).
 void PackU32(std::uint32_t v, std::uint16_t* regs);
@@ -91,7 +112,8 @@ class RegisterMap {
  public:
   explicit RegisterMap(Device& device);
 
-  /// Function 04. 02 when [addr, addr+count) leaves 0 … 84; reserved 81 … 84 read 0.
+  /// Function 04. 02 when [addr, addr+count) leaves 0 … 84 or 200 … 209; reserved 81 … 84 and
+  /// 207 … 209 read 0.
   [[nodiscard]] ModbusException ReadInput(std::uint16_t addr, std::uint16_t count,
                                           std::uint16_t* out);
   /// Function 03. 02 when any address is outside 0 … 41; reserved 5 … 9 and 29 read 0.
@@ -108,8 +130,14 @@ class RegisterMap {
   /// True while protected writes are allowed (within 10 s of writing kUnlockKey).
   [[nodiscard]] bool Unlocked();
   [[nodiscard]] Device& device() { return device_; }
+  /// Serves `counters` in input registers 200–209 (they read 0 until set); set once, before the
+  /// servers start.
+  void SetMqttCounters(const MqttCounters* counters) { mqtt_ = counters; }
 
  private:
+  [[nodiscard]] ModbusException ReadMqttInput(std::uint16_t addr, std::uint16_t count,
+                                              std::uint16_t* out) const;
+
   [[nodiscard]] bool UnlockedLocked(std::uint64_t now_us) const;
 
   std::mutex mutex_;
@@ -119,6 +147,7 @@ class RegisterMap {
   std::array<std::uint16_t, 12> mount_regs_{};
   std::array<std::uint16_t, 6> gravity_regs_{};
   std::uint64_t unlock_until_us_ = 0;
+  const MqttCounters* mqtt_ = nullptr;
   bool unlock_armed_ = false;
 };
 

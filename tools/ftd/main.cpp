@@ -10,6 +10,7 @@
 
 #include "daemon/daemon.hpp"
 #include "tools/common.hpp"
+#include "tools/ftd/mqtt_options.hpp"
 #if FTSTACK_FTD_SIMULATOR
 #include "daemon/sim_backend.hpp"
 #endif
@@ -79,6 +80,7 @@ void AddOptions(CLI::App& app, Args& a) {
                  "serve Modbus TCP on HOST:PORT (port 0: any free)");
   app.add_option("--modbus-rtu", opt.modbus_rtu, "serve Modbus RTU on a serial DEVICE");
   AddRdtOptions(app, opt);
+  ftstack::tools::AddMqttOptions(app, opt);
   app.add_option("--baud", opt.baud, "RTU baud rate")->check(CLI::Range(300u, 4000000u));
   app.add_option("--parity", a.parity, "RTU parity N|E|O")->check(CLI::IsMember({"N", "E", "O"}));
   app.add_option("--unit-id", opt.unit_id, "Modbus unit id")->check(CLI::Range(1u, 247u));
@@ -164,10 +166,10 @@ void Serve(ftstack::daemon::Ftd& ftd, double duration_s, double print_hz, bool s
 
 /// The closing summary on stderr.
 void PrintSummary(const ftstack::daemon::FtdStats& st) {
-  std::fprintf(stderr, "ftd: %llu samples in %.2f s (%.0f Hz)%s\n",
+  std::fprintf(stderr, "ftd: %llu samples in %.2f s (%.0f Hz), %u late%s\n",
                static_cast<unsigned long long>(st.samples), st.elapsed_s,
                st.elapsed_s > 0 ? static_cast<double>(st.samples) / st.elapsed_s : 0.0,
-               st.log_dropped > 0 ? " — log dropped samples" : "");
+               st.late_samples, st.log_dropped > 0 ? " — log dropped samples" : "");
   if (st.adc_errors > 0) {
     std::fprintf(stderr, "ftd: %llu failed ADC steps, %llu back-off pauses\n",
                  static_cast<unsigned long long>(st.adc_errors),
@@ -217,6 +219,7 @@ int Run(int argc, char** argv) {
   ftd.Stop();
   if (status_line) std::fprintf(stderr, "\n");
   PrintSummary(ftd.stats());
+  ftstack::tools::PrintMqttSummary(ftd);
   return kExitOk;
 }
 }  // namespace
