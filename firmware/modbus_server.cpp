@@ -171,7 +171,7 @@ ServerStatus ModbusTcpServer::Open(const char* host, std::uint16_t port, std::ui
   }
   // The context only frames replies on the client sockets handed to it; it never connects.
   ctx_ = modbus_new_tcp("127.0.0.1", MODBUS_TCP_DEFAULT_PORT);
-  mapping_ = modbus_mapping_new(0, 0, kHoldingRegisterSpan, kInputRegisterCount);
+  mapping_ = modbus_mapping_new(0, 0, kHoldingRegisterSpan, kInputAddressSpan);
   if (ctx_ == nullptr || mapping_ == nullptr) return ServerStatus::kLibmodbus;
   (void)modbus_set_response_timeout(ctx_, 0, 1);  // no sleep on libmodbus's own error paths
   return ServerStatus::kOk;
@@ -299,7 +299,7 @@ ModbusRtuServer::~ModbusRtuServer() {
 ServerStatus ModbusRtuServer::Open(const char* device, int baud, char parity,
                                    std::uint8_t unit_id) {
   ctx_ = modbus_new_rtu(device, baud, parity, 8, 1);
-  mapping_ = modbus_mapping_new(0, 0, kHoldingRegisterSpan, kInputRegisterCount);
+  mapping_ = modbus_mapping_new(0, 0, kHoldingRegisterSpan, kInputAddressSpan);
   if (ctx_ == nullptr || mapping_ == nullptr) return ServerStatus::kLibmodbus;
   if (modbus_set_slave(ctx_, unit_id) != 0 || modbus_connect(ctx_) != 0) {
     modbus_free(ctx_);

@@ -1,4 +1,4 @@
-// The Modbus register map, version 2 (docs/spec/modbus-map.md): input image, holding registers.
+// The Modbus register map, version 3 (docs/spec/modbus-map.md): input image, holding registers.
 #pragma once
 
 #include <array>
@@ -10,7 +10,7 @@
 
 namespace ftstack::fw {
 
-inline constexpr std::uint16_t kMapVersion = 2;
+inline constexpr std::uint16_t kMapVersion = 3;
 inline constexpr std::uint16_t kInputRegisterCount = 85;  ///< input registers 0 … 84
 /// Holding 0 … 41: 5 … 9 and 29 reserved.
 inline constexpr std::uint16_t kHoldingRegisterSpan = 42;
@@ -48,6 +48,9 @@ enum MqttInputRegister : std::uint16_t {
   kInMqttReserved207 = 207,  ///< 207 … 209 reserved, read 0
 };
 inline constexpr std::uint16_t kInMqttCount = 10;
+/// Input addresses 0 … kInputAddressSpan − 1 hold every input block (the server's table size);
+/// those between blocks answer exception 02.
+inline constexpr std::uint16_t kInputAddressSpan = kInMqttFirst + kInMqttCount;
 
 /// Holding register addresses.
 enum HoldingRegister : std::uint16_t {

@@ -311,7 +311,7 @@ TEST_F(RegisterMapTest, InputImageCarriesOneSampleInTheSpecifiedLayout) {
   adc_.counts = {400000, -300000, 1000000, 50000, -60000, 70000};
   Step(3);
   const auto r = Input();
-  EXPECT_EQ(r[kInMapVersion], 2);
+  EXPECT_EQ(r[kInMapVersion], 3);
   EXPECT_EQ(r[kInStatus], 0);  // real (fake) hardware, calibrated, no faults
   EXPECT_EQ(UnpackU32(&r[kInSequence]), 3u);
   EXPECT_EQ(UnpackU32(&r[kInTimestampUs]), 2000u);
@@ -368,6 +368,32 @@ TEST_F(RegisterMapTest, AddressesOutsideTheMapGiveException02) {
   EXPECT_EQ(map_->ReadHolding(41, 2, buf.data()), ModbusException::kIllegalDataAddress);
   EXPECT_EQ(Write(42, {0}), ModbusException::kIllegalDataAddress);
   EXPECT_EQ(Write(65535, {0}), ModbusException::kIllegalDataAddress);
+}
+
+TEST_F(RegisterMapTest, MqttBlockReadsThePublishersCountersAndNothingBetweenBlocks) {
+  StartDevice();
+  std::array<std::uint16_t, 125> buf{};
+  buf.fill(0xFFFF);
+  ASSERT_EQ(map_->ReadInput(kInMqttFirst, kInMqttCount, buf.data()), ModbusException::kNone);
+  for (std::uint16_t i = 0; i < kInMqttCount; ++i) EXPECT_EQ(buf[i], 0) << "unset, " << i;
+  MqttCounters c;
+  c.connected = 1;
+  c.published = 0x12345678u;
+  c.dropped = 0xFFFFFFFFu;
+  c.reconnects = 65536;
+  map_->SetMqttCounters(&c);
+  ASSERT_EQ(map_->ReadInput(kInMqttFirst, kInMqttCount, buf.data()), ModbusException::kNone);
+  const std::array<std::uint16_t, 10> want = {1, 0x1234, 0x5678, 0xFFFF, 0xFFFF, 1, 0, 0, 0, 0};
+  for (std::size_t i = 0; i < want.size(); ++i) EXPECT_EQ(buf[i], want[i]) << 200 + i;
+  ASSERT_EQ(map_->ReadInput(205, 2, buf.data()), ModbusException::kNone);
+  EXPECT_EQ(UnpackU32(buf.data()), 65536u);
+  for (const auto& [addr, count] : std::vector<std::pair<int, int>>{
+           {85, 1}, {199, 1}, {199, 2}, {209, 2}, {210, 1}, {84, 120}, {150, 60}}) {
+    EXPECT_EQ(map_->ReadInput(static_cast<std::uint16_t>(addr), static_cast<std::uint16_t>(count),
+                              buf.data()),
+              ModbusException::kIllegalDataAddress)
+        << addr << "+" << count;
+  }
 }
 
 TEST_F(RegisterMapTest, ValuesOutOfRangeGive03AndChangeNothing) {

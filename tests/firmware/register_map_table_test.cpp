@@ -234,7 +234,7 @@ struct Expected {
 std::map<std::string, Expected> ReferenceInputValues(
     const std::array<std::int32_t, hal::kMaxChannels>& counts, const LoadReport& report) {
   std::map<std::string, Expected> e;
-  e["map_version"] = {2, 0, "uint16"};
+  e["map_version"] = {3, 0, "uint16"};
   e["status"] = {0, 0, "uint16"};
   e["sequence"] = {3, 0, "uint32"};
   e["timestamp_us"] = {0.002, 1e-12, "uint32"};  // third sample at 1 kHz, in s after scaling
@@ -261,6 +261,12 @@ std::map<std::string, Expected> ReferenceInputValues(
   e["payload_mass_kg"] = {2.375, 2.375 * 6e-8, "float32"};  // the payload CodeCheck loads
   e["payload_crc32"] = {static_cast<double>(0x0BADC0DEu), 0, "uint32"};
   for (int a = 81; a <= 84; ++a) e["reserved_" + std::to_string(a)] = {0, 0, "uint16"};
+  // The MQTT publisher's counters CodeCheck sets (map v3).
+  e["mqtt_connected"] = {1, 0, "uint16"};
+  e["mqtt_published"] = {4000000000.0, 0, "uint32"};
+  e["mqtt_dropped"] = {17, 0, "uint32"};
+  e["mqtt_reconnects"] = {3, 0, "uint32"};
+  for (int a = 207; a <= 209; ++a) e["reserved_" + std::to_string(a)] = {0, 0, "uint16"};
   return e;
 }
 
@@ -286,6 +292,11 @@ class CodeCheck : public maptest::RegisterMapTest {
     }
     cfg_.payload_crc = 0x0BADC0DEu;
     StartDevice();
+    mqtt_.connected = 1;
+    mqtt_.published = 4000000000u;
+    mqtt_.dropped = 17;
+    mqtt_.reconnects = 3;
+    map_->SetMqttCounters(&mqtt_);
     adc_.counts = {400000, -300000, 1000000, 50000, -60000, 70000};
     Step(3);
     std::vector<std::string> d;
@@ -300,6 +311,8 @@ class CodeCheck : public maptest::RegisterMapTest {
   }
 
  private:
+  MqttCounters mqtt_;
+
   static void CheckUnits(const std::vector<Tag>& tags, std::vector<std::string>* d) {
     for (const Tag& t : tags) {
       bool known = false;
@@ -316,28 +329,31 @@ class CodeCheck : public maptest::RegisterMapTest {
     }
   }
 
+  /// The input tags tile the code's blocks, 0 … 84 and 200 … 209, in order and without gaps.
   static void CheckInputLayout(const std::vector<Tag>& tags, std::vector<std::string>* d) {
     int next = 0;
     for (const Tag& t : tags) {
       if (t.table != "input") continue;
+      if (next == kInputRegisterCount && t.address == kInMqttFirst) next = kInMqttFirst;
       if (t.address != next) d->push_back(t.tag + ": expected address " + std::to_string(next));
       next = t.address + t.registers;
     }
-    if (next != kInputRegisterCount) {
-      d->push_back("input tags end at " + std::to_string(next) + ", the code serves " +
-                   std::to_string(kInputRegisterCount));
+    if (next != kInputAddressSpan) {
+      d->push_back("input tags end at " + std::to_string(next) + ", the code serves up to " +
+                   std::to_string(kInputAddressSpan));
     }
   }
 
   void CheckInputValues(const std::vector<Tag>& tags, std::vector<std::string>* d) {
-    std::array<std::uint16_t, kInputRegisterCount> r{};
-    if (map_->ReadInput(0, kInputRegisterCount, r.data()) != ModbusException::kNone) {
+    std::array<std::uint16_t, kInputAddressSpan> r{};
+    if (map_->ReadInput(0, kInputRegisterCount, r.data()) != ModbusException::kNone ||
+        map_->ReadInput(kInMqttFirst, kInMqttCount, &r[kInMqttFirst]) != ModbusException::kNone) {
       d->push_back("reading the input image failed");
       return;
     }
     const auto ref = ReferenceInputValues(adc_.counts, report_);
     for (const Tag& t : tags) {
-      if (t.table != "input" || t.address < 0 || t.address + t.registers > kInputRegisterCount) {
+      if (t.table != "input" || t.address < 0 || t.address + t.registers > kInputAddressSpan) {
         continue;
       }
       const auto it = ref.find(t.tag);
@@ -449,7 +465,7 @@ TEST(RegisterMapTable, MarkdownAndCsvListTheSameTags) {
   const auto md = ParseMarkdown(ReadText("docs/spec/modbus-map.md"), &errors);
   const auto csv = ParseCsv(ReadText("docs/spec/modbus-map.csv"), &errors);
   EXPECT_TRUE(errors.empty()) << Join(errors);
-  EXPECT_EQ(md.size(), 74u);  // 47 input tags, 27 holding tags (16 + 5 gravity + 6 mount)
+  EXPECT_EQ(md.size(), 81u);  // 54 input tags (47 + 7 MQTT), 27 holding (16 + 5 gravity + 6 mount)
   const auto diffs = CompareTables(md, csv);
   EXPECT_TRUE(diffs.empty()) << Join(diffs);
 }

@@ -125,7 +125,7 @@ TEST(FtdModbus, SimulatedWrenchArrivesWithinDerivedToleranceAndTareZeroes) {
 
   std::array<std::uint16_t, 30> r{};
   ASSERT_EQ(c.Input(0, 30, r.data()), 30);
-  EXPECT_EQ(r[fw::kInMapVersion], 2);  // docs/spec/modbus-map.md
+  EXPECT_EQ(r[fw::kInMapVersion], 3);  // docs/spec/modbus-map.md
   EXPECT_EQ(r[fw::kInStatus] & ~fw::kStatusStale, fw::kStatusSimulated);
   for (std::size_t a = 0; a < 6; ++a) {
     const double tol = kSigmas * e.sigma_si[a] / std::sqrt(kFilter) + e.fixed_error_si[a] +
@@ -371,7 +371,7 @@ TEST(FtdModbus, GarbageAndHalfFramesDoNotDisturbOtherClients) {
     Client c(ftd.port());
     std::array<std::uint16_t, 74> r{};
     while (!stop) {
-      if (c.Input(0, 74, r.data()) == 74 && r[0] == 2) {
+      if (c.Input(0, 74, r.data()) == 74 && r[0] == 3) {
         ++ok;
       } else {
         if (failed++ == 0) {
@@ -489,7 +489,7 @@ TEST(FtdModbus, PipelinedRequestsInOneSegmentAreAllAnswered) {
     const std::uint8_t* r = &got[static_cast<std::size_t>(t) * kReply];
     EXPECT_EQ(r[1], t);
     EXPECT_EQ(r[7], 4);
-    EXPECT_EQ((r[9] << 8) | r[10], 2);  // map version
+    EXPECT_EQ((r[9] << 8) | r[10], 3);  // map version
   }
   close(fd);
   EXPECT_EQ(ftd.Stop(), 0);

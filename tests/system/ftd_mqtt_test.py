@@ -10,7 +10,7 @@ import time
 import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from mqtt_fixture import Broker, Ftd, TempDir, make_tls_files  # noqa: E402
+from mqtt_fixture import Broker, Ftd, TempDir, free_port, make_tls_files  # noqa: E402
 from sparkplug_host import SparkplugHost, reconstruct, sparkplug_b_pb2 as pb  # noqa: E402
 
 GROUP, NODE, DEVICE = "plant1", "cell7", "ft-test"
@@ -24,6 +24,19 @@ def ftd_args(port, *extra, scheme="mqtt", rate_hz=20, keepalive_s=5):
             "--mqtt", f"{scheme}://127.0.0.1:{port}", "--sparkplug-group", GROUP,
             "--edge-node", NODE, "--device", DEVICE, "--mqtt-rate-hz", str(rate_hz),
             "--mqtt-keepalive-s", str(keepalive_s), "--print-hz", "0", *extra]
+
+
+def mbpoll(port, table, first, count):
+    """Input registers read by mbpoll (0-based addresses; '3:int' = uint32 high word first)."""
+    out = subprocess.run(["mbpoll", "-m", "tcp", "-p", str(port), "-a", "1", "-t", table, "-B",
+                          "-0", "-r", str(first), "-c", str(count), "-1", "127.0.0.1"],
+                         capture_output=True, text=True, timeout=10, check=True).stdout
+    values = {}
+    for line in out.splitlines():
+        if line.startswith("["):
+            addr, value = line.split(":", 1)
+            values[int(addr.strip("[]"))] = int(value.strip())
+    return values
 
 
 def check_sequence(test, msgs):
@@ -212,7 +225,8 @@ class MqttTest(unittest.TestCase):
         NBIRTH and DBIRTH again before any DDATA, MQTT/Reconnects counts it."""
         self.broker = Broker(self.tmp.path)
         self.host = SparkplugHost(self.broker.port)
-        ftd = self.start(ftd_args(self.broker.port))
+        modbus = free_port()
+        ftd = self.start(ftd_args(self.broker.port, "--modbus-tcp", f"127.0.0.1:{modbus}"))
         first = self.host.wait_kind("NBIRTH")
         self.host.wait_kind("DDATA")
         self.host.close()
@@ -230,6 +244,14 @@ class MqttTest(unittest.TestCase):
         self.assertEqual(kinds[:2], ["NBIRTH", "DBIRTH"])
         check_sequence(self, self.host.snapshot())
         self.assertEqual(ftd.proc.poll(), None)
+        # Input registers 200-206 (map v3) read by mbpoll: connected, published, dropped,
+        # reconnects, the same counters the Sparkplug metrics carry.
+        connected = mbpoll(modbus, "3", 200, 1)[200]
+        counters = mbpoll(modbus, "3:int", 201, 3)
+        self.assertEqual(connected, 1)
+        self.assertGreater(counters[201], 3)
+        self.assertGreaterEqual(counters[203], dbirth.value("MQTT/Dropped"))
+        self.assertEqual(counters[205], dbirth.value("MQTT/Reconnects"))
 
     def test_tls_with_self_signed_ca(self):
         """mqtts:// with a CA generated here; without that CA the connection is refused."""
