@@ -200,3 +200,15 @@ if [ -x "$B/bench_design" ]; then
         if (col["evaluations"] && $col["evaluations"] != "") printf "  (%d designs)", $col["evaluations"]
         printf "\n" }'
 fi
+
+# --- MQTT fleet (issue 28): N simulated ftd publishing Sparkplug B to one local mosquitto ---------
+# Delivered wrench messages/s vs expected, latency from a window's last sample to the subscriber,
+# lost (seq gaps) and dropped (MQTT/Dropped) messages, CPU per ftd, and the late-sample counters of
+# the same fleet with MQTT on and off, run one after the other (about 1 min in all).
+if [ -x "$BUILD/bin/ftd" ] && [ -f "$BUILD/python/sparkplug_b_pb2.py" ] &&
+   { command -v mosquitto >/dev/null 2>&1 || [ -x /usr/sbin/mosquitto ]; }; then
+  section "MQTT fleet: N ftd -> one mosquitto (Sparkplug B), MQTT on vs off side by side"
+  PATH="/usr/sbin:$PATH" FTD="$BUILD/bin/ftd" SPARKPLUG_PY_DIR="$BUILD/python" \
+    /usr/bin/python3 "$(dirname "$0")/mqtt_fleet.py" 1 10 50 ||
+    echo "  (the fleet benchmark failed)"
+fi
