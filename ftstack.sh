@@ -3,6 +3,7 @@
 #   ./ftstack.sh run  [ftd options]   simulated sensor daemon, Modbus TCP on 127.0.0.1:1502
 #   ./ftstack.sh test                 the whole test suite
 #   ./ftstack.sh sanitize             the whole suite under ASan+UBSan (build-debug/)
+#   ./ftstack.sh mqtt-demo            a local mosquitto and two simulated sensors publishing Sparkplug B
 #   ./ftstack.sh build | deps | bench
 set -euo pipefail
 cd "$(dirname "$0")"
@@ -47,6 +48,34 @@ build() {
   cmake --build "$BUILD_DIR" -j "$(nproc)"
 }
 
+# Two simulated sensors publishing Sparkplug B to the broker on 127.0.0.1:1883: the one already
+# there, else a mosquitto started here (stopped by its PID with the sensors on Ctrl-C).
+mqtt_demo() {
+  local pids=() port=1883 dir
+  dir=$(mktemp -d)
+  trap 'kill "${pids[@]}" 2>/dev/null; wait; rm -rf "$dir"' EXIT
+  trap 'exit 0' INT TERM
+  if (exec 3<>/dev/tcp/127.0.0.1/$port) 2>/dev/null; then
+    log "using the MQTT broker already on 127.0.0.1:$port"
+  else
+    printf 'listener %s 127.0.0.1\nallow_anonymous true\npersistence false\nuser %s\nlog_type error\nlog_type warning\n' \
+      "$port" "$(id -un)" > "$dir/mosquitto.conf"
+    PATH="/usr/sbin:$PATH" mosquitto -c "$dir/mosquitto.conf" & pids+=($!)
+    sleep 0.5
+    log "started mosquitto on 127.0.0.1:$port (PID ${pids[0]})"
+  fi
+  local w
+  for s in a b; do
+    [ "$s" = a ] && w=10,0,-50,0,0.5,0 || w=-5,20,-120,0.2,0,0.1
+    "$BUILD_DIR/bin/ftd" --adc sim --sim-wrench "$w" --print-hz 0 --mqtt "mqtt://127.0.0.1:$port" \
+      --edge-node "demo-$s" --device sensor --seed "$([ "$s" = a ] && echo 1 || echo 2)" "$@" & pids+=($!)
+  done
+  log "two edge nodes publish: spBv1.0/ftstack/{NBIRTH,NDEATH}/demo-a|demo-b, {DBIRTH,DDATA}/demo-a|demo-b/sensor; watch them with:"
+  log "  mosquitto_sub -h 127.0.0.1 -p $port -t 'spBv1.0/ftstack/#' -F '%I %t %l bytes'"
+  log "Ctrl-C stops the sensors (they publish NDEATH)${pids[2]:+ and the broker}"
+  wait
+}
+
 cmd=${1:-help}
 shift || true
 case "$cmd" in
@@ -75,12 +104,16 @@ case "$cmd" in
     cd "$DBG"
     exec ctest --output-on-failure -j "$(nproc)" --timeout 600 "$@"
     ;;
+  mqtt-demo)
+    build
+    mqtt_demo "$@"
+    ;;
   bench)
     build
     exec "$ROOT/bench/run.sh" "$BUILD_DIR" "$@"
     ;;
   *)
-    sed -n '2,6p' "$0" | sed 's/^# \{0,1\}//'
+    sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//'
     [ "$cmd" = help ] || exit 2
     ;;
 esac

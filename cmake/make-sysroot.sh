@@ -24,7 +24,8 @@ suite=${FTSTACK_DEBIAN_SUITE:-bookworm}
 # Target -dev packages and the runtime libraries they link (the tests run these under qemu).
 packages=(libmodbus-dev libmodbus5 libgpiod-dev libgpiod2 libgtest-dev libgmock-dev googletest
   libeigen3-dev nlohmann-json3-dev libcli11-dev libfmt-dev libfmt9
-  libbenchmark-dev libbenchmark1debian)
+  libbenchmark-dev libbenchmark1debian
+  libmosquitto-dev libmosquitto1 libcjson1 libssl3 libprotobuf-c-dev libprotobuf-c1)
 
 stamp="$dir/.ftstack-sysroot"
 want="$arch ${packages[*]}"

@@ -58,8 +58,8 @@ struct Bench {
     if (socketpair(AF_UNIX, SOCK_STREAM, 0, sv) != 0) std::abort();
     tcp = modbus_new_tcp("127.0.0.1", 502);
     rtu = modbus_new_rtu("/dev/null", 19200, 'N', 8, 1);
-    mapping = modbus_mapping_new(0, 0, ftstack::fw::kHoldingRegisterSpan,
-                                 ftstack::fw::kInputAddressSpan);
+    mapping =
+        modbus_mapping_new(0, 0, ftstack::fw::kHoldingRegisterSpan, ftstack::fw::kInputAddressSpan);
     if (tcp == nullptr || rtu == nullptr || mapping == nullptr) std::abort();
     (void)modbus_set_response_timeout(tcp, 0, 1);
     (void)modbus_set_response_timeout(rtu, 0, 1);
