@@ -50,7 +50,7 @@ class Message:
 class SparkplugHost:
     """Subscribes to spBv1.0/# and queues decoded messages."""
 
-    def __init__(self, port, tls_ca=None, client_id=None):
+    def __init__(self, port, tls_ca=None, client_id=None, credentials=None):
         self.port = port
         self.messages = []
         self.queue = queue.Queue()
@@ -58,6 +58,8 @@ class SparkplugHost:
         self.connected = threading.Event()
         self.client = mqtt.Client(client_id=client_id or f"host-{os.getpid()}-{time.time_ns()}",
                                   clean_session=True)
+        if credentials:
+            self.client.username_pw_set(*credentials)
         if tls_ca:
             self.client.tls_set(ca_certs=tls_ca, cert_reqs=ssl.CERT_REQUIRED)
         self.client.on_connect = self._on_connect
