@@ -21,7 +21,8 @@ dir=${2:-$root/out/sysroot-$arch}
 mirror=${FTSTACK_DEBIAN_MIRROR:-http://deb.debian.org/debian}
 suite=${FTSTACK_DEBIAN_SUITE:-bookworm}
 
-# Target -dev packages and the runtime libraries they link (the tests run these under qemu).
+# Target -dev packages and the runtime libraries they link (the tests run these under qemu); ftd's
+# MQTT: libmosquitto (with the libssl3 and libcjson1 it links) and protobuf-c.
 packages=(libmodbus-dev libmodbus5 libgpiod-dev libgpiod2 libgtest-dev libgmock-dev googletest
   libeigen3-dev nlohmann-json3-dev libcli11-dev libfmt-dev libfmt9
   libbenchmark-dev libbenchmark1debian
