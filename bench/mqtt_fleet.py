@@ -3,8 +3,9 @@
 
 For each N: wrench messages per second delivered to one subscriber, end-to-end latency (from the
 last sample of a window, Wrench/Time_us, to the subscriber's receive time) p50/p99, messages lost
-(gaps in each device's seq) and dropped (ftd's own counter), CPU per ftd; then the same N without
---mqtt, and the late-sample counters of both runs side by side.
+(gaps in each device's seq) and dropped (MQTT/Dropped during the interval), CPU per ftd; beside
+them, at the same time, N more ftd without --mqtt: the late-sample counters (input registers
+74-75, read over Modbus at the start and end of the interval) of both fleets under the same load.
 
   FTD=build/bin/ftd SPARKPLUG_PY_DIR=build/python bench/mqtt_fleet.py [N ...]
 Environment: FLEET_SECONDS (measured seconds per run, default 6), FLEET_RATE_HZ (sample rate of
@@ -12,6 +13,8 @@ each simulated sensor, default 500), FLEET_MQTT_HZ (wrench publications per seco
 import os
 import re
 import signal
+import socket
+import struct
 import subprocess
 import sys
 import threading
@@ -79,53 +82,76 @@ def pct(values, q):
     return v[min(len(v) - 1, int(round(q * (len(v) - 1))))]
 
 
-def run_fleet(tmp, broker, n, mqtt):
-    counter = Counter()
-    client = None
+def start_ftd(tmp, broker, i, mqtt):
+    args = [os.environ["FTD"], "--adc", "sim", "--rate-hz", str(RATE_HZ), "--seed", str(i + 1),
+            "--print-hz", "0", "--modbus-tcp", "127.0.0.1:0"]
     if mqtt:
-        import paho.mqtt.client as paho
-        client = paho.Client(client_id=f"fleet-{os.getpid()}-{n}")
-        client.on_message = counter.on_message
-        client.connect("127.0.0.1", broker.port)
-        client.subscribe("spBv1.0/fleet/DDATA/#", qos=0)
-        client.loop_start()
-    procs = []
-    for i in range(n):
-        args = [os.environ["FTD"], "--adc", "sim", "--rate-hz", str(RATE_HZ), "--seed", str(i + 1),
-                "--print-hz", "0"]
-        if mqtt:
-            args += ["--mqtt", f"mqtt://127.0.0.1:{broker.port}", "--sparkplug-group", "fleet",
-                     "--edge-node", f"node{i}", "--device", "ft", "--mqtt-rate-hz", str(MQTT_HZ)]
-        err = open(os.path.join(tmp, f"ftd{i}.{'on' if mqtt else 'off'}.stderr"), "w")
-        procs.append((subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=err), err))
+        args += ["--mqtt", f"mqtt://127.0.0.1:{broker.port}", "--sparkplug-group", "fleet",
+                 "--edge-node", f"node{i}", "--device", "ft", "--mqtt-rate-hz", str(MQTT_HZ)]
+    err = open(os.path.join(tmp, f"ftd{i}.{'on' if mqtt else 'off'}.stderr"), "w")
+    return subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=err), err
+
+
+def late_samples(procs):
+    """Each ftd's late-sample counter (input registers 74-75) over Modbus TCP, function 04."""
+    total = 0
+    for p, err in procs:
+        err.flush()
+        m = re.search(r"serving Modbus TCP on [\d.]+:(\d+)", open(err.name).read())
+        with socket.create_connection(("127.0.0.1", int(m.group(1))), timeout=2) as c:
+            c.sendall(struct.pack(">HHHBBHH", 1, 0, 6, 1, 4, 74, 2))
+            reply = b""
+            while len(reply) < 13:
+                reply += c.recv(13 - len(reply))
+        total += struct.unpack(">I", reply[9:13])[0]
+    return total
+
+
+def stop_all(procs):
+    for p, err in procs:
+        p.send_signal(signal.SIGTERM)
+    for p, err in procs:
+        p.wait(20)
+        err.close()
+
+
+def run_fleet(tmp, broker, n):
+    """n ftd with --mqtt and n without, running at the same time (the same load on the machine)."""
+    import paho.mqtt.client as paho
+    counter = Counter()
+    client = paho.Client(client_id=f"fleet-{os.getpid()}-{n}")
+    client.on_message = counter.on_message
+    client.connect("127.0.0.1", broker.port)
+    client.subscribe("spBv1.0/fleet/#", qos=0)
+    client.loop_start()
+    on, off = [], []
+    for i in range(n):  # interleaved, so that start-up loads both fleets alike
+        on.append(start_ftd(tmp, broker, i, True))
+        off.append(start_ftd(tmp, broker, i, False))
     time.sleep(1.5)  # start-up and births
-    cpu0 = [cpu_s(p.pid) for p, _ in procs]
+    late0 = late_samples(on), late_samples(off)
+    cpu0 = {p.pid: cpu_s(p.pid) for p, _ in on + off}
     with counter.lock:
         counter.measuring = True
         dropped0 = sum(counter.dropped.values())
     t0 = time.time()
-    time.sleep(SECONDS)  # the windows of the interval's last 0.1 s report their drops
+    time.sleep(SECONDS)
     with counter.lock:
         counter.measuring = False
         dropped = sum(counter.dropped.values()) - dropped0
     wall = time.time() - t0
-    cpu1 = [cpu_s(p.pid) for p, _ in procs]
-    late = 0
-    for p, err in procs:
-        p.send_signal(signal.SIGTERM)
-        p.wait(20)
-        err.close()
-        text = open(err.name).read()
-        m = re.search(r", (\d+) late", text)
-        late += int(m.group(1)) if m else 0
-    if client:
-        client.loop_stop()
-        client.disconnect()
-    cpu = [(b - a) / wall * 100 for a, b in zip(cpu0, cpu1)]
+    cpu = {p.pid: (cpu_s(p.pid) - cpu0[p.pid]) / wall * 100 for p, _ in on + off}
+    late_on, late_off = late_samples(on) - late0[0], late_samples(off) - late0[1]
+    stop_all(on + off)
+    client.loop_stop()
+    client.disconnect()
+    cpu_on = [cpu[p.pid] for p, _ in on]
+    cpu_off = [cpu[p.pid] for p, _ in off]
     return {"msgs_s": counter.count / wall, "expected_s": n * MQTT_HZ,
             "p50": pct(counter.latencies_ms, 0.5), "p99": pct(counter.latencies_ms, 0.99),
-            "lost": counter.lost, "dropped": dropped, "cpu_mean": sum(cpu) / len(cpu),
-            "cpu_max": max(cpu), "late": late}
+            "lost": counter.lost, "dropped": dropped, "cpu_mean": sum(cpu_on) / n,
+            "cpu_max": max(cpu_on), "cpu_off": sum(cpu_off) / n, "late": late_on,
+            "late_off": late_off}
 
 
 def main():
@@ -134,17 +160,17 @@ def main():
     broker = Broker(tmp.path)
     try:
         print(f"  {RATE_HZ} Hz simulated sensors, wrench means published at {MQTT_HZ:g} Hz each, "
-              f"{SECONDS:g} s measured per run, one mosquitto on 127.0.0.1")
+              f"{SECONDS:g} s measured per run, one mosquitto on 127.0.0.1; N more without MQTT "
+              "run at the same time")
         print(f"  {'N':>3} {'msgs/s':>8} {'expected':>8} {'p50 ms':>7} {'p99 ms':>7} {'lost':>5} "
               f"{'dropped':>7} {'CPU/ftd %':>10} {'max %':>6} | {'late (MQTT on)':>14} "
               f"{'late (off)':>10} {'CPU off %':>9}")
         for n in sizes:
-            on = run_fleet(tmp.path, broker, n, True)
-            off = run_fleet(tmp.path, broker, n, False)
-            print(f"  {n:>3} {on['msgs_s']:>8.1f} {on['expected_s']:>8.1f} {on['p50']:>7.2f} "
-                  f"{on['p99']:>7.2f} {on['lost']:>5} {on['dropped']:>7} {on['cpu_mean']:>10.2f} "
-                  f"{on['cpu_max']:>6.2f} | {on['late']:>14} {off['late']:>10} "
-                  f"{off['cpu_mean']:>9.2f}", flush=True)
+            r = run_fleet(tmp.path, broker, n)
+            print(f"  {n:>3} {r['msgs_s']:>8.1f} {r['expected_s']:>8.1f} {r['p50']:>7.2f} "
+                  f"{r['p99']:>7.2f} {r['lost']:>5} {r['dropped']:>7} {r['cpu_mean']:>10.2f} "
+                  f"{r['cpu_max']:>6.2f} | {r['late']:>14} {r['late_off']:>10} "
+                  f"{r['cpu_off']:>9.2f}", flush=True)
     finally:
         broker.stop()
         tmp.cleanup()
