@@ -1,12 +1,14 @@
 #include "daemon/mqtt_publisher.hpp"
 
 #include <mosquitto.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <mutex>
@@ -65,6 +67,11 @@ std::pair<std::string, std::string> ReadCredentials(const std::string& path) {
     if (!s->empty() && s->back() == '\r') s->pop_back();
   }
   if (user.empty()) throw FtdError("--mqtt-credentials " + path + ":1: no user name");
+  struct stat st {};
+  if (stat(path.c_str(), &st) == 0 && (st.st_mode & (S_IRWXG | S_IRWXO)) != 0) {
+    std::fprintf(stderr, "ftd: warning: --mqtt-credentials %s is readable by others (chmod 600)\n",
+                 path.c_str());
+  }
   return {user, password};
 }
 

@@ -306,6 +306,7 @@ class MqttTest(unittest.TestCase):
         cred = os.path.join(self.tmp.path, "cred")
         with open(cred, "w") as f:
             f.write("sensor\ns3cret\n")
+        os.chmod(cred, 0o600)
         wrong = os.path.join(self.tmp.path, "wrong")
         with open(wrong, "w") as f:
             f.write("sensor\nnope\n")
@@ -314,10 +315,13 @@ class MqttTest(unittest.TestCase):
         good = self.start(ftd_args(self.broker.port, "--mqtt-credentials", cred))
         self.host.wait_kind("DBIRTH")
         good.stop()
+        self.assertNotIn("readable by others", good.text())
+        os.chmod(wrong, 0o644)
         refused = self.start(ftd_args(self.broker.port, "--mqtt-credentials", wrong), "refused")
         time.sleep(1.5)
         refused.stop()
         self.assertIn("refused the connection", refused.text())
+        self.assertIn("readable by others", refused.text())
         for bad, says in ((["--mqtt", "mqtt://u:p@127.0.0.1:1883"], "--mqtt-credentials"),
                           (["--mqtt", "http://127.0.0.1"], "mqtt://"),
                           (["--mqtt", "mqtt://127.0.0.1", "--edge-node", "a/b"], "--edge-node"),
