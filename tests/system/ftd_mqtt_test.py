@@ -5,6 +5,7 @@ import csv
 import os
 import re
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -179,6 +180,23 @@ class MqttTest(unittest.TestCase):
         self.assertEqual(self.host.wait_kind("DBIRTH").seq, 1)
         self.assertEqual(self.host.wait_kind("DDATA").seq, 2)
         self.assertGreaterEqual(check_sequence(self, self.host.snapshot()), 1)
+
+    def test_default_names(self):
+        """Without --sparkplug-group/--edge-node/--device: group ftstack, the host name, and (no
+        calibration file) ft- and the active calibration's CRC-32 in hex."""
+        self.broker = Broker(self.tmp.path)
+        self.host = SparkplugHost(self.broker.port)
+        self.start(["--adc", "sim", "--mqtt", f"mqtt://127.0.0.1:{self.broker.port}",
+                    "--print-hz", "0"])
+        host = socket.gethostname()
+        for c in "/+# ":
+            host = host.replace(c, "_")
+        nbirth = self.host.wait_kind("NBIRTH")
+        self.assertEqual(nbirth.topic, f"spBv1.0/ftstack/NBIRTH/{host}")
+        dbirth = self.host.wait_kind("DBIRTH")
+        crc = dbirth.value("Config/Calibration CRC")
+        self.assertNotEqual(crc, 0)
+        self.assertEqual(dbirth.topic, f"spBv1.0/ftstack/DBIRTH/{host}/ft-{crc:08x}")
 
     def command(self, name):
         self.host.publish_command(f"spBv1.0/{GROUP}/DCMD/{NODE}/{DEVICE}",
