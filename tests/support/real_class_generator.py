@@ -182,7 +182,7 @@ def generate(seed, duration_s, rate_hz, channels, effects):
         count = int(rng.integers(3, 9)) * channels
         used = set()
         while len(glitches) < count:
-            i = int(rng.integers(2, n - 2))
+            i = int(rng.integers(3, n - 3))
             k = int(rng.integers(0, channels))
             if any(abs(i - j) < 3 for j, kk in used if kk == k):
                 continue

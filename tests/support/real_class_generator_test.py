@@ -19,6 +19,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.dont_write_bytecode = True  # keep the source tree clean
 sys.path.insert(0, HERE)
 from recording_io import read_recording  # noqa: E402
+from signal_tools import isolated_codes, ls_periodogram, moving_average  # noqa: E402
 
 GENERATOR = os.path.join(HERE, "real_class_generator.py")
 
@@ -30,33 +31,6 @@ def generate(workdir, name, *args):
     with open(os.path.join(workdir, name + ".json"), encoding="utf-8") as f:
         truth = json.load(f)
     return read_recording(out), truth
-
-
-def isolated_codes(x, threshold):
-    """Rows where one sample stands off both neighbours, which agree with each other."""
-    mid = 0.5 * (x[:-2] + x[2:])
-    off = np.abs(x[1:-1] - mid) > threshold
-    agree = np.abs(x[2:] - x[:-2]) < 0.25 * threshold
-    return np.nonzero(off & agree)[0] + 1
-
-
-def moving_average(x, width):
-    kernel = np.ones(width) / width
-    padded = np.pad(x, (width // 2, width - 1 - width // 2), mode="edge")
-    return np.convolve(padded, kernel, mode="valid")
-
-
-def ls_periodogram(t, x, freqs):
-    """Power of the best cos+sin fit at each frequency (least squares, uneven t allowed)."""
-    x = x - x.mean()
-    arg = 2.0 * np.pi * np.outer(freqs, t - t[0])
-    c, s = np.cos(arg), np.sin(arg)
-    cc, ss, cs = (c * c).sum(1), (s * s).sum(1), (c * s).sum(1)
-    xc, xs = c @ x, s @ x
-    det = cc * ss - cs * cs
-    a = (xc * ss - xs * cs) / det
-    b = (xs * cc - xc * cs) / det
-    return a * xc + b * xs
 
 
 class GeneratorTruth(unittest.TestCase):
