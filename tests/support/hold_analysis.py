@@ -7,7 +7,8 @@ a stepwise reference force (holds of constant load) and bridge columns:
 1. Converter glitches: samples that stand off both neighbours by more than 50 times the channel's
    first-difference noise while two samples either side are quiet (signal_tools.isolated_codes);
    replaced by the neighbours' mean for everything below, and counted unless they fall inside a
-   load change (there a bounce sampled near its alias can look the same).
+   load change (there a bounce sampled near its alias can look the same) with a code within the
+   record's span (off the span by more than the span itself, a code is a glitch anywhere).
 2. Load changes: where the reference changes. For each, the real load's progress from the old to
    the new level (5-95 %) on the channel with the largest step gives the application time, and
    the last excursion beyond 5 % of the step the settling time; the largest overshoot is reported.
@@ -157,7 +158,11 @@ def analyse(path, force="Fz"):
                for tr in transitions if tr]
     in_changes = {}
     for name in names:
-        inside = [v for v in glitches[name] if any(a <= v <= b for a, b in windows)]
+        # A code off the whole record's span by more than that span is a glitch wherever it is.
+        x = rec.col(name)
+        lo, hi = np.percentile(clean[name], [0.5, 99.5])
+        wild = {float(t[i]) for i in range(len(t)) if x[i] < lo - (hi - lo) or x[i] > hi + (hi - lo)}
+        inside = [v for v in glitches[name] if any(a <= v <= b for a, b in windows) and v not in wild]
         glitches[name] = [v for v in glitches[name] if v not in inside]
         in_changes[name] = inside
     holds = []
