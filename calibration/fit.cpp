@@ -38,13 +38,15 @@ const char* ToString(ModelKind kind) {
       return "quadratic";
     case ModelKind::kQuadraticTemp:
       return "quadratic-temp";
+    case ModelKind::kQuadraticDiag:
+      return "quadratic-diag";
   }
   return "?";
 }
 
 std::optional<ModelKind> ParseModelKind(const std::string& name) {
   for (ModelKind k : {ModelKind::kLinear, ModelKind::kLinearTemp, ModelKind::kQuadratic,
-                      ModelKind::kQuadraticTemp}) {
+                      ModelKind::kQuadraticTemp, ModelKind::kQuadraticDiag}) {
     if (name == ToString(k)) return k;
   }
   return std::nullopt;
@@ -71,7 +73,7 @@ std::vector<ModelKind> CandidateModels(const RigData& d, const FitOptions& optio
       d.temp_c.size() == d.bridges.rows() && d.temp_c.maxCoeff() - d.temp_c.minCoeff() > 1.0;
   std::vector<ModelKind> models = options.models;
   if (models.empty()) {
-    models = {ModelKind::kLinear, ModelKind::kQuadratic};
+    models = {ModelKind::kLinear, ModelKind::kQuadraticDiag, ModelKind::kQuadratic};
     if (has_temp) {
       models.push_back(ModelKind::kLinearTemp);
       models.push_back(ModelKind::kQuadraticTemp);
@@ -139,14 +141,21 @@ struct Folds {
   VectorXd scale;  // standardisation: 1 / RMS of each centred feature
 };
 
-/// Folds over whole blocks: block b (in order of first row) goes to fold b mod K, so neighbouring
-/// blocks (an up and a down sweep) land in different folds.
-void AssignFolds(const RigData& d, int folds, Folds* out) {
-  out->k = std::max(2, std::min(folds, d.block_count));
+/// Folds over whole validation units — groups (load directions) when asked for and there are at
+/// least three, else blocks: unit u (in order of first row) goes to fold u mod K, so neighbouring
+/// blocks (an up and a down sweep) land in different folds. Returns a description.
+std::string AssignFolds(const RigData& d, const FitOptions& options, Folds* out) {
+  const bool groups = options.by_group && d.group_count >= 3 && d.group.size() == d.block.size();
+  const std::vector<int>& unit = groups ? d.group : d.block;
+  const int units = groups ? d.group_count : d.block_count;
+  out->k = std::max(2, std::min(options.folds, units));
   out->rows.assign(static_cast<std::size_t>(out->k), {});
-  for (std::size_t i = 0; i < d.block.size(); ++i) {
-    out->rows[static_cast<std::size_t>(d.block[i] % out->k)].push_back(i);
+  for (std::size_t i = 0; i < unit.size(); ++i) {
+    out->rows[static_cast<std::size_t>(unit[i] % out->k)].push_back(i);
   }
+  if (groups) return std::to_string(units) + " groups (" + d.group_method + ")";
+  std::string why = options.by_group ? " (fewer than 3 groups)" : "";
+  return std::to_string(units) + " load blocks (" + d.block_method + ")" + why;
 }
 
 /// Global means of the features and targets (pass 1).
@@ -288,13 +297,14 @@ void HeldOutResiduals(const FeatureBuilder& builder, const Layout& layout, const
   }
 }
 
-/// Per-block scores, worst first.
-void ScoreBlocks(const RigData& d, FitResult* res) {
-  const std::size_t rows = d.block.size();
-  res->blocks.resize(static_cast<std::size_t>(d.block_count));
-  std::vector<double> block_ss(static_cast<std::size_t>(d.block_count), 0.0);
+/// Held-out scores per unit (block or group), worst first.
+std::vector<BlockScore> ScoreUnits(const RigData& d, const std::vector<int>& unit, int units,
+                                   const FitResult& fit) {
+  const std::size_t rows = unit.size();
+  std::vector<BlockScore> scores(static_cast<std::size_t>(units));
+  std::vector<double> block_ss(static_cast<std::size_t>(units), 0.0);
   for (std::size_t i = 0; i < rows; ++i) {
-    BlockScore& b = res->blocks[static_cast<std::size_t>(d.block[i])];
+    BlockScore& b = scores[static_cast<std::size_t>(unit[i])];
     if (b.rows == 0) b.t_start_s = d.t_s[i];
     b.t_end_s = d.t_s[i];
     ++b.rows;
@@ -302,20 +312,21 @@ void ScoreBlocks(const RigData& d, FitResult* res) {
       const auto ii = static_cast<Eigen::Index>(i);
       const auto aa = static_cast<Eigen::Index>(a);
       b.mean_wrench[a] += d.wrench(ii, aa);
-      block_ss[static_cast<std::size_t>(d.block[i])] +=
-          std::pow(res->heldout_residual(ii, aa) / res->rated[a] * 100.0, 2) / 6.0;
+      block_ss[static_cast<std::size_t>(unit[i])] +=
+          std::pow(fit.heldout_residual(ii, aa) / fit.rated[a] * 100.0, 2) / 6.0;
     }
   }
-  for (std::size_t bi = 0; bi < res->blocks.size(); ++bi) {
-    BlockScore& b = res->blocks[bi];
+  for (std::size_t bi = 0; bi < scores.size(); ++bi) {
+    BlockScore& b = scores[bi];
     b.block = static_cast<int>(bi);
     if (b.rows > 0) {
       for (double& w : b.mean_wrench) w /= static_cast<double>(b.rows);
       b.rms_pct = std::sqrt(block_ss[bi] / static_cast<double>(b.rows));
     }
   }
-  std::sort(res->blocks.begin(), res->blocks.end(),
+  std::sort(scores.begin(), scores.end(),
             [](const BlockScore& a, const BlockScore& b) { return a.rms_pct > b.rms_pct; });
+  return scores;
 }
 
 /// Training residual σ, the parameter part of the uncertainty and the design's condition number.
@@ -362,15 +373,18 @@ void ToCalibration(const Layout& layout, const Folds& folds, const Reference& re
   }
   for (int c = 0; c < n; ++c) cal.offset_mvv[static_cast<std::size_t>(c)] = ref.offset(c);
   if (UsesQuad(res->kind)) {
-    cal.product_count = static_cast<std::uint8_t>(layout.pairs.size());
+    std::size_t used = 0;
     for (std::size_t k = 0; k < layout.pairs.size(); ++k) {
-      cal.products[k] = fw::ProductTerm{static_cast<std::uint8_t>(layout.pairs[k].first),
-                                        static_cast<std::uint8_t>(layout.pairs[k].second)};
+      const auto it = pos.find(layout.quad_start + static_cast<int>(k));
+      if (it == pos.end()) continue;  // a product the model does not use
+      cal.products[used] = fw::ProductTerm{static_cast<std::uint8_t>(layout.pairs[k].first),
+                                           static_cast<std::uint8_t>(layout.pairs[k].second)};
       for (int a = 0; a < 6; ++a) {
-        cal.product_matrix[static_cast<std::size_t>(a)][k] =
-            s.beta(pos.at(layout.quad_start + static_cast<int>(k)), a);
+        cal.product_matrix[static_cast<std::size_t>(a)][used] = s.beta(it->second, a);
       }
+      ++used;
     }
+    cal.product_count = static_cast<std::uint8_t>(used);
   }
   if (UsesTemp(res->kind)) {
     cal.temperature_compensated = true;
@@ -414,7 +428,7 @@ FitResult FitCalibration(const RigData& d, const FitOptions& options) {
   const Reference ref = FindReference(d, res.rated, want_temp);
 
   Folds folds;
-  AssignFolds(d, options.folds, &folds);
+  res.validation = AssignFolds(d, options, &folds);
   res.folds = folds.k;
   CentreFeatures(d, layout, ref, &folds);
   const FeatureBuilder builder(d, layout, ref.offset, ref.t_ref, folds.mu, folds.mu_y);
@@ -425,10 +439,15 @@ FitResult FitCalibration(const RigData& d, const FitOptions& options) {
   const CandidateScore& chosen = ChooseCandidate(res.candidates, options.simpler_tolerance);
   res.kind = chosen.kind;
   res.lambda = chosen.lambda;
+  res.lambda_at_bound =
+      chosen.lambda > 0 &&
+      chosen.lambda >= *std::max_element(options.lambdas.begin(), options.lambdas.end());
   res.heldout_rms_si = chosen.rms_si;
   const std::vector<int> cols = layout.Columns(res.kind);
   HeldOutResiduals(builder, layout, folds, cols, rows, &res);
-  ScoreBlocks(d, &res);
+  res.blocks = ScoreUnits(d, d.block, d.block_count, res);
+  if (d.group.size() == d.block.size() && d.group_count > 0)
+    res.groups = ScoreUnits(d, d.group, d.group_count, res);
 
   // Final fit on all rows.
   Solved s = Solve(folds.total, cols, folds.scale, res.lambda);
