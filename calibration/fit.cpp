@@ -178,7 +178,9 @@ void CentreFeatures(const RigData& d, const Layout& layout, const Reference& ref
 }
 
 /// Pass 2: sufficient statistics per fold, their total, the training complements and the scale.
-void AccumulateFolds(const FeatureBuilder& builder, int p, std::size_t rows, Folds* out) {
+/// With `row_weight`, every row's features and targets are scaled by √w (weighted least squares).
+void AccumulateFolds(const FeatureBuilder& builder, int p, std::size_t rows, Folds* out,
+                     const std::vector<double>* row_weight = nullptr) {
   out->stats.assign(static_cast<std::size_t>(out->k), {});
   out->total.g = MatrixXd::Zero(p, p);
   out->total.xy = MatrixXd::Zero(p, 6);
@@ -192,6 +194,13 @@ void AccumulateFolds(const FeatureBuilder& builder, int p, std::size_t rows, Fol
     for (std::size_t b = 0; b < idx.size(); b += kChunk) {
       const std::size_t e = std::min(idx.size(), b + kChunk);
       builder.Fill(idx, b, e, f, y);
+      if (row_weight != nullptr) {
+        for (std::size_t i = b; i < e; ++i) {
+          const double w = std::sqrt((*row_weight)[idx[i]]);
+          f.row(static_cast<Eigen::Index>(i - b)) *= w;
+          y.row(static_cast<Eigen::Index>(i - b)) *= w;
+        }
+      }
       s.g.selfadjointView<Eigen::Lower>().rankUpdate(f.transpose());
       s.xy.noalias() += f.transpose() * y;
       s.yy += y.colwise().squaredNorm().transpose();
@@ -268,12 +277,13 @@ const CandidateScore& ChooseCandidate(const std::vector<CandidateScore>& candida
 
 /// Held-out residuals of the chosen model, row by row, and their 95th percentile per axis.
 void HeldOutResiduals(const FeatureBuilder& builder, const Layout& layout, const Folds& folds,
-                      const std::vector<int>& cols, std::size_t rows, FitResult* res) {
+                      const Folds& train, const std::vector<int>& cols, std::size_t rows,
+                      FitResult* res) {
   res->heldout_residual.resize(static_cast<Eigen::Index>(rows), 6);
   MatrixXd f;
   MatrixXd y;
   for (int k = 0; k < folds.k; ++k) {
-    const Solved s = SolveWithoutFold(layout, folds, cols, res->kind, res->lambda, k);
+    const Solved s = SolveWithoutFold(layout, train, cols, res->kind, res->lambda, k);
     const auto& idx = folds.rows[static_cast<std::size_t>(k)];
     for (std::size_t b = 0; b < idx.size(); b += kChunk) {
       const std::size_t e = std::min(idx.size(), b + kChunk);
@@ -327,6 +337,52 @@ std::vector<BlockScore> ScoreUnits(const RigData& d, const std::vector<int>& uni
   std::sort(scores.begin(), scores.end(),
             [](const BlockScore& a, const BlockScore& b) { return a.rms_pct > b.rms_pct; });
   return scores;
+}
+
+/// Blocks whose held-out RMS lies more than 3.5 robust standard deviations (1.4826 × MAD) above
+/// the median of all blocks: recorded badly (a slipped mass, a wrong reference) or a load the
+/// model cannot reach. Their rows get the weight limit / RMS (Huber); others 1.
+std::vector<double> SuspectWeights(const RigData& d, const std::vector<BlockScore>& blocks,
+                                   std::vector<int>* suspects) {
+  std::vector<double> rms;
+  for (const BlockScore& b : blocks) rms.push_back(b.rms_pct);
+  std::vector<double> weight;
+  if (rms.size() < 5) return weight;
+  std::vector<double> v = rms;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  const double median = v[v.size() / 2];
+  for (double& x : v) x = std::fabs(x - median);
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  const double limit = median + 3.5 * 1.4826 * v[v.size() / 2];
+  std::vector<double> block_weight(static_cast<std::size_t>(d.block_count), 1.0);
+  for (const BlockScore& b : blocks) {
+    if (b.rms_pct > limit && limit > 0) {
+      suspects->push_back(b.block);
+      block_weight[static_cast<std::size_t>(b.block)] = limit / b.rms_pct;
+    }
+  }
+  if (suspects->empty()) return weight;
+  weight.resize(d.block.size());
+  for (std::size_t i = 0; i < d.block.size(); ++i)
+    weight[i] = block_weight[static_cast<std::size_t>(d.block[i])];
+  return weight;
+}
+
+/// The cross-validated score (as CandidateScore::score) of the chosen model trained on the
+/// weighted folds and tested on the unweighted held-out rows.
+double WeightedScore(const Layout& layout, const Folds& folds, const Folds& weighted,
+                     const std::vector<int>& cols, const FitResult& res, std::size_t rows) {
+  Eigen::Matrix<double, 6, 1> sse = Eigen::Matrix<double, 6, 1>::Zero();
+  for (int k = 0; k < folds.k; ++k) {
+    const Solved s = SolveWithoutFold(layout, weighted, cols, res.kind, res.lambda, k);
+    sse += HeldOutSse(folds.stats[static_cast<std::size_t>(k)], cols, s.beta);
+  }
+  double score = 0.0;
+  for (std::size_t a = 0; a < 6; ++a) {
+    score += sse(static_cast<Eigen::Index>(a)) / static_cast<double>(rows) /
+             std::pow(res.rated[a], 2) / 6.0;
+  }
+  return score;
 }
 
 /// Training residual σ, the parameter part of the uncertainty and the design's condition number.
@@ -444,16 +500,39 @@ FitResult FitCalibration(const RigData& d, const FitOptions& options) {
       chosen.lambda >= *std::max_element(options.lambdas.begin(), options.lambdas.end());
   res.heldout_rms_si = chosen.rms_si;
   const std::vector<int> cols = layout.Columns(res.kind);
-  HeldOutResiduals(builder, layout, folds, cols, rows, &res);
+  HeldOutResiduals(builder, layout, folds, folds, cols, rows, &res);
   res.blocks = ScoreUnits(d, d.block, d.block_count, res);
+  // Robust variant: suspect blocks down-weighted; kept only when it validates better.
+  const std::vector<double> weight = SuspectWeights(d, res.blocks, &res.suspect_blocks);
+  Folds weighted;
+  if (!weight.empty()) {
+    weighted.k = folds.k;
+    weighted.rows = folds.rows;
+    weighted.mu = folds.mu;
+    weighted.mu_y = folds.mu_y;
+    AccumulateFolds(builder, layout.total, rows, &weighted, &weight);
+    weighted.scale = folds.scale;
+    res.plain_score = chosen.score;
+    res.robust_score = WeightedScore(layout, folds, weighted, cols, res, rows);
+    res.robust = res.robust_score < res.plain_score;
+    if (res.robust) {
+      HeldOutResiduals(builder, layout, folds, weighted, cols, rows, &res);
+      for (std::size_t a = 0; a < 6; ++a) {
+        res.heldout_rms_si[a] =
+            std::sqrt(res.heldout_residual.col(static_cast<Eigen::Index>(a)).squaredNorm() / rows);
+      }
+      res.blocks = ScoreUnits(d, d.block, d.block_count, res);
+    }
+  }
+  const Folds& train = res.robust ? weighted : folds;
   if (d.group.size() == d.block.size() && d.group_count > 0)
     res.groups = ScoreUnits(d, d.group, d.group_count, res);
 
   // Final fit on all rows.
-  Solved s = Solve(folds.total, cols, folds.scale, res.lambda);
+  Solved s = Solve(train.total, cols, folds.scale, res.lambda);
   VectorXd alpha;
   VectorXd gamma;
-  if (UsesTemp(res.kind)) ProjectTemperature(layout, cols, folds.total, s.beta, &alpha, &gamma);
+  if (UsesTemp(res.kind)) ProjectTemperature(layout, cols, train.total, s.beta, &alpha, &gamma);
   FinalFitQuality(folds, cols, s, rows, &res);
   res.load_condition = LoadSetCondition(d.wrench, res.rated);
   ToCalibration(layout, folds, ref, cols, s, alpha, gamma, &res);

@@ -139,6 +139,12 @@ struct FitResult {
   Eigen::MatrixXd heldout_residual;  ///< rows × 6: prediction − reference, held-out
   std::vector<BlockScore> blocks;    ///< worst first
   std::vector<BlockScore> groups;    ///< held-out error per validation group, worst first
+  /// Blocks whose held-out error is an outlier (over 3.5 robust σ above the median block):
+  /// reported, and down-weighted in the robust variant.
+  std::vector<int> suspect_blocks;
+  bool robust = false;        ///< the robust variant validated better and was used
+  double plain_score = 0.0;   ///< cross-validated score without / with the down-weighting
+  double robust_score = 0.0;  ///< (0 when no block is suspect)
 };
 
 /// Fits and cross-validates. Throws std::invalid_argument when the data cannot support a fit

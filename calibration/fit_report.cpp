@@ -180,6 +180,8 @@ CalFile CalFileFromFit(const FitResult& fit, const hal::AdcInfo& adc, const std:
                     {"blocks", fit.block_count},
                     {"block_method", fit.block_method},
                     {"validation", fit.validation},
+                    {"suspect_blocks", fit.suspect_blocks},
+                    {"robust", fit.robust},
                     {"lambda_at_bound", fit.lambda_at_bound},
                     {"worst_group", fit.groups.empty() ? -1 : fit.groups.front().block},
                     {"worst_group_rms_pct", fit.groups.empty() ? 0.0 : fit.groups.front().rms_pct},
@@ -222,6 +224,12 @@ std::string FitSummary(const FitResult& fit, const fw::LoadReport& fixed) {
       o << " g" << g.block << " " << Fmt("%.3g%%", g.rms_pct) << ";";
     }
     o << "\n";
+  }
+  if (!fit.suspect_blocks.empty()) {
+    o << "suspect blocks (held-out error an outlier: recorded badly?):";
+    for (const int b : fit.suspect_blocks) o << " #" << b;
+    o << "; down-weighted fit " << (fit.robust ? "used" : "not used") << " (score "
+      << Fmt("%.4g", fit.robust_score) << " against " << Fmt("%.4g", fit.plain_score) << ")\n";
   }
   o << "worst blocks (RMS % of rated):";
   for (std::size_t i = 0; i < std::min<std::size_t>(5, fit.blocks.size()); ++i) {

@@ -4,8 +4,12 @@
 // fixed-point core.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <Eigen/Dense>
+
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <random>
 #include <string>
 
@@ -13,6 +17,7 @@
 #include "calibration/check.hpp"
 #include "calibration/input_units.hpp"
 #include "measurement/recording.hpp"
+#include "tests/calibration/run_ftcal.hpp"
 
 namespace {
 
@@ -191,6 +196,41 @@ TEST(CalCheck, RefusesTooFewOrFlatPoses) {
                              std::sin(0.3 * static_cast<double>(i)) * 9.8, 0.0};  // one plane
   }
   EXPECT_THROW((void)CheckCalibration(poses, Tool(1.0), cal.uncertainty), std::invalid_argument);
+}
+
+TEST(CalCheck, CommandLineGivesAVerdictAndAnExitCodeAScriptCanUse) {
+  std::mt19937_64 rng(7);
+  const CalFile cal = MakeCal(rng);
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("ftcal_check_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string cal_path = (dir / "cal.json").string();
+  ftstack::cal::SaveCalFile(cal_path, cal);
+  const std::string tool = " --mass-kg 2.5 --com-m 0.012,-0.018,0.085";
+  struct Case {
+    Fault fault;
+    int code;
+    std::string word;
+  };
+  const Case cases[] = {{{}, 0, "PASS"}, {{1, 0.01, {}}, 4, "FAIL: Fy"}};
+  for (const Case& c : cases) {
+    const std::string in = (dir / "poses.csv").string();
+    ftstack::WriteRecording(in, Generate(cal, Tool(2.5), c.fault, 11));
+    std::string out;
+    EXPECT_EQ(ftstack::test::RunFtcal("check --cal " + cal_path + " --in " + in + tool, &out),
+              c.code)
+        << out;
+    std::printf("%s", out.c_str());  // for the record (docs/robot.md)
+    EXPECT_NE(out.find(c.word), std::string::npos) << out;
+    EXPECT_NE(out.find("gain error"), std::string::npos) << out;
+  }
+  // No tool given: one line, exit 1.
+  std::string out;
+  EXPECT_EQ(ftstack::test::RunFtcal(
+                "check --cal " + cal_path + " --in " + (dir / "poses.csv").string(), &out),
+            1);
+  EXPECT_NE(out.find("needs the tool"), std::string::npos) << out;
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
