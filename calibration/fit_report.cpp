@@ -282,19 +282,34 @@ void WriteFitReport(const std::string& path, const FitResult& fit, const RigData
       << "<div class='plots'>";
   for (int c = 0; c < 6; ++c) out << ResidualPlot(fit, d, c);
   out << "</div>";
-  out << "<h2>Worst blocks</h2><table><tr><th>block</th><th>t start (s)</th><th>t end (s)</th>"
-      << "<th>rows</th><th>RMS error, % rated</th>";
-  for (const char* a : kAxes) out << "<th>mean " << a << "</th>";
-  out << "</tr>";
-  for (std::size_t i = 0; i < std::min<std::size_t>(10, fit.blocks.size()); ++i) {
-    const BlockScore& b = fit.blocks[i];
-    out << "<tr><td>" << b.block << "</td><td>" << Fmt("%.3f", b.t_start_s) << "</td><td>"
-        << Fmt("%.3f", b.t_end_s) << "</td><td>" << b.rows << "</td><td>" << Fmt("%.4f", b.rms_pct)
-        << "</td>";
-    for (double w : b.mean_wrench) out << "<td>" << Fmt("%.4g", w) << "</td>";
+  // Held-out error per unit (validation group or block), worst first.
+  const auto unit_table = [&](const char* heading, const char* unit,
+                              const std::vector<BlockScore>& scores, std::size_t limit) {
+    out << "<h2>" << heading << "</h2><table><tr><th>" << unit
+        << "</th><th>t start (s)</th><th>t end (s)</th><th>rows</th><th>RMS error, % rated</th>";
+    for (const char* a : kAxes) out << "<th>mean " << a << "</th>";
     out << "</tr>";
+    for (std::size_t i = 0; i < std::min(limit, scores.size()); ++i) {
+      const BlockScore& b = scores[i];
+      out << "<tr><td>" << b.block << "</td><td>" << Fmt("%.3f", b.t_start_s) << "</td><td>"
+          << Fmt("%.3f", b.t_end_s) << "</td><td>" << b.rows << "</td><td>"
+          << Fmt("%.4f", b.rms_pct) << "</td>";
+      for (double w : b.mean_wrench) out << "<td>" << Fmt("%.4g", w) << "</td>";
+      out << "</tr>";
+    }
+    out << "</table>";
+  };
+  if (!fit.groups.empty()) {
+    unit_table("Held-out error per validation group", "group", fit.groups, fit.groups.size());
   }
-  out << "</table><h2>Candidates</h2><table><tr><th>model</th><th>&lambda;</th><th>features</th>"
+  unit_table("Worst blocks", "block", fit.blocks, 10);
+  if (!fit.suspect_blocks.empty()) {
+    out << "<p>Suspect blocks (held-out error over 3.5 robust &sigma; above the median block): ";
+    for (const int b : fit.suspect_blocks) out << b << " ";
+    out << "&mdash; down-weighted fit " << (fit.robust ? "used" : "not used (validated worse)")
+        << ".</p>";
+  }
+  out << "<h2>Candidates</h2><table><tr><th>model</th><th>&lambda;</th><th>features</th>"
       << "<th>score</th>";
   for (const char* a : kAxes) out << "<th>RMS " << a << "</th>";
   out << "</tr>";
