@@ -38,13 +38,15 @@ const char* ToString(ModelKind kind) {
       return "quadratic";
     case ModelKind::kQuadraticTemp:
       return "quadratic-temp";
+    case ModelKind::kQuadraticDiag:
+      return "quadratic-diag";
   }
   return "?";
 }
 
 std::optional<ModelKind> ParseModelKind(const std::string& name) {
   for (ModelKind k : {ModelKind::kLinear, ModelKind::kLinearTemp, ModelKind::kQuadratic,
-                      ModelKind::kQuadraticTemp}) {
+                      ModelKind::kQuadraticTemp, ModelKind::kQuadraticDiag}) {
     if (name == ToString(k)) return k;
   }
   return std::nullopt;
@@ -71,7 +73,7 @@ std::vector<ModelKind> CandidateModels(const RigData& d, const FitOptions& optio
       d.temp_c.size() == d.bridges.rows() && d.temp_c.maxCoeff() - d.temp_c.minCoeff() > 1.0;
   std::vector<ModelKind> models = options.models;
   if (models.empty()) {
-    models = {ModelKind::kLinear, ModelKind::kQuadratic};
+    models = {ModelKind::kLinear, ModelKind::kQuadraticDiag, ModelKind::kQuadratic};
     if (has_temp) {
       models.push_back(ModelKind::kLinearTemp);
       models.push_back(ModelKind::kQuadraticTemp);
@@ -139,14 +141,21 @@ struct Folds {
   VectorXd scale;  // standardisation: 1 / RMS of each centred feature
 };
 
-/// Folds over whole blocks: block b (in order of first row) goes to fold b mod K, so neighbouring
-/// blocks (an up and a down sweep) land in different folds.
-void AssignFolds(const RigData& d, int folds, Folds* out) {
-  out->k = std::max(2, std::min(folds, d.block_count));
+/// Folds over whole validation units — groups (load directions) when asked for and there are at
+/// least three, else blocks: unit u (in order of first row) goes to fold u mod K, so neighbouring
+/// blocks (an up and a down sweep) land in different folds. Returns a description.
+std::string AssignFolds(const RigData& d, const FitOptions& options, Folds* out) {
+  const bool groups = options.by_group && d.group_count >= 3 && d.group.size() == d.block.size();
+  const std::vector<int>& unit = groups ? d.group : d.block;
+  const int units = groups ? d.group_count : d.block_count;
+  out->k = std::max(2, std::min(options.folds, units));
   out->rows.assign(static_cast<std::size_t>(out->k), {});
-  for (std::size_t i = 0; i < d.block.size(); ++i) {
-    out->rows[static_cast<std::size_t>(d.block[i] % out->k)].push_back(i);
+  for (std::size_t i = 0; i < unit.size(); ++i) {
+    out->rows[static_cast<std::size_t>(unit[i] % out->k)].push_back(i);
   }
+  if (groups) return std::to_string(units) + " groups (" + d.group_method + ")";
+  std::string why = options.by_group ? " (fewer than 3 groups)" : "";
+  return std::to_string(units) + " load blocks (" + d.block_method + ")" + why;
 }
 
 /// Global means of the features and targets (pass 1).
@@ -169,7 +178,9 @@ void CentreFeatures(const RigData& d, const Layout& layout, const Reference& ref
 }
 
 /// Pass 2: sufficient statistics per fold, their total, the training complements and the scale.
-void AccumulateFolds(const FeatureBuilder& builder, int p, std::size_t rows, Folds* out) {
+/// With `row_weight`, every row's features and targets are scaled by √w (weighted least squares).
+void AccumulateFolds(const FeatureBuilder& builder, int p, std::size_t rows, Folds* out,
+                     const std::vector<double>* row_weight = nullptr) {
   out->stats.assign(static_cast<std::size_t>(out->k), {});
   out->total.g = MatrixXd::Zero(p, p);
   out->total.xy = MatrixXd::Zero(p, 6);
@@ -183,6 +194,13 @@ void AccumulateFolds(const FeatureBuilder& builder, int p, std::size_t rows, Fol
     for (std::size_t b = 0; b < idx.size(); b += kChunk) {
       const std::size_t e = std::min(idx.size(), b + kChunk);
       builder.Fill(idx, b, e, f, y);
+      if (row_weight != nullptr) {
+        for (std::size_t i = b; i < e; ++i) {
+          const double w = std::sqrt((*row_weight)[idx[i]]);
+          f.row(static_cast<Eigen::Index>(i - b)) *= w;
+          y.row(static_cast<Eigen::Index>(i - b)) *= w;
+        }
+      }
       s.g.selfadjointView<Eigen::Lower>().rankUpdate(f.transpose());
       s.xy.noalias() += f.transpose() * y;
       s.yy += y.colwise().squaredNorm().transpose();
@@ -259,12 +277,13 @@ const CandidateScore& ChooseCandidate(const std::vector<CandidateScore>& candida
 
 /// Held-out residuals of the chosen model, row by row, and their 95th percentile per axis.
 void HeldOutResiduals(const FeatureBuilder& builder, const Layout& layout, const Folds& folds,
-                      const std::vector<int>& cols, std::size_t rows, FitResult* res) {
+                      const Folds& train, const std::vector<int>& cols, std::size_t rows,
+                      FitResult* res) {
   res->heldout_residual.resize(static_cast<Eigen::Index>(rows), 6);
   MatrixXd f;
   MatrixXd y;
   for (int k = 0; k < folds.k; ++k) {
-    const Solved s = SolveWithoutFold(layout, folds, cols, res->kind, res->lambda, k);
+    const Solved s = SolveWithoutFold(layout, train, cols, res->kind, res->lambda, k);
     const auto& idx = folds.rows[static_cast<std::size_t>(k)];
     for (std::size_t b = 0; b < idx.size(); b += kChunk) {
       const std::size_t e = std::min(idx.size(), b + kChunk);
@@ -288,13 +307,14 @@ void HeldOutResiduals(const FeatureBuilder& builder, const Layout& layout, const
   }
 }
 
-/// Per-block scores, worst first.
-void ScoreBlocks(const RigData& d, FitResult* res) {
-  const std::size_t rows = d.block.size();
-  res->blocks.resize(static_cast<std::size_t>(d.block_count));
-  std::vector<double> block_ss(static_cast<std::size_t>(d.block_count), 0.0);
+/// Held-out scores per unit (block or group), worst first.
+std::vector<BlockScore> ScoreUnits(const RigData& d, const std::vector<int>& unit, int units,
+                                   const FitResult& fit) {
+  const std::size_t rows = unit.size();
+  std::vector<BlockScore> scores(static_cast<std::size_t>(units));
+  std::vector<double> block_ss(static_cast<std::size_t>(units), 0.0);
   for (std::size_t i = 0; i < rows; ++i) {
-    BlockScore& b = res->blocks[static_cast<std::size_t>(d.block[i])];
+    BlockScore& b = scores[static_cast<std::size_t>(unit[i])];
     if (b.rows == 0) b.t_start_s = d.t_s[i];
     b.t_end_s = d.t_s[i];
     ++b.rows;
@@ -302,20 +322,67 @@ void ScoreBlocks(const RigData& d, FitResult* res) {
       const auto ii = static_cast<Eigen::Index>(i);
       const auto aa = static_cast<Eigen::Index>(a);
       b.mean_wrench[a] += d.wrench(ii, aa);
-      block_ss[static_cast<std::size_t>(d.block[i])] +=
-          std::pow(res->heldout_residual(ii, aa) / res->rated[a] * 100.0, 2) / 6.0;
+      block_ss[static_cast<std::size_t>(unit[i])] +=
+          std::pow(fit.heldout_residual(ii, aa) / fit.rated[a] * 100.0, 2) / 6.0;
     }
   }
-  for (std::size_t bi = 0; bi < res->blocks.size(); ++bi) {
-    BlockScore& b = res->blocks[bi];
+  for (std::size_t bi = 0; bi < scores.size(); ++bi) {
+    BlockScore& b = scores[bi];
     b.block = static_cast<int>(bi);
     if (b.rows > 0) {
       for (double& w : b.mean_wrench) w /= static_cast<double>(b.rows);
       b.rms_pct = std::sqrt(block_ss[bi] / static_cast<double>(b.rows));
     }
   }
-  std::sort(res->blocks.begin(), res->blocks.end(),
+  std::sort(scores.begin(), scores.end(),
             [](const BlockScore& a, const BlockScore& b) { return a.rms_pct > b.rms_pct; });
+  return scores;
+}
+
+/// Blocks whose held-out RMS lies more than 3.5 robust standard deviations (1.4826 × MAD) above
+/// the median of all blocks: recorded badly (a slipped mass, a wrong reference) or a load the
+/// model cannot reach. Their rows get the weight limit / RMS (Huber); others 1.
+std::vector<double> SuspectWeights(const RigData& d, const std::vector<BlockScore>& blocks,
+                                   std::vector<int>* suspects) {
+  std::vector<double> rms;
+  for (const BlockScore& b : blocks) rms.push_back(b.rms_pct);
+  std::vector<double> weight;
+  if (rms.size() < 5) return weight;
+  std::vector<double> v = rms;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  const double median = v[v.size() / 2];
+  for (double& x : v) x = std::fabs(x - median);
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  const double limit = median + 3.5 * 1.4826 * v[v.size() / 2];
+  std::vector<double> block_weight(static_cast<std::size_t>(d.block_count), 1.0);
+  for (const BlockScore& b : blocks) {
+    if (b.rms_pct > limit && limit > 0) {
+      suspects->push_back(b.block);
+      block_weight[static_cast<std::size_t>(b.block)] = limit / b.rms_pct;
+    }
+  }
+  if (suspects->empty()) return weight;
+  weight.resize(d.block.size());
+  for (std::size_t i = 0; i < d.block.size(); ++i)
+    weight[i] = block_weight[static_cast<std::size_t>(d.block[i])];
+  return weight;
+}
+
+/// The cross-validated score (as CandidateScore::score) of the chosen model trained on the
+/// weighted folds and tested on the unweighted held-out rows.
+double WeightedScore(const Layout& layout, const Folds& folds, const Folds& weighted,
+                     const std::vector<int>& cols, const FitResult& res, std::size_t rows) {
+  Eigen::Matrix<double, 6, 1> sse = Eigen::Matrix<double, 6, 1>::Zero();
+  for (int k = 0; k < folds.k; ++k) {
+    const Solved s = SolveWithoutFold(layout, weighted, cols, res.kind, res.lambda, k);
+    sse += HeldOutSse(folds.stats[static_cast<std::size_t>(k)], cols, s.beta);
+  }
+  double score = 0.0;
+  for (std::size_t a = 0; a < 6; ++a) {
+    score += sse(static_cast<Eigen::Index>(a)) / static_cast<double>(rows) /
+             std::pow(res.rated[a], 2) / 6.0;
+  }
+  return score;
 }
 
 /// Training residual σ, the parameter part of the uncertainty and the design's condition number.
@@ -362,15 +429,18 @@ void ToCalibration(const Layout& layout, const Folds& folds, const Reference& re
   }
   for (int c = 0; c < n; ++c) cal.offset_mvv[static_cast<std::size_t>(c)] = ref.offset(c);
   if (UsesQuad(res->kind)) {
-    cal.product_count = static_cast<std::uint8_t>(layout.pairs.size());
+    std::size_t used = 0;
     for (std::size_t k = 0; k < layout.pairs.size(); ++k) {
-      cal.products[k] = fw::ProductTerm{static_cast<std::uint8_t>(layout.pairs[k].first),
-                                        static_cast<std::uint8_t>(layout.pairs[k].second)};
+      const auto it = pos.find(layout.quad_start + static_cast<int>(k));
+      if (it == pos.end()) continue;  // a product the model does not use
+      cal.products[used] = fw::ProductTerm{static_cast<std::uint8_t>(layout.pairs[k].first),
+                                           static_cast<std::uint8_t>(layout.pairs[k].second)};
       for (int a = 0; a < 6; ++a) {
-        cal.product_matrix[static_cast<std::size_t>(a)][k] =
-            s.beta(pos.at(layout.quad_start + static_cast<int>(k)), a);
+        cal.product_matrix[static_cast<std::size_t>(a)][used] = s.beta(it->second, a);
       }
+      ++used;
     }
+    cal.product_count = static_cast<std::uint8_t>(used);
   }
   if (UsesTemp(res->kind)) {
     cal.temperature_compensated = true;
@@ -414,7 +484,7 @@ FitResult FitCalibration(const RigData& d, const FitOptions& options) {
   const Reference ref = FindReference(d, res.rated, want_temp);
 
   Folds folds;
-  AssignFolds(d, options.folds, &folds);
+  res.validation = AssignFolds(d, options, &folds);
   res.folds = folds.k;
   CentreFeatures(d, layout, ref, &folds);
   const FeatureBuilder builder(d, layout, ref.offset, ref.t_ref, folds.mu, folds.mu_y);
@@ -425,16 +495,44 @@ FitResult FitCalibration(const RigData& d, const FitOptions& options) {
   const CandidateScore& chosen = ChooseCandidate(res.candidates, options.simpler_tolerance);
   res.kind = chosen.kind;
   res.lambda = chosen.lambda;
+  res.lambda_at_bound =
+      chosen.lambda > 0 &&
+      chosen.lambda >= *std::max_element(options.lambdas.begin(), options.lambdas.end());
   res.heldout_rms_si = chosen.rms_si;
   const std::vector<int> cols = layout.Columns(res.kind);
-  HeldOutResiduals(builder, layout, folds, cols, rows, &res);
-  ScoreBlocks(d, &res);
+  HeldOutResiduals(builder, layout, folds, folds, cols, rows, &res);
+  res.blocks = ScoreUnits(d, d.block, d.block_count, res);
+  // Robust variant: suspect blocks down-weighted; kept only when it validates better.
+  const std::vector<double> weight = SuspectWeights(d, res.blocks, &res.suspect_blocks);
+  Folds weighted;
+  if (!weight.empty()) {
+    weighted.k = folds.k;
+    weighted.rows = folds.rows;
+    weighted.mu = folds.mu;
+    weighted.mu_y = folds.mu_y;
+    AccumulateFolds(builder, layout.total, rows, &weighted, &weight);
+    weighted.scale = folds.scale;
+    res.plain_score = chosen.score;
+    res.robust_score = WeightedScore(layout, folds, weighted, cols, res, rows);
+    res.robust = res.robust_score < res.plain_score;
+    if (res.robust) {
+      HeldOutResiduals(builder, layout, folds, weighted, cols, rows, &res);
+      for (std::size_t a = 0; a < 6; ++a) {
+        res.heldout_rms_si[a] =
+            std::sqrt(res.heldout_residual.col(static_cast<Eigen::Index>(a)).squaredNorm() / rows);
+      }
+      res.blocks = ScoreUnits(d, d.block, d.block_count, res);
+    }
+  }
+  const Folds& train = res.robust ? weighted : folds;
+  if (d.group.size() == d.block.size() && d.group_count > 0)
+    res.groups = ScoreUnits(d, d.group, d.group_count, res);
 
   // Final fit on all rows.
-  Solved s = Solve(folds.total, cols, folds.scale, res.lambda);
+  Solved s = Solve(train.total, cols, folds.scale, res.lambda);
   VectorXd alpha;
   VectorXd gamma;
-  if (UsesTemp(res.kind)) ProjectTemperature(layout, cols, folds.total, s.beta, &alpha, &gamma);
+  if (UsesTemp(res.kind)) ProjectTemperature(layout, cols, train.total, s.beta, &alpha, &gamma);
   FinalFitQuality(folds, cols, s, rows, &res);
   res.load_condition = LoadSetCondition(d.wrench, res.rated);
   ToCalibration(layout, folds, ref, cols, s, alpha, gamma, &res);

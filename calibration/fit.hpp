@@ -1,5 +1,5 @@
 // Fitting a calibration from rig data: affine, temperature and second-order models, chosen by
-// cross-validation over whole load blocks, with ridge regularisation.
+// cross-validation over whole load directions (or load blocks), with ridge regularisation.
 #pragma once
 
 #include <Eigen/Dense>
@@ -37,7 +37,23 @@ struct RigData {
   std::vector<int> block;   ///< block of every row, 0 … block_count − 1 (in order of first row)
   int block_count = 0;
   std::string block_method;  ///< how blocks were found ("column pose", "holds", "chunks")
+  /// Validation group of every row (0 … group_count − 1): what a new use differs in — the robot
+  /// orientation or load direction. Whole blocks always share a group.
+  std::vector<int> group;
+  int group_count = 0;
+  std::string group_method;  ///< "column group" or "load direction within 5°"
 };
+
+/// Groups blocks by the direction of their mean load: the force direction where the block's
+/// force is at least 10 % of the largest block force (a mass held in one orientation gives one
+/// direction whatever its size or lever), else the direction of the moment (each axis divided by
+/// its scale); unloaded blocks (every axis within 2 % of scale) form one group. Directions within
+/// `tolerance_deg` of a group's first block join it. Returns the group of every block.
+[[nodiscard]] std::vector<int> GroupBlocksByLoadDirection(const Eigen::MatrixXd& wrench,
+                                                          const std::vector<int>& block,
+                                                          int block_count,
+                                                          const std::array<double, 6>& scale,
+                                                          double tolerance_deg, int* group_count);
 
 /// Groups rows into blocks. A `block` or `pose` column wins (rows with equal values form one
 /// block, wherever they are); otherwise static holds are detected from the reference wrench
@@ -48,7 +64,9 @@ struct RigData {
                                             const BlockOptions& options, int* block_count,
                                             std::string* method);
 
-/// Reads the columns a fit needs (b0…, Fx…Mz, optional temp_C, block/pose) and finds blocks.
+/// Reads the columns a fit needs (b0…, Fx…Mz, optional temp_C, block/pose, group) and finds
+/// blocks and validation groups (a `group` column wins; otherwise GroupBlocksByLoadDirection
+/// with 5°; a block whose rows carry two group values is refused).
 /// Throws RecordingError naming the file when columns are missing or N is not 1 … 8.
 [[nodiscard]] RigData RigDataFromRecording(const Recording& rec, const BlockOptions& options);
 
@@ -58,16 +76,23 @@ enum class ModelKind {
   kLinearTemp,     ///< affine + per-channel bias and gain slopes against temperature
   kQuadratic,      ///< affine + all products of two channels
   kQuadraticTemp,  ///< both
+  kQuadraticDiag,  ///< affine + the square of every channel (no cross products)
 };
 [[nodiscard]] const char* ToString(ModelKind kind);
-/// "linear", "linear-temp", "quadratic", "quadratic-temp"; nullopt otherwise.
+/// "linear", "linear-temp", "quadratic", "quadratic-temp", "quadratic-diag"; nullopt otherwise.
 [[nodiscard]] std::optional<ModelKind> ParseModelKind(const std::string& name);
 
 struct FitOptions {
   std::vector<ModelKind> models;  ///< candidates; empty → every model the data supports
   /// Ridge strengths tried, relative to the standardised features (0 = plain least squares).
-  std::vector<double> lambdas = {0.0, 1e-9, 1e-7, 1e-5, 1e-3, 1e-1};
-  int folds = 10;                 ///< cross-validation folds (whole blocks), ≤ number of blocks
+  std::vector<double> lambdas = {0.0,  1e-9, 1e-7, 1e-5, 1e-4, 1e-3,
+                                 3e-3, 0.01, 0.03, 0.1,  0.3,  1.0};
+  /// Cross-validation folds, ≤ number of validation units. Unit g goes to fold g mod folds, so
+  /// with no more units than folds every unit is held out alone.
+  int folds = 10;
+  /// Hold out whole validation groups (load directions; the default when there are at least
+  /// three), or whole blocks (holds).
+  bool by_group = true;
   std::array<double, 6> rated{};  ///< rated range per axis; 0 → the largest |load| in the data
   /// The model with the fewest coefficients whose score is within this fraction of the best one
   /// wins (with its own best λ): a simpler model is preferred when it generalises as well.
@@ -83,9 +108,9 @@ struct CandidateScore {
   std::array<double, 6> rms_si{};  ///< held-out RMS per axis, N and N·m
 };
 
-/// Held-out error of one block under the chosen model.
+/// Held-out error of one block (or validation group) under the chosen model.
 struct BlockScore {
-  int block = 0;
+  int block = 0;  ///< block or group index
   std::size_t rows = 0;
   double t_start_s = 0.0;
   double t_end_s = 0.0;
@@ -98,6 +123,8 @@ struct FitResult {
   ModelKind kind = ModelKind::kLinear;
   double lambda = 0.0;
   int folds = 0;
+  std::string validation;        ///< what was held out: "12 groups (load direction within 5°)"
+  bool lambda_at_bound = false;  ///< λ is the largest tried: the penalty is not resolved
   std::size_t rows = 0;
   int block_count = 0;
   std::string block_method;
@@ -111,6 +138,13 @@ struct FitResult {
   std::vector<CandidateScore> candidates;
   Eigen::MatrixXd heldout_residual;  ///< rows × 6: prediction − reference, held-out
   std::vector<BlockScore> blocks;    ///< worst first
+  std::vector<BlockScore> groups;    ///< held-out error per validation group, worst first
+  /// Blocks whose held-out error is an outlier (over 3.5 robust σ above the median block):
+  /// reported, and down-weighted in the robust variant.
+  std::vector<int> suspect_blocks;
+  bool robust = false;        ///< the robust variant validated better and was used
+  double plain_score = 0.0;   ///< cross-validated score without / with the down-weighting
+  double robust_score = 0.0;  ///< (0 when no block is suspect)
 };
 
 /// Fits and cross-validates. Throws std::invalid_argument when the data cannot support a fit

@@ -179,6 +179,12 @@ CalFile CalFileFromFit(const FitResult& fit, const hal::AdcInfo& adc, const std:
                     {"rows", fit.rows},
                     {"blocks", fit.block_count},
                     {"block_method", fit.block_method},
+                    {"validation", fit.validation},
+                    {"suspect_blocks", fit.suspect_blocks},
+                    {"robust", fit.robust},
+                    {"lambda_at_bound", fit.lambda_at_bound},
+                    {"worst_group", fit.groups.empty() ? -1 : fit.groups.front().block},
+                    {"worst_group_rms_pct", fit.groups.empty() ? 0.0 : fit.groups.front().rms_pct},
                     {"heldout_rms", fit.heldout_rms_si},
                     {"heldout_p95", fit.heldout_p95_si},
                     {"fit_uncertainty", fit.fit_uncertainty_si},
@@ -190,8 +196,10 @@ CalFile CalFileFromFit(const FitResult& fit, const hal::AdcInfo& adc, const std:
 std::string FitSummary(const FitResult& fit, const fw::LoadReport& fixed) {
   std::ostringstream o;
   o << "model: " << ToString(fit.kind) << ", ridge lambda " << Fmt("%g", fit.lambda)
-    << " (chosen by " << fit.folds << "-fold cross-validation over " << fit.block_count
-    << " load blocks [" << fit.block_method << "], " << fit.rows << " rows)\n";
+    << " (chosen by " << fit.folds << "-fold cross-validation holding out whole " << fit.validation
+    << ", " << fit.rows << " rows)\n";
+  if (fit.lambda_at_bound)
+    o << "warning: lambda is the largest tried; the penalty is not resolved by the data\n";
   o << "condition number: load set " << Fmt("%.3g", fit.load_condition) << ", design "
     << Fmt("%.3g", fit.design_condition) << "\n";
   o << "axis   rated        held-out RMS        held-out 95%        fit unc.    fixed-pt worst\n";
@@ -209,6 +217,19 @@ std::string FitSummary(const FitResult& fit, const fw::LoadReport& fixed) {
   for (const CandidateScore& c : fit.candidates) {
     o << "  " << ToString(c.kind) << " lambda=" << Fmt("%g", c.lambda) << " features=" << c.features
       << " score=" << Fmt("%.4g", c.score) << "\n";
+  }
+  if (!fit.groups.empty()) {
+    o << "held-out RMS per group (% of rated), worst first:";
+    for (const BlockScore& g : fit.groups) {
+      o << " g" << g.block << " " << Fmt("%.3g%%", g.rms_pct) << ";";
+    }
+    o << "\n";
+  }
+  if (!fit.suspect_blocks.empty()) {
+    o << "suspect blocks (held-out error an outlier: recorded badly?):";
+    for (const int b : fit.suspect_blocks) o << " #" << b;
+    o << "; down-weighted fit " << (fit.robust ? "used" : "not used") << " (score "
+      << Fmt("%.4g", fit.robust_score) << " against " << Fmt("%.4g", fit.plain_score) << ")\n";
   }
   o << "worst blocks (RMS % of rated):";
   for (std::size_t i = 0; i < std::min<std::size_t>(5, fit.blocks.size()); ++i) {
@@ -235,9 +256,10 @@ void WriteFitReport(const std::string& path, const FitResult& fit, const RigData
       << "text-align:right}th{background:#eee}.plots svg{margin:4px}</style></head><body>";
   out << "<h1>Calibration fit: " << Escape(title) << "</h1>";
   out << "<p>Model <b>" << ToString(fit.kind) << "</b>, ridge &lambda; = " << Fmt("%g", fit.lambda)
-      << ", chosen by " << fit.folds << "-fold cross-validation holding out whole load blocks ("
-      << fit.block_count << " blocks found by " << Escape(fit.block_method) << ", " << fit.rows
-      << " rows). Errors below are on <b>held-out</b> blocks only.</p>";
+      << ", chosen by " << fit.folds << "-fold cross-validation holding out whole "
+      << Escape(fit.validation) << " (" << fit.block_count << " blocks found by "
+      << Escape(fit.block_method) << ", " << fit.rows
+      << " rows). Errors below are on <b>held-out</b> rows only.</p>";
   out << "<p>Condition number of the load set: <b>" << Fmt("%.3g", fit.load_condition)
       << "</b>; of the chosen model's standardised design: <b>" << Fmt("%.3g", fit.design_condition)
       << "</b>.</p>";
@@ -260,19 +282,34 @@ void WriteFitReport(const std::string& path, const FitResult& fit, const RigData
       << "<div class='plots'>";
   for (int c = 0; c < 6; ++c) out << ResidualPlot(fit, d, c);
   out << "</div>";
-  out << "<h2>Worst blocks</h2><table><tr><th>block</th><th>t start (s)</th><th>t end (s)</th>"
-      << "<th>rows</th><th>RMS error, % rated</th>";
-  for (const char* a : kAxes) out << "<th>mean " << a << "</th>";
-  out << "</tr>";
-  for (std::size_t i = 0; i < std::min<std::size_t>(10, fit.blocks.size()); ++i) {
-    const BlockScore& b = fit.blocks[i];
-    out << "<tr><td>" << b.block << "</td><td>" << Fmt("%.3f", b.t_start_s) << "</td><td>"
-        << Fmt("%.3f", b.t_end_s) << "</td><td>" << b.rows << "</td><td>" << Fmt("%.4f", b.rms_pct)
-        << "</td>";
-    for (double w : b.mean_wrench) out << "<td>" << Fmt("%.4g", w) << "</td>";
+  // Held-out error per unit (validation group or block), worst first.
+  const auto unit_table = [&](const char* heading, const char* unit,
+                              const std::vector<BlockScore>& scores, std::size_t limit) {
+    out << "<h2>" << heading << "</h2><table><tr><th>" << unit
+        << "</th><th>t start (s)</th><th>t end (s)</th><th>rows</th><th>RMS error, % rated</th>";
+    for (const char* a : kAxes) out << "<th>mean " << a << "</th>";
     out << "</tr>";
+    for (std::size_t i = 0; i < std::min(limit, scores.size()); ++i) {
+      const BlockScore& b = scores[i];
+      out << "<tr><td>" << b.block << "</td><td>" << Fmt("%.3f", b.t_start_s) << "</td><td>"
+          << Fmt("%.3f", b.t_end_s) << "</td><td>" << b.rows << "</td><td>"
+          << Fmt("%.4f", b.rms_pct) << "</td>";
+      for (double w : b.mean_wrench) out << "<td>" << Fmt("%.4g", w) << "</td>";
+      out << "</tr>";
+    }
+    out << "</table>";
+  };
+  if (!fit.groups.empty()) {
+    unit_table("Held-out error per validation group", "group", fit.groups, fit.groups.size());
   }
-  out << "</table><h2>Candidates</h2><table><tr><th>model</th><th>&lambda;</th><th>features</th>"
+  unit_table("Worst blocks", "block", fit.blocks, 10);
+  if (!fit.suspect_blocks.empty()) {
+    out << "<p>Suspect blocks (held-out error over 3.5 robust &sigma; above the median block): ";
+    for (const int b : fit.suspect_blocks) out << b << " ";
+    out << "&mdash; down-weighted fit " << (fit.robust ? "used" : "not used (validated worse)")
+        << ".</p>";
+  }
+  out << "<h2>Candidates</h2><table><tr><th>model</th><th>&lambda;</th><th>features</th>"
       << "<th>score</th>";
   for (const char* a : kAxes) out << "<th>RMS " << a << "</th>";
   out << "</tr>";

@@ -44,8 +44,9 @@ struct Layout {
     if (t) {
       for (int i = 0; i <= n; ++i) cols.push_back(temp_start + i);
     }
-    if (q) {
-      for (std::size_t i = 0; i < pairs.size(); ++i)
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      const bool square = pairs[i].first == pairs[i].second;
+      if (q || (kind == ModelKind::kQuadraticDiag && square))
         cols.push_back(quad_start + static_cast<int>(i));
     }
     return cols;
@@ -69,7 +70,8 @@ inline bool UsesTemp(ModelKind k) {
   return k == ModelKind::kLinearTemp || k == ModelKind::kQuadraticTemp;
 }
 inline bool UsesQuad(ModelKind k) {
-  return k == ModelKind::kQuadratic || k == ModelKind::kQuadraticTemp;
+  return k == ModelKind::kQuadratic || k == ModelKind::kQuadraticTemp ||
+         k == ModelKind::kQuadraticDiag;
 }
 
 /// Sufficient statistics of one fold, features centred by the global means (column 0 stays 1).

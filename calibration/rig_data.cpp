@@ -94,6 +94,110 @@ std::vector<int> DetectBlocks(const Eigen::MatrixXd& wrench, const BlockOptions&
   return block;
 }
 
+std::vector<int> GroupBlocksByLoadDirection(const Eigen::MatrixXd& wrench,
+                                            const std::vector<int>& block, int block_count,
+                                            const std::array<double, 6>& scale,
+                                            double tolerance_deg, int* group_count) {
+  const auto nb = static_cast<Eigen::Index>(block_count);
+  Eigen::MatrixXd mean = Eigen::MatrixXd::Zero(nb, 6);
+  Eigen::VectorXd count = Eigen::VectorXd::Zero(nb);
+  for (std::size_t i = 0; i < block.size(); ++i) {
+    mean.row(block[i]) += wrench.row(static_cast<Eigen::Index>(i));
+    count(block[i]) += 1.0;
+  }
+  for (Eigen::Index b = 0; b < nb; ++b) mean.row(b) /= std::max(1.0, count(b));
+  double max_force = 0.0;
+  for (Eigen::Index b = 0; b < nb; ++b)
+    max_force = std::max(max_force, mean.row(b).head<3>().norm());
+  const double cos_tol = std::cos(tolerance_deg * 3.14159265358979323846 / 180.0);
+  std::vector<Eigen::Matrix<double, 6, 1>> firsts;  // unit direction of each group's first block
+  std::vector<int> group(static_cast<std::size_t>(block_count), -1);
+  int unloaded = -1;
+  for (Eigen::Index b = 0; b < nb; ++b) {
+    Eigen::Matrix<double, 6, 1> u = Eigen::Matrix<double, 6, 1>::Zero();
+    bool loaded = false;
+    for (int a = 0; a < 6; ++a) {
+      const double s =
+          scale[static_cast<std::size_t>(a)] > 0 ? scale[static_cast<std::size_t>(a)] : 1.0;
+      loaded = loaded || std::fabs(mean(b, a)) > 0.02 * s;
+      if (a >= 3) u(a) = mean(b, a) / s;
+    }
+    if (!loaded) {
+      if (unloaded < 0) {
+        unloaded = static_cast<int>(firsts.size());
+        firsts.emplace_back(u);
+      }
+      group[static_cast<std::size_t>(b)] = unloaded;
+      continue;
+    }
+    const double force = mean.row(b).head<3>().norm();
+    if (force >= 0.1 * max_force && force > 0) {  // the force's direction alone
+      u.setZero();
+      u.head<3>() = mean.row(b).head<3>().transpose();
+    }
+    u.normalize();
+    int g = -1;
+    for (std::size_t k = 0; k < firsts.size() && g < 0; ++k) {
+      if (static_cast<int>(k) != unloaded && firsts[k].dot(u) >= cos_tol) g = static_cast<int>(k);
+    }
+    if (g < 0) {
+      g = static_cast<int>(firsts.size());
+      firsts.push_back(u);
+    }
+    group[static_cast<std::size_t>(b)] = g;
+  }
+  *group_count = static_cast<int>(firsts.size());
+  return group;
+}
+
+namespace {
+
+/// Numbers the distinct values of a column in order of first row.
+std::vector<int> NumberValues(const std::vector<double>& col, int* count) {
+  std::map<double, int> ids;
+  std::vector<int> out(col.size());
+  for (std::size_t i = 0; i < col.size(); ++i) {
+    auto it = ids.find(col[i]);
+    if (it == ids.end()) it = ids.emplace(col[i], static_cast<int>(ids.size())).first;
+    out[i] = it->second;
+  }
+  *count = static_cast<int>(ids.size());
+  return out;
+}
+
+/// Validation groups: a `group` column, else the load direction of each block.
+void FindGroups(const Recording& rec, const BlockOptions& options, RigData* d) {
+  if (rec.Has("group")) {
+    d->group = NumberValues(rec.Column("group"), &d->group_count);
+    d->group_method = "column group";
+    std::vector<int> of_block(static_cast<std::size_t>(d->block_count), -1);
+    for (std::size_t i = 0; i < d->group.size(); ++i) {
+      int& g = of_block[static_cast<std::size_t>(d->block[i])];
+      if (g >= 0 && g != d->group[i]) {
+        throw RecordingError(rec.path + ":" +
+                             std::to_string(i < rec.data_lines.size() ? rec.data_lines[i] : i + 1) +
+                             ": column group changes inside a load block; a block (pose or hold) "
+                             "must lie in one group");
+      }
+      g = d->group[i];
+    }
+    return;
+  }
+  std::array<double, 6> scale = options.scale;
+  for (int a = 0; a < 6; ++a) {
+    auto& s = scale[static_cast<std::size_t>(a)];
+    if (!(s > 0)) s = d->wrench.col(a).cwiseAbs().maxCoeff();
+  }
+  const std::vector<int> of_block =
+      GroupBlocksByLoadDirection(d->wrench, d->block, d->block_count, scale, 5.0, &d->group_count);
+  d->group.resize(d->block.size());
+  for (std::size_t i = 0; i < d->block.size(); ++i)
+    d->group[i] = of_block[static_cast<std::size_t>(d->block[i])];
+  d->group_method = "load direction within 5°";
+}
+
+}  // namespace
+
 RigData RigDataFromRecording(const Recording& rec, const BlockOptions& options) {
   RigData d;
   d.path = rec.path;
@@ -129,19 +233,12 @@ RigData RigDataFromRecording(const Recording& rec, const BlockOptions& options) 
   }
   const char* label = rec.Has("block") ? "block" : rec.Has("pose") ? "pose" : nullptr;
   if (label != nullptr) {
-    const auto& col = rec.Column(label);
-    std::map<double, int> ids;
-    d.block.resize(rows);
-    for (std::size_t i = 0; i < rows; ++i) {
-      auto it = ids.find(col[i]);
-      if (it == ids.end()) it = ids.emplace(col[i], static_cast<int>(ids.size())).first;
-      d.block[i] = it->second;
-    }
-    d.block_count = static_cast<int>(ids.size());
+    d.block = NumberValues(rec.Column(label), &d.block_count);
     d.block_method = std::string("column ") + label;
   } else {
     d.block = DetectBlocks(d.wrench, options, &d.block_count, &d.block_method);
   }
+  FindGroups(rec, options, &d);
   return d;
 }
 

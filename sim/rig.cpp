@@ -162,4 +162,30 @@ std::vector<Wrench> RigLoads(const std::vector<RigStep>& steps) {
   return loads;
 }
 
+std::string RigStepTable(const std::vector<RigStep>& steps) {
+  std::string out;
+  char line[256];
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const Wrench& w = steps[i].wrench;
+    std::snprintf(line, sizeof line, "%4zu  %-28s  %8.2f %8.2f %8.2f %7.3f %7.3f %7.3f  %5.1f C\n",
+                  i, steps[i].label.c_str(), w(0), w(1), w(2), w(3), w(4), w(5),
+                  steps[i].temperature_c);
+    out += line;
+  }
+  return out;
+}
+
+Recording RigProfileRecording(const std::vector<ProfileWrench::Key>& keys) {
+  Recording prof;
+  prof.names = {"t", "Fx", "Fy", "Fz", "Mx", "My", "Mz", "temp_C"};
+  prof.columns.resize(8);
+  for (const auto& k : keys) {
+    prof.columns[0].push_back(k.t_s);
+    for (int a = 0; a < 6; ++a) prof.columns[static_cast<std::size_t>(1 + a)].push_back(k.w(a));
+    prof.columns[7].push_back(k.temperature_c);
+  }
+  prof.metadata.push_back("source: ftcal design");
+  return prof;
+}
+
 }  // namespace ftstack::sim

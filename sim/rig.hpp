@@ -42,6 +42,12 @@ struct RigStep {
 [[nodiscard]] std::vector<ProfileWrench::Key> RigKeys(const std::vector<RigStep>& steps,
                                                       const RigDesignOptions& options);
 
+/// One line per step (index, label, wrench, temperature), as `ftcal design` prints it.
+[[nodiscard]] std::string RigStepTable(const std::vector<RigStep>& steps);
+
+/// The keyframes as a profile recording: t, Fx…Mz, temp_C (what `ftsim record --profile` reads).
+[[nodiscard]] Recording RigProfileRecording(const std::vector<ProfileWrench::Key>& keys);
+
 /// Runs the keyframes through the sensor: SimulatedSensor → hal::sim::SimAdc (its noise,
 /// resolution and seed) → counts → mV/V. Columns t, Fx…Mz (the applied reference), b0…, temp_C,
 /// and `pose` (index of the step being held or approached) when `with_pose`.

@@ -214,7 +214,8 @@ TEST_F(FtcalCli, RecordingsFromFtsimWithEffectsPickTheRightModelAtTheNoiseFloor)
     std::string model;
   };
   const Scenario scenarios[] = {
-      {"--profile rig --effect bridge_nonlinearity:channels=[0,3] --seed 3", "quadratic"},
+      // A nonlinearity of each bridge alone: its square, no cross products.
+      {"--profile rig --effect bridge_nonlinearity:channels=[0,3] --seed 3", "quadratic-diag"},
       {"--profile thermal --effect thermal_zero_drift --effect thermal_span_drift --seed 4",
        "linear-temp"},
   };
