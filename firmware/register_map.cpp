@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "firmware/fixed_point.hpp"
+#include "firmware/health_registers.hpp"
 
 namespace ftstack::fw {
 namespace {
@@ -27,7 +28,12 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 /// Holding registers 5 … 9 and 29: reserved. They read 0 and accept 0 (so that a PLC's block
 /// read or write of 0 … 29 works); any other value is refused with 03.
 [[nodiscard]] bool HoldingReserved(std::uint32_t a) {
-  return (a > kHoldUnlock && a < kHoldTransform) || a == kHoldReserved29;
+  return (a > kHoldUnlock && a < kHoldTransform) || a == kHoldReserved29 ||
+         (a >= kHoldReserved42 && a < kHoldHealthCommand);
+}
+
+[[nodiscard]] bool HoldingHealth(std::uint32_t a) {
+  return a >= kHoldHealthCommand && a < kHoldHealthEnd;
 }
 
 [[nodiscard]] bool InGravity(std::uint32_t a) { return a >= kHoldGravity && a < kHoldGravity + 6u; }
@@ -111,6 +117,7 @@ void BuildInputRegisters(const DeviceSample& d, const hal::AdcInfo& adc, std::ui
   PackFloat32(static_cast<float>(static_cast<double>(d.payload_mass_ug) * 1e-9),
               &r[kInPayloadMass]);
   PackU32(d.payload_crc, &r[kInPayloadCrc]);
+  BuildHealthInputRegisters(d, &r[kInHealthFirst]);
 }
 
 RegisterMap::RegisterMap(Device& device) : device_(device), settings_(device.initial_settings()) {}
@@ -176,7 +183,9 @@ ModbusException RegisterMap::ReadHolding(std::uint16_t addr, std::uint16_t count
         v = settings_.gravity_comp ? 1 : 0;
         break;
       default:
-        if (HoldingReserved(a)) {
+        if (HoldingHealth(a)) {
+          v = ReadHealthHolding(settings_, a);
+        } else if (HoldingReserved(a)) {
           v = 0;
         } else if (InGravity(a)) {
           v = gravity_regs_[a - kHoldGravity];
@@ -248,7 +257,11 @@ ModbusException RegisterMap::WriteHolding(std::uint16_t addr, const std::uint16_
         }
         next.gravity_comp = v == 1;
         break;
-      default:  // 5 … 9, 29 reserved, 10 … 21 tool transform, 22 … 27 gravity, 30 … 41 mount
+      default:  // reserved, 10 … 21 tool transform, 22 … 27 gravity, 30 … 41 mount, 50 … 79 health
+        if (HoldingHealth(a)) {  // not protected: thresholds and commissioning are the PLC's
+          if (!WriteHealthHolding(a, v, &next)) return ModbusException::kIllegalDataValue;
+          break;
+        }
         if (HoldingReserved(a)) {
           if (v != 0) return ModbusException::kIllegalDataValue;
           break;

@@ -1,4 +1,4 @@
-// The Modbus register map, version 2 (docs/spec/modbus-map.md): input image, holding registers.
+// The Modbus register map, version 3 (docs/spec/modbus-map.md): input image, holding registers.
 #pragma once
 
 #include <array>
@@ -9,10 +9,14 @@
 
 namespace ftstack::fw {
 
-inline constexpr std::uint16_t kMapVersion = 2;
-inline constexpr std::uint16_t kInputRegisterCount = 85;  ///< input registers 0 … 84
-/// Holding 0 … 41: 5 … 9 and 29 reserved.
-inline constexpr std::uint16_t kHoldingRegisterSpan = 42;
+inline constexpr std::uint16_t kMapVersion = 3;
+/// Input registers 0 … 199: 81 … 99 reserved, 100 … 199 the health watch (health_registers.hpp).
+inline constexpr std::uint16_t kInputRegisterCount = 200;
+/// Input registers 0 … 84, map version 2's image: one read covers it (a Modbus read carries at
+/// most 125 registers; the whole v3 image takes two).
+inline constexpr std::uint16_t kInputRegistersV2 = 85;
+/// Holding 0 … 79: 5 … 9, 29 and 42 … 49 reserved; 50 … 79 the health watch.
+inline constexpr std::uint16_t kHoldingRegisterSpan = 80;
 
 /// Input register addresses (0-based protocol addresses).
 enum InputRegister : std::uint16_t {
@@ -35,6 +39,7 @@ enum InputRegister : std::uint16_t {
   kInPayloadMass = 77,     ///< float32 kg, payload of gravity compensation (0: none). Map v2
   kInPayloadCrc = 79,      ///< uint32, CRC-32 of the payload file (0: none). Map v2
   kInReserved81 = 81,      ///< 81 … 84 reserved, read 0. Map v2
+  kInReserved85 = 85,      ///< 85 … 99 reserved, read 0. Map v3
 };
 
 /// Holding register addresses.
@@ -49,6 +54,7 @@ enum HoldingRegister : std::uint16_t {
   kHoldGravityComp = 28,  ///< 0 off, 1 on (needs a payload). Map v2
   kHoldReserved29 = 29,   ///< reserved, reads 0. Map v2
   kHoldMount = 30,  ///< float32 × 6 mount transform (same layout), protected, 30 … 41. Map v2
+  kHoldReserved42 = 42,  ///< 42 … 49 reserved, read 0. Map v3
 };
 
 /// Values of the command register.
@@ -91,14 +97,16 @@ class RegisterMap {
  public:
   explicit RegisterMap(Device& device);
 
-  /// Function 04. 02 when [addr, addr+count) leaves 0 … 84; reserved 81 … 84 read 0.
+  /// Function 04. 02 when [addr, addr+count) leaves 0 … 199; reserved 81 … 99, 190 … 199 read 0.
   [[nodiscard]] ModbusException ReadInput(std::uint16_t addr, std::uint16_t count,
                                           std::uint16_t* out);
-  /// Function 03. 02 when any address is outside 0 … 41; reserved 5 … 9 and 29 read 0.
+  /// Function 03. 02 when any address is outside 0 … 79; reserved 5 … 9, 29, 42 … 49 and 60 … 79
+  /// read 0.
   [[nodiscard]] ModbusException ReadHolding(std::uint16_t addr, std::uint16_t count,
                                             std::uint16_t* out);
   /// Functions 06 and 16. 02 for an address outside the map; 03 for a value out of range, an
-  /// unknown command, a non-zero value in a reserved register (5–9, 29), a protected register (3,
+  /// unknown command, a non-zero value in a reserved register (5–9, 29, 42–49, 60–79), a health
+  /// threshold (51–59) outside its range, a protected register (3,
   /// 10–21, 30–41) while locked, a write covering only one half of a float (10–27, 30–41), a
   /// gravity component that is not finite or beyond ±20 m/s², or gravity compensation on (28 = 1)
   /// without a payload. On any exception nothing changes.

@@ -311,7 +311,7 @@ TEST_F(RegisterMapTest, InputImageCarriesOneSampleInTheSpecifiedLayout) {
   adc_.counts = {400000, -300000, 1000000, 50000, -60000, 70000};
   Step(3);
   const auto r = Input();
-  EXPECT_EQ(r[kInMapVersion], 2);
+  EXPECT_EQ(r[kInMapVersion], 3);
   EXPECT_EQ(r[kInStatus], 0);  // real (fake) hardware, calibrated, no faults
   EXPECT_EQ(UnpackU32(&r[kInSequence]), 3u);
   EXPECT_EQ(UnpackU32(&r[kInTimestampUs]), 2000u);
@@ -351,8 +351,9 @@ TEST_F(RegisterMapTest, AddressesOutsideTheMapGiveException02) {
   StartDevice();
   std::array<std::uint16_t, 125> buf{};
   EXPECT_EQ(map_->ReadInput(84, 1, buf.data()), ModbusException::kNone);
-  EXPECT_EQ(map_->ReadInput(84, 2, buf.data()), ModbusException::kIllegalDataAddress);
-  EXPECT_EQ(map_->ReadInput(85, 1, buf.data()), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(map_->ReadInput(199, 1, buf.data()), ModbusException::kNone);  // map v3: 0 … 199
+  EXPECT_EQ(map_->ReadInput(199, 2, buf.data()), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(map_->ReadInput(200, 1, buf.data()), ModbusException::kIllegalDataAddress);
   EXPECT_EQ(map_->ReadHolding(0, 5, buf.data()), ModbusException::kNone);
   EXPECT_EQ(map_->ReadHolding(10, 12, buf.data()), ModbusException::kNone);
   // 5 … 9 are reserved, not a hole: a PLC's block read of 0 … 15 or 0 … 21 works.
@@ -364,9 +365,9 @@ TEST_F(RegisterMapTest, AddressesOutsideTheMapGiveException02) {
     EXPECT_EQ(Write(a, {1}), ModbusException::kIllegalDataValue);
     EXPECT_EQ(Write(a, {0}), ModbusException::kNone);
   }
-  EXPECT_EQ(map_->ReadHolding(0, 42, buf.data()), ModbusException::kNone);  // map v2: 0 … 41
-  EXPECT_EQ(map_->ReadHolding(41, 2, buf.data()), ModbusException::kIllegalDataAddress);
-  EXPECT_EQ(Write(42, {0}), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(map_->ReadHolding(0, 80, buf.data()), ModbusException::kNone);  // map v3: 0 … 79
+  EXPECT_EQ(map_->ReadHolding(79, 2, buf.data()), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(Write(80, {0}), ModbusException::kIllegalDataAddress);
   EXPECT_EQ(Write(65535, {0}), ModbusException::kIllegalDataAddress);
 }
 

@@ -220,6 +220,10 @@ const std::vector<UnitRule>& UnitRules() {
                                               {"kg", "_kg", "kg"},
                                               {"m/s²", "_mps2", "m/s²"},
                                               {"samples", "", "samples"},
+                                              {"%", "_pct", "%"},
+                                              {"%/K", "_pct_per_k", "%/K"},
+                                              {"Hz", "_hz", "Hz"},
+                                              {"s", "_s", "s"},
                                               {"", "", ""}};
   return rules;
 }
@@ -234,7 +238,7 @@ struct Expected {
 std::map<std::string, Expected> ReferenceInputValues(
     const std::array<std::int32_t, hal::kMaxChannels>& counts, const LoadReport& report) {
   std::map<std::string, Expected> e;
-  e["map_version"] = {2, 0, "uint16"};
+  e["map_version"] = {3, 0, "uint16"};
   e["status"] = {0, 0, "uint16"};
   e["sequence"] = {3, 0, "uint32"};
   e["timestamp_us"] = {0.002, 1e-12, "uint32"};  // third sample at 1 kHz, in s after scaling
@@ -260,7 +264,28 @@ std::map<std::string, Expected> ReferenceInputValues(
   e["timestamp_wraps"] = {0, 0, "uint16"};
   e["payload_mass_kg"] = {2.375, 2.375 * 6e-8, "float32"};  // the payload CodeCheck loads
   e["payload_crc32"] = {static_cast<double>(0x0BADC0DEu), 0, "uint32"};
-  for (int a = 81; a <= 84; ++a) e["reserved_" + std::to_string(a)] = {0, 0, "uint16"};
+  for (int a = 81; a <= 99; ++a) e["reserved_" + std::to_string(a)] = {0, 0, "uint16"};
+  for (int a = 190; a <= 199; ++a) e["reserved_" + std::to_string(a)] = {0, 0, "uint16"};
+  // The health watch three samples after start (the fixture has a rated range: it runs): normal,
+  // nothing found, nothing measured yet.
+  for (const char* tag :
+       {"health_state", "health_findings", "retare_suggested", "retare_reason", "finding1_cause",
+        "finding2_cause", "finding3_cause", "finding4_cause", "tare_count"}) {
+    e[tag] = {0, 0, "uint16"};
+  }
+  e["health_watch_on"] = {1, 0, "uint16"};
+  for (const char* tag : {"zero_points", "tare_age_s"}) e[tag] = {0, 0, "uint32"};
+  for (const char* tag : {"thermal_zero_pct_per_k", "mains50_pct", "mains60_pct", "noise_ratio",
+                          "ring_hz", "ring_ref_hz", "creep_pct", "tare_temp_c"}) {
+    e[tag] = {0, 0, "float32"};
+  }
+  for (std::size_t a = 0; a < 6; ++a) {
+    const std::string axis = std::string(axes[a]) + (a < 3 ? "_n" : "_nm");
+    e["zero_" + axis] = {0, 0, "float32"};
+    for (int k = 1; k <= 4; ++k) {
+      e["finding" + std::to_string(k) + "_err_" + axis] = {0, 0, "float32"};
+    }
+  }
   return e;
 }
 
@@ -364,7 +389,7 @@ class CodeCheck : public maptest::RegisterMapTest {
       if (t.table != "holding") continue;
       for (int i = 0; i < t.registers; ++i) covered.insert(t.address + i);
     }
-    for (int a = 0; a < 50; ++a) {
+    for (int a = 0; a < 100; ++a) {
       std::uint16_t v = 0;
       const bool readable =
           map_->ReadHolding(static_cast<std::uint16_t>(a), 1, &v) == ModbusException::kNone;
@@ -416,7 +441,7 @@ class CodeCheck : public maptest::RegisterMapTest {
       Unlock();
       if (WriteValue(t, v) != ModbusException::kNone) {
         d->push_back(t.tag + ": " + std::to_string(v) + " (in range) refused");
-      } else if (t.tag != "command" && t.tag != "unlock" &&
+      } else if (t.tag != "command" && t.tag != "unlock" && t.tag != "health_command" &&
                  std::fabs(ReadValue(t) - v) > std::fabs(v) * 1e-6) {
         d->push_back(t.tag + ": " + std::to_string(v) + " written, " +
                      std::to_string(ReadValue(t)) + " read back");
@@ -449,7 +474,8 @@ TEST(RegisterMapTable, MarkdownAndCsvListTheSameTags) {
   const auto md = ParseMarkdown(ReadText("docs/spec/modbus-map.md"), &errors);
   const auto csv = ParseCsv(ReadText("docs/spec/modbus-map.csv"), &errors);
   EXPECT_TRUE(errors.empty()) << Join(errors);
-  EXPECT_EQ(md.size(), 74u);  // 47 input tags, 27 holding tags (16 + 5 gravity + 6 mount)
+  // 47 + 75 input tags (map v3: health), 27 + 38 holding tags (16 + 5 gravity + 6 mount; health)
+  EXPECT_EQ(md.size(), 187u);
   const auto diffs = CompareTables(md, csv);
   EXPECT_TRUE(diffs.empty()) << Join(diffs);
 }

@@ -215,8 +215,8 @@ TEST(FtdClients, RtuOverPtyPairServesTheMapAndSurvivesGarbage) {
   modbus_set_response_timeout(c, 1, 0);
   ASSERT_EQ(modbus_connect(c), 0);
   std::uint16_t r[fw::kInputRegisterCount] = {};
-  ASSERT_EQ(modbus_read_input_registers(c, 0, fw::kInputRegisterCount, r), fw::kInputRegisterCount);
-  EXPECT_EQ(r[fw::kInMapVersion], 2);  // docs/spec/modbus-map.md
+  ASSERT_EQ(modbus_read_input_registers(c, 0, fw::kInputRegistersV2, r), fw::kInputRegistersV2);
+  EXPECT_EQ(r[fw::kInMapVersion], 3);  // docs/spec/modbus-map.md
   EXPECT_EQ(r[fw::kInBridgeCount], 6);
   for (std::size_t a = 0; a < 6; ++a) {
     EXPECT_NEAR(fw::UnpackFloat32(&r[fw::kInWrenchFloat + 2 * a]), applied[a], 5 * sigma[a] + 1e-3)
@@ -264,7 +264,7 @@ TEST(FtdClients, RtuOverPtyPairServesTheMapAndSurvivesGarbage) {
     std::this_thread::sleep_for(std::chrono::milliseconds(250));  // > the slave's byte timeout
     modbus_flush(c);
     ASSERT_EQ(modbus_read_input_registers(c, 0, 2, r), 2) << "burst " << burst;
-    EXPECT_EQ(r[0], 2);  // map version
+    EXPECT_EQ(r[0], 3);  // map version
   }
   modbus_close(c);
   modbus_free(c);

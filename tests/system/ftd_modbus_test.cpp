@@ -125,7 +125,7 @@ TEST(FtdModbus, SimulatedWrenchArrivesWithinDerivedToleranceAndTareZeroes) {
 
   std::array<std::uint16_t, 30> r{};
   ASSERT_EQ(c.Input(0, 30, r.data()), 30);
-  EXPECT_EQ(r[fw::kInMapVersion], 2);  // docs/spec/modbus-map.md
+  EXPECT_EQ(r[fw::kInMapVersion], 3);  // docs/spec/modbus-map.md
   EXPECT_EQ(r[fw::kInStatus] & ~fw::kStatusStale, fw::kStatusSimulated);
   for (std::size_t a = 0; a < 6; ++a) {
     const double tol = kSigmas * e.sigma_si[a] / std::sqrt(kFilter) + e.fixed_error_si[a] +
@@ -236,7 +236,7 @@ TEST(FtdModbus, OverloadPeaksAndToolTransformEndToEnd) {
   const Expected e = DeriveExpected();
   ASSERT_TRUE(c.WaitSamples(200));
   std::array<std::uint16_t, fw::kInputRegisterCount> r{};
-  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
+  ASSERT_EQ(c.Input(0, fw::kInputRegistersV2, r.data()), fw::kInputRegistersV2);
   EXPECT_NE(r[fw::kInStatus] & fw::kStatusOverload, 0);
   // One continuing overload is one event, not one per sample.
   EXPECT_EQ(UnpackU32(&r[fw::kInOverloadEvents]), 1u);
@@ -248,7 +248,7 @@ TEST(FtdModbus, OverloadPeaksAndToolTransformEndToEnd) {
   // Clearing while the overload continues: the counter restarts at the ongoing event.
   ASSERT_EQ(c.Write(fw::kHoldCommand, fw::kCmdClearPeaks), 1);
   ASSERT_TRUE(c.WaitSamples(5));
-  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
+  ASSERT_EQ(c.Input(0, fw::kInputRegistersV2, r.data()), fw::kInputRegistersV2);
   EXPECT_EQ(UnpackU32(&r[fw::kInOverloadEvents]), 1u);
   EXPECT_LT(UnpackFloat32(&r[fw::kInPeaks + 4]),
             450.0 + kSigmas * e.sigma_si[2] + e.fixed_error_si[2]);
@@ -340,7 +340,7 @@ TEST(FtdModbus, CalibrationSlotsAndTheirCrc) {
   ASSERT_EQ(c.Write(fw::kHoldFilterLength, 256), 1);
   ASSERT_TRUE(c.WaitSamples(300));
   std::array<std::uint16_t, fw::kInputRegisterCount> r{};
-  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
+  ASSERT_EQ(c.Input(0, fw::kInputRegistersV2, r.data()), fw::kInputRegistersV2);
   EXPECT_EQ(r[fw::kInCalSlot], 0);
   EXPECT_EQ(UnpackU32(&r[fw::kInCalCrc]), FileCrcField(a));
   const double tol = kSigmas * e.sigma_si[2] / 16.0 + e.fixed_error_si[2];
@@ -348,7 +348,7 @@ TEST(FtdModbus, CalibrationSlotsAndTheirCrc) {
   ASSERT_EQ(c.Write(fw::kHoldUnlock, fw::kUnlockKey), 1);
   ASSERT_EQ(c.Write(fw::kHoldCalSlot, 1), 1);
   ASSERT_TRUE(c.WaitSamples(300));  // the switch restarts the filter
-  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
+  ASSERT_EQ(c.Input(0, fw::kInputRegistersV2, r.data()), fw::kInputRegistersV2);
   EXPECT_EQ(r[fw::kInCalSlot], 1);
   EXPECT_EQ(UnpackU32(&r[fw::kInCalCrc]), FileCrcField(b));
   EXPECT_NE(FileCrcField(a), FileCrcField(b));
@@ -489,7 +489,7 @@ TEST(FtdModbus, PipelinedRequestsInOneSegmentAreAllAnswered) {
     const std::uint8_t* r = &got[static_cast<std::size_t>(t) * kReply];
     EXPECT_EQ(r[1], t);
     EXPECT_EQ(r[7], 4);
-    EXPECT_EQ((r[9] << 8) | r[10], 2);  // map version
+    EXPECT_EQ((r[9] << 8) | r[10], 3);  // map version
   }
   close(fd);
   EXPECT_EQ(ftd.Stop(), 0);
@@ -638,14 +638,14 @@ TEST(FtdModbus, OverloadUnderTareSeesTheLoadOnTheBody) {
   ASSERT_EQ(c.Write(fw::kHoldCommand, fw::kCmdTare), 1);
   ASSERT_TRUE(wait_sample(2500));
   std::array<std::uint16_t, fw::kInputRegisterCount> r{};
-  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
+  ASSERT_EQ(c.Input(0, fw::kInputRegistersV2, r.data()), fw::kInputRegistersV2);
   ASSERT_NE(r[fw::kInStatus] & fw::kStatusTareActive, 0);
   ASSERT_LT(UnpackU32(&r[fw::kInTimestampUs]), 8000000u) << "the read came after the 380 N hold";
   EXPECT_NEAR(UnpackFloat32(&r[fw::kInWrenchFloat + 4]), 0.0, 1.0);
   EXPECT_EQ(r[fw::kInStatus] & fw::kStatusOverload, 0);  // 95 % of rated
   EXPECT_EQ(UnpackU32(&r[fw::kInOverloadEvents]), 0u);
   ASSERT_TRUE(wait_sample(10000));  // 460 N since 8.2 s
-  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
+  ASSERT_EQ(c.Input(0, fw::kInputRegistersV2, r.data()), fw::kInputRegistersV2);
   EXPECT_NEAR(UnpackFloat32(&r[fw::kInWrenchFloat + 4]), 80.0, 1.0);
   EXPECT_NE(r[fw::kInStatus] & fw::kStatusOverload, 0);
   EXPECT_EQ(r[fw::kInStatus] & fw::kStatusBridgeFault, 0);
@@ -674,7 +674,7 @@ TEST(FtdModbus, UnusableCalibrationFilesStillServeAndSayWhy) {
                       std::array<std::uint16_t, fw::kInputRegisterCount>* r) {
     Client c(ftd.port());
     if (!c.WaitSamples(50)) return false;
-    return c.Input(0, fw::kInputRegisterCount, r->data()) == fw::kInputRegisterCount;
+    return c.Input(0, fw::kInputRegistersV2, r->data()) == fw::kInputRegistersV2;
   };
   std::array<std::uint16_t, fw::kInputRegisterCount> r{};
   {  // bad A, good B: runs on B and says so
