@@ -71,7 +71,7 @@ std::unique_ptr<RenderedBridges> Render(const sim::SensorDescription& desc, cons
 class SimulatedBackend final : public AdcBackend {
  public:
   explicit SimulatedBackend(const FtdOptions& opt) : desc_(sim::DefaultSensorDescription()) {
-    if (!opt.sim_effects.empty()) {
+    if (!opt.sim_effects.empty() || !opt.sim_profile.empty()) {
       rendered_ = Render(desc_, opt);
       hal::sim::SimAdcParams params = AdcParams(opt);
       rendered_adc_ = std::make_unique<hal::sim::SimAdc>(*rendered_, params);
