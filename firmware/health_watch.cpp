@@ -117,6 +117,7 @@ void HealthWatch::ResetReference(std::int32_t temperature_mdegc, bool has_temper
   // The output jumps at a tare: no load change, transient or hold is judged across it.
   ResetFilters();
   capturing_ = false;
+  analysing_ = kAxes;
   creep_phase_ = CreepPhase::kIdle;
   block_moved_ = true;
 }
@@ -357,6 +358,11 @@ void HealthWatch::FinishBlock() {
 
 void HealthWatch::UpdateRinging(const HealthInput& in) {
   if (refractory_ > 0) --refractory_;
+  if (analysing_ < kAxes) {  // one axis of the finished capture per sample (bounded cost)
+    AnalyseAxis(analysing_++);
+    if (analysing_ == kAxes) FinishRinging();
+    return;
+  }
   if (!capturing_) {
     if (refractory_ > 0) return;
     bool jump = false;
@@ -373,14 +379,23 @@ void HealthWatch::UpdateRinging(const HealthInput& in) {
   if (++capture_pos_ < kRingCapture) return;
   capturing_ = false;
   refractory_ = static_cast<std::uint32_t>(kRingCapture) * capture_stride_;
-  FinishRinging();
+  analysing_ = 0;  // the next six samples analyse it, one axis each
+}
+
+void HealthWatch::AnalyseAxis(std::size_t r) {
+  // Hysteresis: 4σ of the noise (the commissioning's, or the current one before it is known).
+  const std::int64_t sigma = sigma_ref_q8_[r] > 0 ? sigma_ref_q8_[r] : sigma_q8_[r];
+  const std::int32_t h = Sat32(((4 * sigma) >> 8) + 1);
+  ring_axis_[r] = MeasureRinging(capture_[r].data(), kRingCapture, rate_ / capture_stride_, h);
+  // A ringing well clear of the noise only (8 hysteresis bands): the count is then clean.
+  if (ring_axis_[r].amplitude < 8 * h) ring_axis_[r].freq_mhz = 0;
 }
 
 void HealthWatch::FinishRinging() {
-  const std::uint32_t capture_rate = rate_ / capture_stride_;
   // The axis that moved most (share of rated) carries the frequency.
   std::size_t dom = 0;
   std::int64_t best = -1;
+  WrenchLsb amplitude{};
   for (std::size_t r = 0; r < kAxes; ++r) {
     const std::int64_t share =
         Abs(std::int64_t{capture_[r][kRingCapture - 1]} - capture_[r][0]) * 10000 / rated_[r];
@@ -388,19 +403,9 @@ void HealthWatch::FinishRinging() {
       best = share;
       dom = r;
     }
+    amplitude[r] = ring_axis_[r].freq_mhz > 0 ? ring_axis_[r].amplitude : 0;
   }
-  WrenchLsb amplitude{};
-  RingingResult main{};
-  for (std::size_t r = 0; r < kAxes; ++r) {
-    // Hysteresis: 4σ of the noise (the commissioning's, or the current one before it is known).
-    const std::int64_t sigma = sigma_ref_q8_[r] > 0 ? sigma_ref_q8_[r] : sigma_q8_[r];
-    const std::int32_t h = Sat32(((4 * sigma) >> 8) + 1);
-    RingingResult rr = MeasureRinging(capture_[r].data(), kRingCapture, capture_rate, h);
-    // A ringing well clear of the noise only (8 hysteresis bands): the count is then clean.
-    if (rr.amplitude < 8 * h) rr.freq_mhz = 0;
-    amplitude[r] = rr.freq_mhz > 0 ? rr.amplitude : 0;
-    if (r == dom) main = rr;
-  }
+  const RingingResult& main = ring_axis_[dom];
   if (main.freq_mhz <= 0) return;
   report_.ring_mhz = main.freq_mhz;
   ring_last_mhz_[ring_measured_ % 3] = main.freq_mhz;

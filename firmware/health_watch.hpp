@@ -20,8 +20,9 @@ struct HealthInput {
   bool tare_pending = false;
 };
 
-/// Integer-only; no heap; the cost of one Step is bounded (a few hundred operations per sample,
-/// plus one ringing analysis of kRingCapture samples per axis at the end of a capture).
+/// Integer-only; no heap; the cost of one Step is bounded: a few hundred operations, plus at most
+/// one ringing analysis of kRingCapture samples (one axis on each of the six samples after a
+/// transient capture ends).
 /// Single-threaded: the sampling thread calls everything.
 class HealthWatch {
  public:
@@ -55,6 +56,7 @@ class HealthWatch {
   void UpdateBlock(const HealthInput& in, const WrenchLsb& d);
   void FinishBlock();
   void UpdateRinging(const HealthInput& in);
+  void AnalyseAxis(std::size_t axis);
   void FinishRinging();
   void UpdateCreep(const HealthInput& in, bool moving);
   void FinishCreep();
@@ -110,6 +112,8 @@ class HealthWatch {
   std::uint32_t capture_stride_ = 1;
   std::uint32_t stride_count_ = 0;
   std::uint32_t refractory_ = 0;
+  std::size_t analysing_ = kAxes;  ///< the capture's axis analysed next (kAxes: none pending)
+  std::array<RingingResult, kAxes> ring_axis_{};
   std::array<std::int32_t, 3> ring_last_mhz_{};
   std::uint32_t ring_measured_ = 0;
   std::array<std::int32_t, 3> ring_learn_mhz_{};

@@ -280,5 +280,27 @@ TEST(FtdHealth, StepsWithoutEffectsRaiseNothing) {
   EXPECT_EQ(seen, 0);
 }
 
+TEST(FtdHealth, PoweredUpUnderLoadIsOverloadNotBridgeFault) {
+  // 900 N on Fz (225 % of rated) from the first sample: bridges 0, 2, 4 start at a rail.
+  test::FtdProcess ftd(
+      {"--modbus-tcp", "127.0.0.1:0", "--print-hz", "0", "--sim-wrench", "0,0,900,0,0,0"});
+  ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  std::string out;
+  const std::string port = std::to_string(ftd.port());
+  ASSERT_EQ(
+      test::RunShell("mbpoll -m tcp -p " + port + " -a 1 -t 3 -0 -r 1 -c 1 -1 127.0.0.1", &out), 0)
+      << out;
+  const int status = static_cast<int>(test::ParseMbpoll(out).at(1));
+  EXPECT_NE(status & 0x1, 0) << status;  // saturated: no wrench value
+  EXPECT_NE(status & 0x2, 0) << status;  // overload
+  EXPECT_EQ(status & 0x4, 0) << status;  // not a bridge fault
+  ASSERT_EQ(
+      test::RunShell(
+          "mbpoll -m tcp -p " + port + " -a 1 -t 3:int -B -0 -r 58 -c 1 -1 " + "127.0.0.1", &out),
+      0);
+  EXPECT_EQ(test::ParseMbpoll(out).at(58), 1);  // one overload event, from the start
+}
+
 }  // namespace
 }  // namespace ftstack
