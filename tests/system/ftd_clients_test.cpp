@@ -92,7 +92,7 @@ TEST(FtdClients, ReadmeMbpollExamplesWork) {
       saw_int = true;
     } else if (l.find("-t 3 -r 1 -c 2") != std::string::npos) {
       ASSERT_EQ(v.size(), 2u) << out;
-      EXPECT_EQ(v.at(1), 2.0);  // map version
+      EXPECT_EQ(v.at(1), 3.0);  // map version
       EXPECT_EQ(static_cast<int>(v.at(2)) & fw::kStatusSimulated, fw::kStatusSimulated);
       saw_status = true;
     } else if (l.find("-r 45 -c 6") != std::string::npos) {

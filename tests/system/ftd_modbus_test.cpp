@@ -371,7 +371,7 @@ TEST(FtdModbus, GarbageAndHalfFramesDoNotDisturbOtherClients) {
     Client c(ftd.port());
     std::array<std::uint16_t, 74> r{};
     while (!stop) {
-      if (c.Input(0, 74, r.data()) == 74 && r[0] == 2) {
+      if (c.Input(0, 74, r.data()) == 74 && r[0] == fw::kMapVersion) {
         ++ok;
       } else {
         if (failed++ == 0) {
