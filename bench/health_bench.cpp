@@ -40,6 +40,8 @@ std::vector<HealthInput> Inputs(std::uint32_t rate) {
       in.tared[r] = static_cast<std::int32_t>((s >> 40) % 41) - 20;
     }
     in.tared[2] += static_cast<std::int32_t>(std::lround((on + ring) * 0.4 * kRated[2]));
+    in.untared = in.tared;  // the rainflow counters run too
+    in.untared_valid = true;
   }
   return v;
 }

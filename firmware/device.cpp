@@ -114,6 +114,8 @@ void Device::WatchHealth(const PublishedSample& p, std::uint16_t status) {
   tare_was_pending_ = pending;
   HealthInput in;
   in.tared = core.unfiltered;
+  in.untared = core.structural;
+  in.untared_valid = core.structural_valid;
   in.valid =
       core.updated && !core.arithmetic_saturated &&
       (status & (kStatusSaturated | kStatusCalInvalid | kStatusBridgeFault | kStatusAdcFault)) == 0;

@@ -71,6 +71,8 @@ struct HealthReport {
   std::uint32_t tare_age_s = 0;        ///< since the last tare (or start)
   std::int32_t tare_temp_mdegc = 0;    ///< temperature at the last tare (0 without one)
   std::uint16_t tare_count = 0;        ///< tares since start
+  /// Rainflow full cycles of the untared load per axis with a range ≥ 10 % of rated.
+  std::array<std::uint32_t, kAxes> cycles{};
 };
 
 }  // namespace ftstack::fw

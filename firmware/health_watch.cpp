@@ -51,6 +51,10 @@ bool HealthWatch::Configure(std::uint32_t rate_hz, const WrenchLsb& rated_lsb) {
     }
   }
   capture_stride_ = rate_hz <= 2000 ? 1 : rate_hz / 1000;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    // Turning points beyond 2 % of rated (noise makes none); cycles of 10 % of rated and more.
+    rainflow_[r].Configure(rated_lsb[r] / 50, rated_lsb[r] / 10);
+  }
   seg_len_ = 2 * rate_hz;
   configured_ = true;
   SetThresholds(th_);
@@ -86,6 +90,7 @@ void HealthWatch::Clear() {
   error_ = {};
   ResetReference(0, false);  // the next sample's temperature becomes the reference
   ring_measured_ = 0;
+  for (RainflowCounter& c : rainflow_) c.Clear();
 }
 
 void HealthWatch::OnTare(std::int32_t temperature_mdegc, bool has_temperature, bool cleared) {
@@ -137,6 +142,9 @@ void HealthWatch::SetFinding(HealthCause cause, bool on, const WrenchLsb& error)
 void HealthWatch::Step(const HealthInput& in) {
   if (!configured_) return;
   ++samples_;
+  if (in.untared_valid) {
+    for (std::size_t r = 0; r < kAxes; ++r) rainflow_[r].Add(in.untared[r]);
+  }
   if (!in.valid) {
     ResetFilters();
     stable_run_ = 0;
@@ -490,6 +498,7 @@ void HealthWatch::Publish(const HealthInput& in) {
   r.findings = active_;
   r.ring_ref_mhz = ring_ref_mhz_;
   r.tare_age_s = static_cast<std::uint32_t>(samples_ / rate_) - tare_sample_;
+  for (std::size_t a = 0; a < kAxes; ++a) r.cycles[a] = rainflow_[a].cycles();
   r.slots = {};
   std::size_t k = 0;
   for (std::size_t i = 0; i < kHealthCauses && k < kHealthSlots; ++i) {

@@ -6,6 +6,7 @@
 
 #include "firmware/health_signal.hpp"
 #include "firmware/health_types.hpp"
+#include "firmware/rainflow.hpp"
 #include "firmware/wrench.hpp"
 
 namespace ftstack::fw {
@@ -18,6 +19,8 @@ struct HealthInput {
   bool has_temperature = false;
   std::uint16_t status = 0;  ///< the device's status bits of this sample (for the NE 107 state)
   bool tare_pending = false;
+  WrenchLsb untared{};  ///< the load the body carries (no tare), also at a rail (a lower bound)
+  bool untared_valid = false;
 };
 
 /// Integer-only; no heap; the cost of one Step is bounded: a few hundred operations, plus at most
@@ -126,6 +129,9 @@ class HealthWatch {
   std::array<std::array<std::int64_t, kAxes>, 3> seg_sum_{};
   std::uint32_t creep_count_ = 0;
   std::uint32_t seg_len_ = 0;
+
+  // Load history: rainflow cycles of the untared load per axis.
+  std::array<RainflowCounter, kAxes> rainflow_{};
 
   // Findings.
   std::uint16_t active_ = 0;

@@ -2,9 +2,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include "firmware/health_signal.hpp"
+#include "firmware/rainflow.hpp"
 
 namespace ftstack::fw {
 namespace {
@@ -95,6 +97,70 @@ TEST(CreepRemaining, ExponentialApproachFromSegmentMeans) {
   }
   // Not an exponential approach (growing increments): what was seen.
   EXPECT_EQ(CreepRemaining(0, 10, 30), 30);
+}
+
+/// ASTM E1049-85 rainflow (three-point rule with the starting point), on turning points in double:
+/// the full cycles (step 4) with a range of at least `min_range`.
+int AstmFullCycles(const std::vector<double>& peaks, double min_range) {
+  std::vector<double> s;
+  std::size_t start = 0;  // index in s of the starting point S
+  int full = 0;
+  for (const double p : peaks) {
+    s.push_back(p);
+    while (s.size() >= 3) {
+      const std::size_t n = s.size();
+      const double x = std::fabs(s[n - 1] - s[n - 2]);
+      const double y = std::fabs(s[n - 2] - s[n - 3]);
+      if (x < y) break;
+      if (n - 3 == start) {  // Y contains S: a half cycle; S moves on
+        s.erase(s.begin() + static_cast<long>(start));
+        continue;
+      }
+      if (y >= min_range) ++full;
+      s.erase(s.begin() + static_cast<long>(n - 3), s.begin() + static_cast<long>(n - 1));
+    }
+  }
+  return full;
+}
+
+TEST(RainflowCounter, FullCyclesAgreeWithAstmE1049OnRandomHistories) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> level(-100000.0, 100000.0);
+  for (int history = 0; history < 20; ++history) {
+    // Alternating turning points at least 3 gates apart, joined by ramps of 5 samples with
+    // noise below the gate: the counter must find exactly these turning points.
+    std::vector<double> peaks = {0.0};
+    while (peaks.size() < 400) {
+      const double v = level(rng);
+      const bool up = peaks.size() % 2 == 1;
+      if ((up && v > peaks.back() + 6000) || (!up && v < peaks.back() - 6000)) peaks.push_back(v);
+    }
+    RainflowCounter c;
+    c.Configure(2000, 20000);
+    std::uniform_int_distribution<int> noise(-400, 400);
+    for (std::size_t i = 1; i < peaks.size(); ++i) {
+      for (int k = 0; k < 5; ++k) {
+        const double v = peaks[i - 1] + (peaks[i] - peaks[i - 1]) * k / 5.0;
+        c.Add(static_cast<std::int32_t>(std::lround(v)) + (k == 0 ? 0 : noise(rng)));
+      }
+    }
+    c.Add(static_cast<std::int32_t>(std::lround(peaks.back())));
+    c.Add(
+        static_cast<std::int32_t>(std::lround(peaks.back() - (peaks.back() > 0 ? 1 : -1) * 3000)));
+    std::vector<double> rounded;
+    for (const double p : peaks) rounded.push_back(static_cast<double>(std::lround(p)));
+    EXPECT_EQ(static_cast<int>(c.cycles()), AstmFullCycles(rounded, 20000)) << history;
+    EXPECT_GT(c.cycles(), 50u);
+  }
+}
+
+TEST(RainflowCounter, NoiseBelowTheGateCountsNothing) {
+  RainflowCounter c;
+  c.Configure(2000, 1);
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> noise(-999, 999);
+  for (int i = 0; i < 100000; ++i) c.Add(50000 + noise(rng));
+  EXPECT_EQ(c.cycles(), 0u);
 }
 
 }  // namespace

@@ -63,6 +63,8 @@ class Runner {
         in.tared[r] = static_cast<std::int32_t>(
             std::lround(y[r] + noise_.Next() * scene_.noise_fraction * kRated[r]));
       }
+      in.untared = in.tared;  // no tare in the scenes: the load is the output
+      in.untared_valid = true;
       watch_.Step(in);
       if (each_second && n_ % scene_.rate == 0) each_second(t);
     }

@@ -139,15 +139,17 @@ std::string WriteProfile(const test::TempDir& dir, const std::string& name,
   return path;
 }
 
-/// Fz steps 0 → 160 N (40 % of rated, 5 ms edges) every 18 s: creep and ringing show in the holds.
-std::string StepProfile(const test::TempDir& dir) {
+/// Fz steps (5 ms edges) every 18 s from 2 s on, through `levels` (N), starting at 0.
+std::string StepProfile(const test::TempDir& dir,
+                        const std::vector<double>& levels = {160, 0, 160, 0, 160}) {
   std::string k;
-  for (int i = 0; i < 5; ++i) {
-    const double t = 2.0 + 18.0 * i;
-    const double from = i % 2 == 0 ? 0 : 160, to = i % 2 == 0 ? 160 : 0;
+  double from = 0;
+  for (std::size_t i = 0; i < levels.size(); ++i) {
+    const double t = 2.0 + 18.0 * static_cast<double>(i);
     k += (i ? "," : "") + std::string("{\"t_s\":") + std::to_string(t) + ",\"wrench\":[0,0," +
          std::to_string(from) + ",0,0,0]},{\"t_s\":" + std::to_string(t + 0.005) +
-         ",\"wrench\":[0,0," + std::to_string(to) + ",0,0,0]}";
+         ",\"wrench\":[0,0," + std::to_string(levels[i]) + ",0,0,0]}";
+    from = levels[i];
   }
   return WriteProfile(
       dir, "steps.json",
@@ -266,7 +268,9 @@ TEST(FtdHealth, ZeroDriftFlaggedWithItsSize) {
 
 TEST(FtdHealth, StepsWithoutEffectsRaiseNothing) {
   test::TempDir dir;
-  Health h({"--sim-profile", StepProfile(dir), "--sim-span-s", "90"});
+  // Levels 160, 40, 120, 0, 60 N: the turning points 0 160 40 120 0 close one full rainflow cycle
+  // (40 ↔ 120 N, 20 % of rated: |40 − 120| ≤ |160 − 40| and ≤ |120 − 0|, margins of 40 N).
+  Health h({"--sim-profile", StepProfile(dir, {160, 40, 120, 0, 60}), "--sim-span-s", "90"});
   ASSERT_GT(h.port(), 0) << h.Stderr();
   double t = 0;
   int seen = 0;
@@ -278,6 +282,9 @@ TEST(FtdHealth, StepsWithoutEffectsRaiseNothing) {
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
   }
   EXPECT_EQ(seen, 0);
+  // Load history: that one cycle on Fz, nothing on the other axes.
+  const auto cycles = h.Read("3", 190, 6);
+  for (int a = 0; a < 6; ++a) EXPECT_EQ(cycles.at(190 + a), a == 2 ? 1 : 0) << "axis " << a;
 }
 
 TEST(FtdHealth, PoweredUpUnderLoadIsOverloadNotBridgeFault) {
