@@ -149,14 +149,14 @@ LoadResult Hammer(int port, int clients, double seconds) {
         modbus_free(c);
         return;
       }
-      std::uint16_t regs[ftstack::fw::kInputRegisterCount];
+      std::uint16_t regs[ftstack::fw::kInputRegistersV2];
       auto& mine = lat[static_cast<std::size_t>(i)];
       mine.reserve(200000);
       while (!go) std::this_thread::yield();
       while (!stop) {
         const auto t0 = Clock::now();
-        if (modbus_read_input_registers(c, 0, ftstack::fw::kInputRegisterCount, regs) !=
-            ftstack::fw::kInputRegisterCount) {
+        if (modbus_read_input_registers(c, 0, ftstack::fw::kInputRegistersV2, regs) !=
+            ftstack::fw::kInputRegistersV2) {
           if (errors++ == 0) std::fprintf(stderr, "first error: %s\n", modbus_strerror(errno));
           continue;
         }

@@ -41,6 +41,23 @@ if [ -x "$B/bench_core" ]; then
   "$B/bench_core" --benchmark_min_time="$MIN_TIME" --benchmark_format=csv 2>/dev/null | core_table
 fi
 
+# --- the health watch (issue 27): ns per sample at 1 and 8 kHz, the worst sample, share of budget --
+health_table() {
+  awk -F, 'NR>1 && $1 ~ /BM_/ { gsub(/"/,"",$1); t[$1]=$4 }
+      END {
+        for (r = 1000; r <= 8000; r *= 8) if (t["BM_HealthWatchStep/" r] > 0)
+          printf "  watch per sample at %d Hz: %.1f ns (%.3f %% of the %d us sample budget)\n", r,
+            t["BM_HealthWatchStep/" r], t["BM_HealthWatchStep/" r] / (1e7 / r), 1e6 / r
+        if (t["BM_RingingAnalysis"] > 0)
+          printf "  worst sample (one ringing analysis after a transient capture): +%.0f ns (%.2f %% of 125 us)\n",
+            t["BM_RingingAnalysis"], t["BM_RingingAnalysis"] / 1250
+      }'
+}
+if [ -x "$B/bench_health" ]; then
+  section "health watch (CPU ns per sample, goal <= 1000 ns on the host)"
+  "$B/bench_health" --benchmark_min_time="$MIN_TIME" --benchmark_format=csv 2>/dev/null | health_table
+fi
+
 # --- the same on aarch64 under qemu-user (issue 15), when a cross build of bench_core exists ------
 # cmake --preset cross-aarch64 -DFTSTACK_BUILD_BENCH=ON && cmake --build build-aarch64 --target
 # bench_core (sysroot: cmake/make-sysroot.sh arm64). qemu translates each instruction, so the

@@ -107,6 +107,7 @@ void Ftd::StartThreads() {
   // Memory first (before the threads' stacks), then the sampling thread's policy; one line says
   // what the system granted. A benchmark run (--unpaced) never asks: it would hog a core.
   const std::string memory = opt_.paced ? LockMemory() : "memory not locked (--unpaced)";
+  if (!SizeThreadStacks()) std::fprintf(stderr, "ftd: thread stacks keep the default size\n");
   threads_.emplace_back([this] { SamplingLoop(); });
   pthread_setname_np(threads_.back().native_handle(), "ftd-sampler");
   bool rt = false;

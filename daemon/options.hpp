@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace ftstack::daemon {
 
@@ -20,6 +21,14 @@ struct FtdOptions {
   std::string adc = "sim";                          ///< sim, hx711, spi
   std::optional<std::array<double, 6>> sim_wrench;  ///< constant applied wrench, N and N·m
   std::string replay;                               ///< recording whose wrench columns are played
+  /// Effects injected into the simulated sensor (--sim-effect, ftsim record's vocabulary); with
+  /// them (or a sim_profile) the bridges are rendered once at start-up over sim_span_s of
+  /// sim_profile (a profile of ftsim record; empty: the constant --sim-wrench at 20 °C) and hold
+  /// their last value after.
+  std::vector<std::string> sim_effects;
+  std::string sim_profile;
+  double sim_span_s = 600.0;
+  double sim_speed = 1.0;  ///< paced simulated ADC: simulated seconds per wall-clock second
   unsigned rate_hz = 1000;
   std::string cal;    ///< calibration file for slot 0 ("" = built-in)
   std::string cal_b;  ///< calibration file for slot 1 ("" = none)

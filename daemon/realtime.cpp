@@ -11,6 +11,15 @@
 #include <fstream>
 
 namespace ftstack::daemon {
+
+bool SizeThreadStacks() {
+  pthread_attr_t attr;
+  if (pthread_attr_init(&attr) != 0) return false;
+  const bool ok = pthread_attr_setstacksize(&attr, kThreadStackBytes) == 0 &&
+                  pthread_setattr_default_np(&attr) == 0;
+  pthread_attr_destroy(&attr);
+  return ok;
+}
 namespace {
 
 constexpr int kCapIpcLock = 14;  // linux/capability.h

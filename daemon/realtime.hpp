@@ -3,6 +3,7 @@
 
 #include <pthread.h>
 
+#include <cstddef>
 #include <string>
 
 namespace ftstack::daemon {
@@ -10,6 +11,15 @@ namespace ftstack::daemon {
 /// SCHED_FIFO priority asked for the sampling thread (capped at RLIMIT_RTPRIO without
 /// CAP_SYS_NICE).
 inline constexpr int kSamplingPriority = 50;
+
+/// Stack of each thread ftd starts. Locked memory locks stacks whole (the default is
+/// RLIMIT_STACK, 8 MiB each); the deepest thread (a Modbus reply: one input image and one
+/// published sample on its stack, libmodbus's frame buffers) needs a few KiB.
+inline constexpr std::size_t kThreadStackBytes = 256 * 1024;
+
+/// Makes kThreadStackBytes the stack size of every thread created after it (std::thread too).
+/// Returns false where the C library refuses.
+[[nodiscard]] bool SizeThreadStacks();
 
 /// Locks the process's memory (mlockall, current and future) where the system permits it: with
 /// CAP_IPC_LOCK or an unlimited RLIMIT_MEMLOCK (a limited lock would make later allocations fail).

@@ -1,10 +1,15 @@
 #include "daemon/sim_backend.hpp"
 
+#include <cmath>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "hal/sim/sim_adc.hpp"
 #include "measurement/recording.hpp"
 #include "sim/ideal_calibration.hpp"
+#include "sim/load_profile.hpp"
+#include "sim/record.hpp"
 #include "sim/sensor_description.hpp"
 #include "sim/simulated_sensor.hpp"
 #include "sim/wrench_source.hpp"
@@ -12,9 +17,66 @@
 namespace ftstack::daemon {
 namespace {
 
+/// Bridge outputs rendered once at start-up by the simulator's effect composition (what
+/// `ftsim record --effect` injects), read back at each conversion's time; after the rendered span
+/// the last sample holds.
+class RenderedBridges final : public hal::sim::BridgeSignalSource {
+ public:
+  RenderedBridges(Eigen::MatrixXd mvv, std::vector<double> temp_c, double rate_hz)
+      : mvv_(std::move(mvv)), temp_c_(std::move(temp_c)), rate_hz_(rate_hz) {}
+  [[nodiscard]] std::uint8_t channel_count() const override {
+    return static_cast<std::uint8_t>(mvv_.rows());
+  }
+  [[nodiscard]] bool Sample(double t_s, double* bridge_mvv, double* temperature_c) override {
+    const double at = std::floor(t_s * rate_hz_ + 0.5);
+    const Eigen::Index last = mvv_.cols() - 1;
+    const Eigen::Index i =
+        at <= 0 ? 0 : (at >= static_cast<double>(last) ? last : static_cast<Eigen::Index>(at));
+    for (Eigen::Index c = 0; c < mvv_.rows(); ++c) bridge_mvv[c] = mvv_(c, i);
+    if (temperature_c != nullptr) *temperature_c = temp_c_[static_cast<std::size_t>(i)];
+    return true;
+  }
+
+ private:
+  Eigen::MatrixXd mvv_;
+  std::vector<double> temp_c_;
+  double rate_hz_;
+};
+
+/// The bridges of `desc` under the options' profile (or constant wrench) with --sim-effect
+/// injected, over --sim-span-s at the sample rate. Throws on a bad effect or profile.
+std::unique_ptr<RenderedBridges> Render(const sim::SensorDescription& desc, const FtdOptions& opt) {
+  const sim::SensorModel& model = *desc.model;
+  sim::LoadProfile profile;
+  if (!opt.sim_profile.empty()) {
+    profile = sim::MakeProfile(opt.sim_profile, model.rated(), opt.seed, opt.sim_span_s);
+  } else {
+    Wrench w = Wrench::Zero();
+    if (opt.sim_wrench) {
+      for (int i = 0; i < 6; ++i) w(i) = (*opt.sim_wrench)[static_cast<std::size_t>(i)];
+    }
+    profile = sim::LoadProfile("constant", {0.0}, {w}, {0.0}, {20.0}, opt.sim_span_s, opt.rate_hz);
+  }
+  const double rows = profile.duration_s() * opt.rate_hz;
+  if (rows < 2 || rows > 2e7) {
+    throw std::invalid_argument("--sim-span-s: " + std::to_string(rows) +
+                                " samples to render (2 … 2e7: shorten the span or the rate)");
+  }
+  sim::ComposeSetup setup =
+      sim::SetUpCompose(model, profile, opt.rate_hz, sim::ParseEffects(opt.sim_effects), opt.seed);
+  Eigen::MatrixXd mvv = sim::ComposeWithEffects(&setup);
+  return std::make_unique<RenderedBridges>(std::move(mvv), setup.in.temp_c, opt.rate_hz);
+}
+
 class SimulatedBackend final : public AdcBackend {
  public:
   explicit SimulatedBackend(const FtdOptions& opt) : desc_(sim::DefaultSensorDescription()) {
+    if (!opt.sim_effects.empty() || !opt.sim_profile.empty()) {
+      rendered_ = Render(desc_, opt);
+      hal::sim::SimAdcParams params = AdcParams(opt);
+      rendered_adc_ = std::make_unique<hal::sim::SimAdc>(*rendered_, params);
+      return;
+    }
     if (!opt.replay.empty()) {
       ReadOptions ro;
       ro.required = {"t"};
@@ -27,16 +89,11 @@ class SimulatedBackend final : public AdcBackend {
       }
       source_ = std::make_unique<sim::ConstantWrench>(w);
     }
-    // The built-in sensor's converter at the requested rate (its datasheet noise); a rate the
-    // converter cannot run keeps the nominal operating point's noise.
-    hal::sim::SimAdcParams params = sim::AdcParamsOrNominal(desc_, opt.rate_hz);
-    params.seed = opt.seed;
-    params.realtime = opt.paced;
-    params.stall_every = opt.sim_stall_every;
-    params.stall_us = static_cast<std::uint32_t>(opt.sim_stall_ms * 1000.0);
-    simulated_ = std::make_unique<sim::SimulatedAdc>(desc_, *source_, params);
+    simulated_ = std::make_unique<sim::SimulatedAdc>(desc_, *source_, AdcParams(opt));
   }
-  hal::Adc& adc() override { return simulated_->adc(); }
+  hal::Adc& adc() override {
+    return rendered_adc_ ? static_cast<hal::Adc&>(*rendered_adc_) : simulated_->adc();
+  }
   [[nodiscard]] std::uint8_t channel_count() const override {
     return static_cast<std::uint8_t>(desc_.model->channel_count());
   }
@@ -47,7 +104,21 @@ class SimulatedBackend final : public AdcBackend {
   }
 
  private:
+  /// The built-in sensor's converter at the requested rate (its datasheet noise); a rate the
+  /// converter cannot run keeps the nominal operating point's noise.
+  [[nodiscard]] hal::sim::SimAdcParams AdcParams(const FtdOptions& opt) const {
+    hal::sim::SimAdcParams params = sim::AdcParamsOrNominal(desc_, opt.rate_hz);
+    params.seed = opt.seed;
+    params.realtime = opt.paced;
+    params.speed = opt.sim_speed;
+    params.stall_every = opt.sim_stall_every;
+    params.stall_us = static_cast<std::uint32_t>(opt.sim_stall_ms * 1000.0);
+    return params;
+  }
+
   sim::SensorDescription desc_;
+  std::unique_ptr<RenderedBridges> rendered_;
+  std::unique_ptr<hal::sim::SimAdc> rendered_adc_;
   std::unique_ptr<sim::WrenchSource> source_;
   std::unique_ptr<sim::SimulatedAdc> simulated_;
 };

@@ -336,18 +336,38 @@ void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts,
   if (clamped) *saturated = true;
 }
 
+bool WrenchCore::FirstSampleRailsAreLoad(const hal::AdcSample& in) const {
+  // Powered up under load, bridges are already at their rails: no previous sample tells a ramp
+  // from a jump. A load drives several bridges together; an open or shorted gauge pins one. So
+  // two or more channels at the same rail read as a load (overload evidence); a single channel
+  // at a rail reads as a bridge fault until it leaves the rail.
+  int at_max = 0;
+  int at_min = 0;
+  for (std::size_t c = 0; c < in.channel_count && c < kMaxChannels; ++c) {
+    const bool flagged = (in.flags[c] & hal::kChannelSaturated) != 0;
+    const std::int64_t mid = (std::int64_t{cal_.max_counts} + cal_.min_counts) / 2;
+    if (in.counts[c] >= cal_.max_counts || (flagged && in.counts[c] > mid)) ++at_max;
+    if (in.counts[c] <= cal_.min_counts || (flagged && in.counts[c] <= mid)) ++at_min;
+  }
+  return at_max >= 2 || at_min >= 2;
+}
+
 // The per-sample stages are inlined into Process: the split is for reading, not a call each.
 [[gnu::always_inline]] inline WrenchCore::Faults WrenchCore::DetectFaults(const hal::AdcSample& in,
                                                                           CoreOutput& out) {
   const std::size_t n = in.channel_count;
   Faults f;
   bool all_same = n > 0;
+  // The first sample has no path to judge: see FirstSampleRailsAreLoad.
+  const bool first_is_load = !seen_sample_ && FirstSampleRailsAreLoad(in);
   for (std::size_t c = 0; c < n && c < kMaxChannels; ++c) {
     const std::int32_t v = in.counts[c];
     const bool at_rail = cal_.valid && (v >= cal_.max_counts || v <= cal_.min_counts);
     const bool flagged = (in.flags[c] & hal::kChannelSaturated) != 0;
     const bool sat = at_rail || flagged;
-    if (sat && !was_saturated_[c]) {
+    if (sat && !seen_sample_) {
+      rail_jump_[c] = !first_is_load;
+    } else if (sat && !was_saturated_[c]) {
       // Entering saturation from inside the middle half of the range in one sample: a jump.
       const std::int64_t mid = (std::int64_t{cal_.max_counts} + cal_.min_counts) / 2;
       const std::int64_t quarter = (std::int64_t{cal_.max_counts} - cal_.min_counts) / 4;
@@ -367,6 +387,7 @@ void WrenchCore::Apply(const std::array<std::int32_t, kMaxChannels>& counts,
     }
     last_counts_[c] = v;
   }
+  seen_sample_ = true;
   same_count_run_ = all_same ? static_cast<std::uint16_t>(
                                    same_count_run_ < 0xFFFF ? same_count_run_ + 1 : same_count_run_)
                              : 0;

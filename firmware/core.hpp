@@ -91,6 +91,8 @@ class WrenchCore {
   };
   /// Fault detection on the raw counts; sets the fault status bits in out.
   [[nodiscard]] Faults DetectFaults(const hal::AdcSample& in, CoreOutput& out);
+  /// The first sample's rails: true when two or more channels sit at the same rail (a load).
+  [[nodiscard]] bool FirstSampleRailsAreLoad(const hal::AdcSample& in) const;
   /// Tare accumulation of one usable sample; activates the tare when complete.
   void AccumulateTare(const hal::AdcSample& in, std::int32_t dt_mdegc);
   /// Moving average of y over the last filter_length_ samples into out.wrench.
@@ -202,6 +204,7 @@ class WrenchCore {
   /// gauge, not a load (a load ramps through the range; an open gauge jumps).
   std::array<bool, kMaxChannels> rail_jump_{};
   std::array<bool, kMaxChannels> was_saturated_{};  ///< saturated in the previous sample
+  bool seen_sample_ = false;  ///< a sample was processed (last_counts_ holds a real one)
 };
 
 }  // namespace ftstack::fw

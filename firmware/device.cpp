@@ -34,9 +34,13 @@ DeviceStatus Device::Start(const DeviceConfig& config) {
   active_ = DeviceSettings{};
   active_.cal_slot = config.initial_slot;
   active_.filter_length = core_.filter_length();
+  // The watch judges every threshold against the rated range: without one it stays off.
+  (void)health_.Configure(rate, config.rated_lsb);
+  active_.health = health_.thresholds();
   initial_settings_ = active_;
   settings_.Write(active_);
   settings_seen_ = settings_.writes();
+  tare_was_pending_ = false;
   last_ = DeviceSample{};
   last_.cal_slot = active_.cal_slot;
   last_.cal_crc = config.slots[active_.cal_slot].crc32;
@@ -49,6 +53,7 @@ DeviceStatus Device::Start(const DeviceConfig& config) {
   last_sample_us_.store(last_.publish_time_us, std::memory_order_release);
   previous_read_us_ = 0;
   late_samples_ = 0;
+  last_.health_on = health_.configured();
   last_.sample.status = kStatusStale;  // nothing sampled yet
   published_.Write(last_);
   return DeviceStatus::kOk;
@@ -81,12 +86,44 @@ void Device::ApplySettings() {
       (void)core_.RequestTare(tare_samples_);  // tare_samples_ is within range by construction
     } else if (s.tare_kind == 2) {
       core_.ClearTare();
+      health_.OnTare(last_.sample.temperature_mdegc, last_.sample.has_temperature, true);
     }
+  }
+  if (!(s.health == active_.health)) {
+    active_.health = s.health;
+    health_.SetThresholds(s.health);
+  }
+  if (s.health_generation != active_.health_generation) {
+    active_.health_generation = s.health_generation;
+    if (s.health_command == 1) health_.Commission();
+    if (s.health_command == 2) health_.Clear();
   }
   if (s.clear_generation != active_.clear_generation) {
     active_.clear_generation = s.clear_generation;
     overload_.Clear();
   }
+}
+
+void Device::WatchHealth(const PublishedSample& p, std::uint16_t status) {
+  if (!health_.configured()) return;
+  const CoreOutput& core = sampler_.core_output();
+  const bool pending = core_.tare_pending();
+  if (tare_was_pending_ && !pending && core_.tare_active()) {
+    health_.OnTare(p.temperature_mdegc, p.has_temperature, false);
+  }
+  tare_was_pending_ = pending;
+  HealthInput in;
+  in.tared = core.unfiltered;
+  in.untared = core.structural;
+  in.untared_valid = core.structural_valid;
+  in.valid =
+      core.updated && !core.arithmetic_saturated &&
+      (status & (kStatusSaturated | kStatusCalInvalid | kStatusBridgeFault | kStatusAdcFault)) == 0;
+  in.temperature_mdegc = p.temperature_mdegc;
+  in.has_temperature = p.has_temperature;
+  in.status = status;
+  in.tare_pending = pending;
+  health_.Step(in);
 }
 
 hal::Status Device::Step(bool* published) {
@@ -138,6 +175,7 @@ hal::Status Device::Step(bool* published) {
   }
   // A wrench clipped by the arithmetic is not a measurement: flag it like a saturated bridge.
   if (core.arithmetic_saturated) sticky_status_ |= kStatusSaturated;
+  WatchHealth(p, static_cast<std::uint16_t>(p.status | sticky_status_));
   if (++since_publish_ < active_.decimation) return s;
   since_publish_ = 0;
 
@@ -177,6 +215,8 @@ hal::Status Device::Step(bool* published) {
   d.payload_mass_ug = config_.payload.present ? config_.payload.mass_ug : 0;
   d.payload_crc = config_.payload_crc;
   d.publish_time_us = now_us;
+  d.health = health_.report();
+  d.health_on = health_.configured();
   last_ = d;
   published_.Write(d);
   *published = true;

@@ -7,6 +7,7 @@
 
 #include "firmware/core.hpp"
 #include "firmware/gravity_comp.hpp"
+#include "firmware/health_watch.hpp"
 #include "firmware/overload.hpp"
 #include "firmware/sampler.hpp"
 #include "firmware/seqlock.hpp"
@@ -32,6 +33,8 @@ struct DeviceSample {
   std::int64_t payload_mass_ug = 0;     ///< payload of gravity compensation, µg (0: none)
   std::uint32_t payload_crc = 0;        ///< CRC-32 of its payload file (input registers 79–80)
   std::uint8_t peaks_invalid_axes = 0;  ///< bit r: peak r is not a value (sensor frame)
+  HealthReport health{};                ///< the health watch (input registers 100 … 189)
+  bool health_on = false;               ///< the watch runs (it needs a rated range)
 };
 
 /// One calibration slot as the device holds it.
@@ -52,6 +55,9 @@ struct DeviceSettings {
   std::uint32_t clear_generation = 0;           ///< +1 per "clear peaks and overload counter"
   std::array<std::int32_t, 3> gravity_umps2{};  ///< gravity in the sensor frame, µm/s²
   bool gravity_comp = false;                    ///< subtract the payload (needs one)
+  HealthThresholds health{};                    ///< the health watch's thresholds
+  std::uint32_t health_generation = 0;          ///< +1 per health command
+  std::uint8_t health_command = 0;  ///< 1 = commission, 2 = clear findings (the latest wins)
 };
 
 inline constexpr std::uint16_t kMaxDecimation = 1000;
@@ -120,6 +126,8 @@ class Device {
 
  private:
   void ApplySettings();
+  /// Feeds the health watch one processed sample (and tells it of a completed tare).
+  void WatchHealth(const PublishedSample& p, std::uint16_t status);
 
   hal::Adc& adc_;
   WrenchCore& core_;
@@ -127,6 +135,8 @@ class Device {
   DeviceConfig config_{};
   std::uint64_t (*clock_)() = &MonotonicUs;
   OverloadMonitor overload_{};
+  HealthWatch health_{};
+  bool tare_was_pending_ = false;
   Seqlock<DeviceSample> published_{};
   Seqlock<DeviceSettings> settings_{};
   std::uint32_t settings_seen_ = 0;

@@ -2,10 +2,12 @@
 
 #include <sched.h>
 
+#include <algorithm>
 #include <bit>
 #include <limits>
 
 #include "firmware/fixed_point.hpp"
+#include "firmware/health_registers.hpp"
 
 namespace ftstack::fw {
 namespace {
@@ -27,7 +29,12 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 /// Holding registers 5 … 9 and 29: reserved. They read 0 and accept 0 (so that a PLC's block
 /// read or write of 0 … 29 works); any other value is refused with 03.
 [[nodiscard]] bool HoldingReserved(std::uint32_t a) {
-  return (a > kHoldUnlock && a < kHoldTransform) || a == kHoldReserved29;
+  return (a > kHoldUnlock && a < kHoldTransform) || a == kHoldReserved29 ||
+         (a >= kHoldReserved42 && a < kHoldHealthCommand);
+}
+
+[[nodiscard]] bool HoldingHealth(std::uint32_t a) {
+  return a >= kHoldHealthCommand && a < kHoldHealthEnd;
 }
 
 [[nodiscard]] bool InGravity(std::uint32_t a) { return a >= kHoldGravity && a < kHoldGravity + 6u; }
@@ -111,6 +118,7 @@ void BuildInputRegisters(const DeviceSample& d, const hal::AdcInfo& adc, std::ui
   PackFloat32(static_cast<float>(static_cast<double>(d.payload_mass_ug) * 1e-9),
               &r[kInPayloadMass]);
   PackU32(d.payload_crc, &r[kInPayloadCrc]);
+  BuildHealthInputRegisters(d, &r[kInHealthFirst]);
 }
 
 RegisterMap::RegisterMap(Device& device) : device_(device), settings_(device.initial_settings()) {}
@@ -141,13 +149,21 @@ ModbusException RegisterMap::ReadMqttInput(std::uint16_t addr, std::uint16_t cou
 
 ModbusException RegisterMap::ReadInput(std::uint16_t addr, std::uint16_t count,
                                        std::uint16_t* out) {
-  if (count != 0 && addr >= kInMqttFirst &&
-      static_cast<std::uint32_t>(addr) + count <= std::uint32_t{kInMqttFirst} + kInMqttCount) {
-    return ReadMqttInput(addr, count, out);
+  const std::uint32_t end = static_cast<std::uint32_t>(addr) + count;
+  if (count == 0 || end > kInputAddressSpan) return ModbusException::kIllegalDataAddress;
+  if (addr < kInputRegisterCount) {
+    const auto in_image =
+        static_cast<std::uint16_t>(std::min<std::uint32_t>(end, kInputRegisterCount) - addr);
+    const ModbusException e = ReadSampleInput(addr, in_image, out);
+    if (e != ModbusException::kNone || in_image == count) return e;
+    return ReadMqttInput(kInMqttFirst, static_cast<std::uint16_t>(count - in_image),
+                         out + in_image);
   }
-  if (count == 0 || static_cast<std::uint32_t>(addr) + count > kInputRegisterCount) {
-    return ModbusException::kIllegalDataAddress;
-  }
+  return ReadMqttInput(addr, count, out);
+}
+
+ModbusException RegisterMap::ReadSampleInput(std::uint16_t addr, std::uint16_t count,
+                                             std::uint16_t* out) {
   DeviceSample d{};
   // The writer may be preempted in the middle of a publication (odd sequence): let it run
   // rather than spinning. Only a writer stuck for 1000 scheduler rounds gives exception 04.
@@ -195,7 +211,9 @@ ModbusException RegisterMap::ReadHolding(std::uint16_t addr, std::uint16_t count
         v = settings_.gravity_comp ? 1 : 0;
         break;
       default:
-        if (HoldingReserved(a)) {
+        if (HoldingHealth(a)) {
+          v = ReadHealthHolding(settings_, a);
+        } else if (HoldingReserved(a)) {
           v = 0;
         } else if (InGravity(a)) {
           v = gravity_regs_[a - kHoldGravity];
@@ -267,7 +285,11 @@ ModbusException RegisterMap::WriteHolding(std::uint16_t addr, const std::uint16_
         }
         next.gravity_comp = v == 1;
         break;
-      default:  // 5 … 9, 29 reserved, 10 … 21 tool transform, 22 … 27 gravity, 30 … 41 mount
+      default:  // reserved, 10 … 21 tool transform, 22 … 27 gravity, 30 … 41 mount, 50 … 79 health
+        if (HoldingHealth(a)) {  // not protected: thresholds and commissioning are the PLC's
+          if (!WriteHealthHolding(a, v, &next)) return ModbusException::kIllegalDataValue;
+          break;
+        }
         if (HoldingReserved(a)) {
           if (v != 0) return ModbusException::kIllegalDataValue;
           break;

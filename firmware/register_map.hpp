@@ -11,9 +11,14 @@
 namespace ftstack::fw {
 
 inline constexpr std::uint16_t kMapVersion = 3;
-inline constexpr std::uint16_t kInputRegisterCount = 85;  ///< input registers 0 … 84
-/// Holding 0 … 41: 5 … 9 and 29 reserved.
-inline constexpr std::uint16_t kHoldingRegisterSpan = 42;
+/// Input registers 0 … 199 (the sample's image): 81 … 99 reserved, 100 … 199 the health watch
+/// (health_registers.hpp); the MQTT block 200 … 209 follows (MqttInputRegister).
+inline constexpr std::uint16_t kInputRegisterCount = 200;
+/// Input registers 0 … 84, map version 2's image: one read covers it (a Modbus read carries at
+/// most 125 registers; the whole v3 image takes two).
+inline constexpr std::uint16_t kInputRegistersV2 = 85;
+/// Holding 0 … 79: 5 … 9, 29 and 42 … 49 reserved; 50 … 79 the health watch.
+inline constexpr std::uint16_t kHoldingRegisterSpan = 80;
 
 /// Input register addresses (0-based protocol addresses).
 enum InputRegister : std::uint16_t {
@@ -36,6 +41,7 @@ enum InputRegister : std::uint16_t {
   kInPayloadMass = 77,     ///< float32 kg, payload of gravity compensation (0: none). Map v2
   kInPayloadCrc = 79,      ///< uint32, CRC-32 of the payload file (0: none). Map v2
   kInReserved81 = 81,      ///< 81 … 84 reserved, read 0. Map v2
+  kInReserved85 = 85,      ///< 85 … 99 reserved, read 0. Map v3
 };
 
 /// The MQTT block of input registers, 200–209 (map v3): a second range of the input table.
@@ -48,9 +54,10 @@ enum MqttInputRegister : std::uint16_t {
   kInMqttReserved207 = 207,  ///< 207 … 209 reserved, read 0
 };
 inline constexpr std::uint16_t kInMqttCount = 10;
-/// Input addresses 0 … kInputAddressSpan − 1 hold every input block (the server's table size);
-/// those between blocks answer exception 02.
+/// Input addresses 0 … kInputAddressSpan − 1: the sample image followed by the MQTT block (the
+/// server's table size).
 inline constexpr std::uint16_t kInputAddressSpan = kInMqttFirst + kInMqttCount;
+static_assert(kInMqttFirst == kInputRegisterCount, "the MQTT block follows the sample image");
 
 /// Holding register addresses.
 enum HoldingRegister : std::uint16_t {
@@ -64,6 +71,7 @@ enum HoldingRegister : std::uint16_t {
   kHoldGravityComp = 28,  ///< 0 off, 1 on (needs a payload). Map v2
   kHoldReserved29 = 29,   ///< reserved, reads 0. Map v2
   kHoldMount = 30,  ///< float32 × 6 mount transform (same layout), protected, 30 … 41. Map v2
+  kHoldReserved42 = 42,  ///< 42 … 49 reserved, read 0. Map v3
 };
 
 /// Values of the command register.
@@ -115,15 +123,17 @@ class RegisterMap {
  public:
   explicit RegisterMap(Device& device);
 
-  /// Function 04. 02 when [addr, addr+count) leaves 0 … 84 or 200 … 209; reserved 81 … 84 and
-  /// 207 … 209 read 0.
+  /// Function 04. 02 when [addr, addr+count) leaves 0 … 209 (a read may span the main and the
+  /// MQTT block); reserved 81 … 99, 190 … 199 and 207 … 209 read 0.
   [[nodiscard]] ModbusException ReadInput(std::uint16_t addr, std::uint16_t count,
                                           std::uint16_t* out);
-  /// Function 03. 02 when any address is outside 0 … 41; reserved 5 … 9 and 29 read 0.
+  /// Function 03. 02 when any address is outside 0 … 79; reserved 5 … 9, 29, 42 … 49 and 60 … 79
+  /// read 0.
   [[nodiscard]] ModbusException ReadHolding(std::uint16_t addr, std::uint16_t count,
                                             std::uint16_t* out);
   /// Functions 06 and 16. 02 for an address outside the map; 03 for a value out of range, an
-  /// unknown command, a non-zero value in a reserved register (5–9, 29), a protected register (3,
+  /// unknown command, a non-zero value in a reserved register (5–9, 29, 42–49, 60–79), a health
+  /// threshold (51–59) outside its range, a protected register (3,
   /// 10–21, 30–41) while locked, a write covering only one half of a float (10–27, 30–41), a
   /// gravity component that is not finite or beyond ±20 m/s², or gravity compensation on (28 = 1)
   /// without a payload. On any exception nothing changes.
@@ -138,6 +148,9 @@ class RegisterMap {
   void SetMqttCounters(const MqttCounters* counters) { mqtt_ = counters; }
 
  private:
+  /// Input registers 0 … kInputRegisterCount − 1 from the latest published sample.
+  [[nodiscard]] ModbusException ReadSampleInput(std::uint16_t addr, std::uint16_t count,
+                                                std::uint16_t* out);
   [[nodiscard]] ModbusException ReadMqttInput(std::uint16_t addr, std::uint16_t count,
                                               std::uint16_t* out) const;
 

@@ -259,10 +259,45 @@ nlohmann::json MakeTruth(const RecordRequest& req, const ComposeInput& in,
 
 }  // namespace
 
+ComposeSetup SetUpCompose(const SensorModel& model, LoadProfile& profile, double rate_hz,
+                          const std::vector<EffectSpec>& specs, std::uint64_t seed) {
+  const Wrench rated = model.rated();
+  const auto rows = static_cast<std::size_t>(std::floor(profile.duration_s() * rate_hz + 1e-9)) + 1;
+  ComposeSetup setup;
+  ComposeInput& in = setup.in;
+  in.model = &model;
+  in.profile = &profile;
+  in.rated = rated;
+  in.t_s.resize(rows);
+  for (std::size_t i = 0; i < rows; ++i) in.t_s[i] = static_cast<double>(i) / rate_hz;
+
+  EffectContext ctx;
+  ctx.channels = model.channel_count();
+  ctx.rated = rated;
+  ctx.sensitivity = model.Sensitivity();
+  ctx.duration_s = in.t_s.back();
+  ctx.rate_hz = rate_hz;
+  ctx.t0_c = profile.TemperatureAt(0.0);
+  ctx.seed = seed;
+  for (std::size_t i = 0; i < specs.size(); ++i) {
+    setup.effects.push_back(ResolveEffect(specs[i], ctx, static_cast<int>(i)));
+  }
+  for (const auto& e : setup.effects) {
+    if (e.kind == EffectKind::kOverloadShift) InsertOverload(e, profile, rated);
+  }
+  in.temp_c.resize(rows);
+  for (std::size_t i = 0; i < rows; ++i) in.temp_c[i] = profile.TemperatureAt(in.t_s[i]);
+  return setup;
+}
+
+Eigen::MatrixXd ComposeWithEffects(ComposeSetup* setup) {
+  DefaultSaturationLimits(Compose({}, setup->in), &setup->effects);
+  return Compose(setup->effects, setup->in);
+}
+
 RecordResult MakeRecording(const RecordRequest& req) {
   if (!req.sensor.model) throw std::invalid_argument("record: no sensor model");
   const SensorModel& model = *req.sensor.model;
-  const int n = model.channel_count();
   const Wrench rated = model.rated();
   const double noise = CheckedNoise(req);
 
@@ -277,29 +312,9 @@ RecordResult MakeRecording(const RecordRequest& req) {
                                 " rows: choose --duration-s and --rate-hz for 2 … 2e7 rows");
   }
 
-  ComposeInput in;
-  in.model = &model;
-  in.profile = &profile;
-  in.rated = rated;
-  in.t_s.resize(rows);
-  for (std::size_t i = 0; i < rows; ++i) in.t_s[i] = static_cast<double>(i) / rate;
-
-  EffectContext ctx;
-  ctx.channels = n;
-  ctx.rated = rated;
-  ctx.sensitivity = model.Sensitivity();
-  ctx.duration_s = in.t_s.back();
-  ctx.rate_hz = rate;
-  ctx.t0_c = profile.TemperatureAt(0.0);
-  ctx.seed = req.seed;
-  for (std::size_t i = 0; i < req.effects.size(); ++i) {
-    res.effects.push_back(ResolveEffect(req.effects[i], ctx, static_cast<int>(i)));
-  }
-  for (const auto& e : res.effects) {
-    if (e.kind == EffectKind::kOverloadShift) InsertOverload(e, profile, rated);
-  }
-  in.temp_c.resize(rows);
-  for (std::size_t i = 0; i < rows; ++i) in.temp_c[i] = profile.TemperatureAt(in.t_s[i]);
+  ComposeSetup setup = SetUpCompose(model, profile, rate, req.effects, req.seed);
+  const ComposeInput& in = setup.in;
+  res.effects = std::move(setup.effects);
 
   const Eigen::MatrixXd sim = Compose({}, in);
   DefaultSaturationLimits(sim, &res.effects);

@@ -39,6 +39,21 @@ struct RecordResult {
 /// SensorDescriptionError or std::invalid_argument with a one-line reason.
 [[nodiscard]] RecordResult MakeRecording(const RecordRequest& request);
 
+/// What Compose needs for `profile` sampled at `rate_hz` from 0 to its duration, with `specs`
+/// resolved against `model` (defaults filled in; the overloads an overload_shift needs inserted
+/// into `profile`). The input points at `model` and `profile`: they must outlive it.
+struct ComposeSetup {
+  ComposeInput in;
+  std::vector<Effect> effects;
+};
+[[nodiscard]] ComposeSetup SetUpCompose(const SensorModel& model, LoadProfile& profile,
+                                        double rate_hz, const std::vector<EffectSpec>& specs,
+                                        std::uint64_t seed);
+
+/// The bridge outputs (N × rows, mV/V, noise-free) with the set-up's effects, as MakeRecording
+/// composes its real recording (saturation limits defaulted from the model's prediction).
+[[nodiscard]] Eigen::MatrixXd ComposeWithEffects(ComposeSetup* setup);
+
 /// Parses several --effect arguments (see ParseEffectSpec).
 [[nodiscard]] std::vector<EffectSpec> ParseEffects(const std::vector<std::string>& texts);
 

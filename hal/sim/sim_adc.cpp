@@ -56,8 +56,10 @@ Status SimAdc::DoWaitDataReady(std::uint32_t timeout_us) {
     return Status::kTimeout;
   }
   if (params_.realtime) {
+    const double speed = params_.speed > 0 ? params_.speed : 1.0;
     const std::int64_t due_ns =
-        start_ns_ + static_cast<std::int64_t>(index_ * 1000000000ULL / info_.rate_hz);
+        start_ns_ +
+        static_cast<std::int64_t>(static_cast<double>(index_) * 1e9 / (info_.rate_hz * speed));
     const std::int64_t now_ns = MonotonicNs();
     if (due_ns > now_ns + std::int64_t{timeout_us} * 1000) {
       SleepUntilNs(now_ns + std::int64_t{timeout_us} * 1000);

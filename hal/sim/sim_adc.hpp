@@ -39,6 +39,7 @@ struct SimAdcParams {
   double noise_rms_mvv = 1.0e-4;  ///< input-referred white noise per channel, mV/V RMS
   std::uint64_t seed = 1;         ///< noise seed: equal seeds give equal sample streams
   bool realtime = false;          ///< pace WaitDataReady to the wall clock (false: virtual time)
+  double speed = 1.0;             ///< with realtime: simulated seconds per wall-clock second (> 0)
   /// Operating point the noise figure belongs to (a converter model's gain and data rate, see
   /// sim/adc_models.hpp). 0 accepts any; otherwise Configure rejects another value with
   /// kInvalidArgument, so the noise of the counts always matches the configuration.

@@ -178,5 +178,39 @@ TEST(Core, InputsBeyondTheRailsAreClampedAndFlagged) {
   EXPECT_EQ(y, y_rail);
 }
 
+TEST(Core, PoweredUpUnderLoadIsSaturationNotABridgeFault) {
+  // The first sample already has bridges 0, 2 and 4 at the lower rail (a large Fz, as the
+  // built-in sensor under 900 N): a load, not an open gauge.
+  WrenchCore core;
+  core.SetCalibration(DiagonalCal(100.0));
+  core.SetLimits(CoreLimits{10, 4});
+  hal::AdcSample s = Sample(1000, 6);
+  for (const int c : {0, 2, 4}) {
+    s.counts[c] = -(1 << 23);
+    s.flags[c] = hal::kChannelSaturated;
+  }
+  CoreOutput out{};
+  for (int i = 0; i < 20; ++i) {
+    s.counts[1] += 1;
+    core.Process(s, false, out);
+    EXPECT_FALSE(out.status & kStatusBridgeFault) << i;
+    EXPECT_TRUE(out.status & kStatusSaturated) << i;
+    EXPECT_TRUE(out.saturated_by_load) << i;
+  }
+  // One channel alone at a rail from the first sample: an open gauge (bridge fault).
+  WrenchCore lone;
+  lone.SetCalibration(DiagonalCal(100.0));
+  lone.SetLimits(CoreLimits{10, 4});
+  hal::AdcSample one = Sample(1000, 6);
+  one.counts[3] = (1 << 23) - 1;
+  one.flags[3] = hal::kChannelSaturated;
+  for (int i = 0; i < 4; ++i) {
+    one.counts[0] += 1;
+    lone.Process(one, false, out);
+  }
+  EXPECT_TRUE(out.status & kStatusBridgeFault);
+  EXPECT_FALSE(out.saturated_by_load);
+}
+
 }  // namespace
 }  // namespace ftstack::fw

@@ -351,8 +351,10 @@ TEST_F(RegisterMapTest, AddressesOutsideTheMapGiveException02) {
   StartDevice();
   std::array<std::uint16_t, 125> buf{};
   EXPECT_EQ(map_->ReadInput(84, 1, buf.data()), ModbusException::kNone);
-  EXPECT_EQ(map_->ReadInput(84, 2, buf.data()), ModbusException::kIllegalDataAddress);
-  EXPECT_EQ(map_->ReadInput(85, 1, buf.data()), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(map_->ReadInput(199, 1, buf.data()), ModbusException::kNone);  // map v3: 0 … 209
+  EXPECT_EQ(map_->ReadInput(209, 1, buf.data()), ModbusException::kNone);
+  EXPECT_EQ(map_->ReadInput(209, 2, buf.data()), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(map_->ReadInput(210, 1, buf.data()), ModbusException::kIllegalDataAddress);
   EXPECT_EQ(map_->ReadHolding(0, 5, buf.data()), ModbusException::kNone);
   EXPECT_EQ(map_->ReadHolding(10, 12, buf.data()), ModbusException::kNone);
   // 5 … 9 are reserved, not a hole: a PLC's block read of 0 … 15 or 0 … 21 works.
@@ -364,13 +366,13 @@ TEST_F(RegisterMapTest, AddressesOutsideTheMapGiveException02) {
     EXPECT_EQ(Write(a, {1}), ModbusException::kIllegalDataValue);
     EXPECT_EQ(Write(a, {0}), ModbusException::kNone);
   }
-  EXPECT_EQ(map_->ReadHolding(0, 42, buf.data()), ModbusException::kNone);  // map v2: 0 … 41
-  EXPECT_EQ(map_->ReadHolding(41, 2, buf.data()), ModbusException::kIllegalDataAddress);
-  EXPECT_EQ(Write(42, {0}), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(map_->ReadHolding(0, 80, buf.data()), ModbusException::kNone);  // map v3: 0 … 79
+  EXPECT_EQ(map_->ReadHolding(79, 2, buf.data()), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(Write(80, {0}), ModbusException::kIllegalDataAddress);
   EXPECT_EQ(Write(65535, {0}), ModbusException::kIllegalDataAddress);
 }
 
-TEST_F(RegisterMapTest, MqttBlockReadsThePublishersCountersAndNothingBetweenBlocks) {
+TEST_F(RegisterMapTest, MqttBlockReadsThePublishersCountersAlsoInAReadAcrossBlocks) {
   StartDevice();
   std::array<std::uint16_t, 125> buf{};
   buf.fill(0xFFFF);
@@ -387,8 +389,16 @@ TEST_F(RegisterMapTest, MqttBlockReadsThePublishersCountersAndNothingBetweenBloc
   for (std::size_t i = 0; i < want.size(); ++i) EXPECT_EQ(buf[i], want[i]) << 200 + i;
   ASSERT_EQ(map_->ReadInput(205, 2, buf.data()), ModbusException::kNone);
   EXPECT_EQ(UnpackU32(buf.data()), 65536u);
-  for (const auto& [addr, count] : std::vector<std::pair<int, int>>{
-           {85, 1}, {199, 1}, {199, 2}, {209, 2}, {210, 1}, {84, 120}, {150, 60}}) {
+  // A read across the sample image and the MQTT block: the health block's last registers (read
+  // alone as the reference) followed by the counters.
+  std::array<std::uint16_t, 125> alone{};
+  ASSERT_EQ(map_->ReadInput(190, 10, alone.data()), ModbusException::kNone);
+  buf.fill(0xFFFF);
+  ASSERT_EQ(map_->ReadInput(190, 20, buf.data()), ModbusException::kNone);
+  for (std::size_t i = 0; i < 10; ++i) EXPECT_EQ(buf[i], alone[i]) << 190 + i;
+  for (std::size_t i = 0; i < want.size(); ++i) EXPECT_EQ(buf[10 + i], want[i]) << 200 + i;
+  for (const auto& [addr, count] :
+       std::vector<std::pair<int, int>>{{209, 2}, {210, 1}, {150, 61}, {0, 211}}) {
     EXPECT_EQ(map_->ReadInput(static_cast<std::uint16_t>(addr), static_cast<std::uint16_t>(count),
                               buf.data()),
               ModbusException::kIllegalDataAddress)

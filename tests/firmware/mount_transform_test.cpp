@@ -112,7 +112,7 @@ TEST_F(RegisterMapTest, MountTransformWrittenOverModbusReportsTheBaseFrame) {
   std::uint16_t h[12] = {};
   ASSERT_EQ(map_->ReadHolding(kHoldMount, 12, h), ModbusException::kNone);
   EXPECT_FLOAT_EQ(UnpackFloat32(&h[10]), 90.0f);
-  EXPECT_EQ(map_->ReadHolding(42, 1, h), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(map_->ReadHolding(kHoldingRegisterSpan, 1, h), ModbusException::kIllegalDataAddress);
   EXPECT_FLOAT_EQ(UnpackFloat32(&r[kInPeaks + 2]), 0.0f);  // peaks stay in the sensor frame
 }
 

@@ -220,6 +220,10 @@ const std::vector<UnitRule>& UnitRules() {
                                               {"kg", "_kg", "kg"},
                                               {"m/s²", "_mps2", "m/s²"},
                                               {"samples", "", "samples"},
+                                              {"%", "_pct", "%"},
+                                              {"%/K", "_pct_per_k", "%/K"},
+                                              {"Hz", "_hz", "Hz"},
+                                              {"s", "_s", "s"},
                                               {"", "", ""}};
   return rules;
 }
@@ -260,7 +264,29 @@ std::map<std::string, Expected> ReferenceInputValues(
   e["timestamp_wraps"] = {0, 0, "uint16"};
   e["payload_mass_kg"] = {2.375, 2.375 * 6e-8, "float32"};  // the payload CodeCheck loads
   e["payload_crc32"] = {static_cast<double>(0x0BADC0DEu), 0, "uint32"};
-  for (int a = 81; a <= 84; ++a) e["reserved_" + std::to_string(a)] = {0, 0, "uint16"};
+  for (int a = 81; a <= 99; ++a) e["reserved_" + std::to_string(a)] = {0, 0, "uint16"};
+  for (int a = 196; a <= 199; ++a) e["reserved_" + std::to_string(a)] = {0, 0, "uint16"};
+  // The health watch three samples after start (the fixture has a rated range: it runs): normal,
+  // nothing found, nothing measured yet.
+  for (const char* tag :
+       {"health_state", "health_findings", "retare_suggested", "retare_reason", "finding1_cause",
+        "finding2_cause", "finding3_cause", "finding4_cause", "tare_count", "cycles_Fx",
+        "cycles_Fy", "cycles_Fz", "cycles_Mx", "cycles_My", "cycles_Mz"}) {
+    e[tag] = {0, 0, "uint16"};
+  }
+  e["health_watch_on"] = {1, 0, "uint16"};
+  for (const char* tag : {"zero_points", "tare_age_s"}) e[tag] = {0, 0, "uint32"};
+  for (const char* tag : {"thermal_zero_pct_per_k", "mains50_pct", "mains60_pct", "noise_ratio",
+                          "ring_hz", "ring_ref_hz", "creep_pct", "tare_temp_c"}) {
+    e[tag] = {0, 0, "float32"};
+  }
+  for (std::size_t a = 0; a < 6; ++a) {
+    const std::string axis = std::string(axes[a]) + (a < 3 ? "_n" : "_nm");
+    e["zero_" + axis] = {0, 0, "float32"};
+    for (int k = 1; k <= 4; ++k) {
+      e["finding" + std::to_string(k) + "_err_" + axis] = {0, 0, "float32"};
+    }
+  }
   // The MQTT publisher's counters CodeCheck sets (map v3).
   e["mqtt_connected"] = {1, 0, "uint16"};
   e["mqtt_published"] = {4000000000.0, 0, "uint32"};
@@ -329,7 +355,7 @@ class CodeCheck : public maptest::RegisterMapTest {
     }
   }
 
-  /// The input tags tile the code's blocks, 0 … 84 and 200 … 209, in order and without gaps.
+  /// The input tags tile the code's blocks, 0 … 199 and 200 … 209, in order and without gaps.
   static void CheckInputLayout(const std::vector<Tag>& tags, std::vector<std::string>* d) {
     int next = 0;
     for (const Tag& t : tags) {
@@ -380,7 +406,7 @@ class CodeCheck : public maptest::RegisterMapTest {
       if (t.table != "holding") continue;
       for (int i = 0; i < t.registers; ++i) covered.insert(t.address + i);
     }
-    for (int a = 0; a < 50; ++a) {
+    for (int a = 0; a < 100; ++a) {
       std::uint16_t v = 0;
       const bool readable =
           map_->ReadHolding(static_cast<std::uint16_t>(a), 1, &v) == ModbusException::kNone;
@@ -432,7 +458,7 @@ class CodeCheck : public maptest::RegisterMapTest {
       Unlock();
       if (WriteValue(t, v) != ModbusException::kNone) {
         d->push_back(t.tag + ": " + std::to_string(v) + " (in range) refused");
-      } else if (t.tag != "command" && t.tag != "unlock" &&
+      } else if (t.tag != "command" && t.tag != "unlock" && t.tag != "health_command" &&
                  std::fabs(ReadValue(t) - v) > std::fabs(v) * 1e-6) {
         d->push_back(t.tag + ": " + std::to_string(v) + " written, " +
                      std::to_string(ReadValue(t)) + " read back");
@@ -465,7 +491,9 @@ TEST(RegisterMapTable, MarkdownAndCsvListTheSameTags) {
   const auto md = ParseMarkdown(ReadText("docs/spec/modbus-map.md"), &errors);
   const auto csv = ParseCsv(ReadText("docs/spec/modbus-map.csv"), &errors);
   EXPECT_TRUE(errors.empty()) << Join(errors);
-  EXPECT_EQ(md.size(), 81u);  // 54 input tags (47 + 7 MQTT), 27 holding (16 + 5 gravity + 6 mount)
+  // 47 + 75 + 7 input tags (map v3: health, MQTT), 27 + 38 holding tags (16 + 5 gravity + 6
+  // mount; health)
+  EXPECT_EQ(md.size(), 194u);
   const auto diffs = CompareTables(md, csv);
   EXPECT_TRUE(diffs.empty()) << Join(diffs);
 }

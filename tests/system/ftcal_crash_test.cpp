@@ -93,13 +93,13 @@ void ExpectFtdStartsWith(const std::string& dir, char slot, std::uint32_t crc,
   ASSERT_EQ(modbus_connect(ctx), 0) << what;
   std::uint16_t r[fw::kInputRegisterCount] = {};
   int rc = -1;
-  for (int i = 0; i < 200 && rc != static_cast<int>(fw::kInputRegisterCount); ++i) {
-    rc = modbus_read_input_registers(ctx, 0, fw::kInputRegisterCount, r);
+  for (int i = 0; i < 200 && rc != static_cast<int>(fw::kInputRegistersV2); ++i) {
+    rc = modbus_read_input_registers(ctx, 0, fw::kInputRegistersV2, r);
     if (rc < 0) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   modbus_close(ctx);
   modbus_free(ctx);
-  ASSERT_EQ(rc, static_cast<int>(fw::kInputRegisterCount)) << what;
+  ASSERT_EQ(rc, static_cast<int>(fw::kInputRegistersV2)) << what;
   EXPECT_EQ(r[fw::kInCalSlot], slot == 'A' ? 0 : 1) << what << "\n" << ftd.Stderr();
   EXPECT_EQ(fw::UnpackU32(&r[fw::kInCalCrc]), crc) << what;
   EXPECT_EQ(r[fw::kInStatus] & fw::kStatusCalInvalid, 0) << what;

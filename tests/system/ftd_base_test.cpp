@@ -57,8 +57,8 @@ TEST(FtdBase, EmergencyStopOfABaseProfileIsOneOverloadEvent) {
   ASSERT_EQ(modbus_connect(c), 0);
   std::array<std::uint16_t, fw::kInputRegisterCount> r{};
   auto read = [&] {
-    return modbus_read_input_registers(c, 0, fw::kInputRegisterCount, r.data()) ==
-           fw::kInputRegisterCount;
+    return modbus_read_input_registers(c, 0, fw::kInputRegistersV2, r.data()) ==
+           fw::kInputRegistersV2;
   };
   auto wait_sequence = [&](std::uint32_t n) {
     for (int i = 0; i < 20000; ++i) {

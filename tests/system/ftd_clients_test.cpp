@@ -14,33 +14,13 @@
 #include "sim/ideal_calibration.hpp"
 #include "tests/system/builtin_adc.hpp"
 #include "tests/system/ftd_process.hpp"
+#include "tests/system/mbpoll.hpp"
 
 namespace ftstack {
 namespace {
 
-/// Runs a shell command, returns its exit status and combined output.
-int RunShell(const std::string& cmd, std::string* output) {
-  std::FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  if (p == nullptr) return -1;
-  char buf[512];
-  output->clear();
-  while (std::fgets(buf, sizeof(buf), p) != nullptr) *output += buf;
-  const int status = pclose(p);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-/// mbpoll's "[ref]: value" lines.
-std::map<int, double> ParseMbpoll(const std::string& out) {
-  std::map<int, double> v;
-  std::istringstream in(out);
-  std::string line;
-  while (std::getline(in, line)) {
-    int ref = 0;
-    double value = 0;
-    if (std::sscanf(line.c_str(), "[%d]: %lf", &ref, &value) == 2) v[ref] = value;
-  }
-  return v;
-}
+using test::ParseMbpoll;
+using test::RunShell;
 
 /// The mbpoll command lines of the README (text before a '#' comment).
 std::vector<std::string> ReadmeMbpollLines(const std::string& mode) {
@@ -137,7 +117,7 @@ TEST(FtdClients, ReadmeMbpollExamplesWork) {
   modbus_free(c);
   // An illegal address: mbpoll exits 1 and names the exception.
   std::string out;
-  EXPECT_EQ(RunShell("mbpoll -m tcp " + port + " -a 1 -t 3 -r 86 -c 1 -1 127.0.0.1", &out), 1);
+  EXPECT_EQ(RunShell("mbpoll -m tcp " + port + " -a 1 -t 3 -r 1001 -c 1 -1 127.0.0.1", &out), 1);
   EXPECT_NE(out.find("Illegal data address"), std::string::npos) << out;
   EXPECT_EQ(RunShell("mbpoll -m tcp " + port + " -a 1 -t 4 -r 2 127.0.0.1 0", &out), 1);
   EXPECT_NE(out.find("Illegal data value"), std::string::npos) << out;
@@ -215,14 +195,14 @@ TEST(FtdClients, RtuOverPtyPairServesTheMapAndSurvivesGarbage) {
   modbus_set_response_timeout(c, 1, 0);
   ASSERT_EQ(modbus_connect(c), 0);
   std::uint16_t r[fw::kInputRegisterCount] = {};
-  ASSERT_EQ(modbus_read_input_registers(c, 0, fw::kInputRegisterCount, r), fw::kInputRegisterCount);
+  ASSERT_EQ(modbus_read_input_registers(c, 0, fw::kInputRegistersV2, r), fw::kInputRegistersV2);
   EXPECT_EQ(r[fw::kInMapVersion], 3);  // docs/spec/modbus-map.md
   EXPECT_EQ(r[fw::kInBridgeCount], 6);
   for (std::size_t a = 0; a < 6; ++a) {
     EXPECT_NEAR(fw::UnpackFloat32(&r[fw::kInWrenchFloat + 2 * a]), applied[a], 5 * sigma[a] + 1e-3)
         << "axis " << a;
   }
-  EXPECT_EQ(modbus_read_input_registers(c, fw::kInputRegisterCount, 1, r), -1);
+  EXPECT_EQ(modbus_read_input_registers(c, fw::kInputAddressSpan, 1, r), -1);
   EXPECT_EQ(errno, EMBXILADD);
   EXPECT_EQ(modbus_write_register(c, fw::kHoldCalSlot, 1), -1);
   EXPECT_EQ(errno, EMBXILVAL);

@@ -171,9 +171,9 @@ TEST(FtdModbus, ExceptionsAndProtectedWritesOverTheWire) {
   ASSERT_TRUE(c.connected());
   std::array<std::uint16_t, 130> r{};
   int err = 0;
-  EXPECT_EQ(c.Input(fw::kInputRegisterCount, 1, r.data(), &err), -1);
+  EXPECT_EQ(c.Input(fw::kInputAddressSpan, 1, r.data(), &err), -1);
   EXPECT_EQ(err, EMBXILADD);
-  EXPECT_EQ(c.Input(fw::kInputRegisterCount - 4, 5, r.data(), &err), -1);
+  EXPECT_EQ(c.Input(fw::kInputAddressSpan - 4, 5, r.data(), &err), -1);
   EXPECT_EQ(err, EMBXILADD);
   EXPECT_EQ(c.Holding(fw::kHoldingRegisterSpan, 1, r.data(), &err), -1);  // map v2: 0 … 41
   EXPECT_EQ(err, EMBXILADD);
@@ -236,7 +236,7 @@ TEST(FtdModbus, OverloadPeaksAndToolTransformEndToEnd) {
   const Expected e = DeriveExpected();
   ASSERT_TRUE(c.WaitSamples(200));
   std::array<std::uint16_t, fw::kInputRegisterCount> r{};
-  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
+  ASSERT_EQ(c.Input(0, fw::kInputRegistersV2, r.data()), fw::kInputRegistersV2);
   EXPECT_NE(r[fw::kInStatus] & fw::kStatusOverload, 0);
   // One continuing overload is one event, not one per sample.
   EXPECT_EQ(UnpackU32(&r[fw::kInOverloadEvents]), 1u);
@@ -248,7 +248,7 @@ TEST(FtdModbus, OverloadPeaksAndToolTransformEndToEnd) {
   // Clearing while the overload continues: the counter restarts at the ongoing event.
   ASSERT_EQ(c.Write(fw::kHoldCommand, fw::kCmdClearPeaks), 1);
   ASSERT_TRUE(c.WaitSamples(5));
-  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
+  ASSERT_EQ(c.Input(0, fw::kInputRegistersV2, r.data()), fw::kInputRegistersV2);
   EXPECT_EQ(UnpackU32(&r[fw::kInOverloadEvents]), 1u);
   EXPECT_LT(UnpackFloat32(&r[fw::kInPeaks + 4]),
             450.0 + kSigmas * e.sigma_si[2] + e.fixed_error_si[2]);
@@ -340,7 +340,7 @@ TEST(FtdModbus, CalibrationSlotsAndTheirCrc) {
   ASSERT_EQ(c.Write(fw::kHoldFilterLength, 256), 1);
   ASSERT_TRUE(c.WaitSamples(300));
   std::array<std::uint16_t, fw::kInputRegisterCount> r{};
-  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
+  ASSERT_EQ(c.Input(0, fw::kInputRegistersV2, r.data()), fw::kInputRegistersV2);
   EXPECT_EQ(r[fw::kInCalSlot], 0);
   EXPECT_EQ(UnpackU32(&r[fw::kInCalCrc]), FileCrcField(a));
   const double tol = kSigmas * e.sigma_si[2] / 16.0 + e.fixed_error_si[2];
@@ -348,7 +348,7 @@ TEST(FtdModbus, CalibrationSlotsAndTheirCrc) {
   ASSERT_EQ(c.Write(fw::kHoldUnlock, fw::kUnlockKey), 1);
   ASSERT_EQ(c.Write(fw::kHoldCalSlot, 1), 1);
   ASSERT_TRUE(c.WaitSamples(300));  // the switch restarts the filter
-  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
+  ASSERT_EQ(c.Input(0, fw::kInputRegistersV2, r.data()), fw::kInputRegistersV2);
   EXPECT_EQ(r[fw::kInCalSlot], 1);
   EXPECT_EQ(UnpackU32(&r[fw::kInCalCrc]), FileCrcField(b));
   EXPECT_NE(FileCrcField(a), FileCrcField(b));
@@ -371,7 +371,7 @@ TEST(FtdModbus, GarbageAndHalfFramesDoNotDisturbOtherClients) {
     Client c(ftd.port());
     std::array<std::uint16_t, 74> r{};
     while (!stop) {
-      if (c.Input(0, 74, r.data()) == 74 && r[0] == 3) {
+      if (c.Input(0, 74, r.data()) == 74 && r[0] == fw::kMapVersion) {
         ++ok;
       } else {
         if (failed++ == 0) {
@@ -638,14 +638,14 @@ TEST(FtdModbus, OverloadUnderTareSeesTheLoadOnTheBody) {
   ASSERT_EQ(c.Write(fw::kHoldCommand, fw::kCmdTare), 1);
   ASSERT_TRUE(wait_sample(2500));
   std::array<std::uint16_t, fw::kInputRegisterCount> r{};
-  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
+  ASSERT_EQ(c.Input(0, fw::kInputRegistersV2, r.data()), fw::kInputRegistersV2);
   ASSERT_NE(r[fw::kInStatus] & fw::kStatusTareActive, 0);
   ASSERT_LT(UnpackU32(&r[fw::kInTimestampUs]), 8000000u) << "the read came after the 380 N hold";
   EXPECT_NEAR(UnpackFloat32(&r[fw::kInWrenchFloat + 4]), 0.0, 1.0);
   EXPECT_EQ(r[fw::kInStatus] & fw::kStatusOverload, 0);  // 95 % of rated
   EXPECT_EQ(UnpackU32(&r[fw::kInOverloadEvents]), 0u);
   ASSERT_TRUE(wait_sample(10000));  // 460 N since 8.2 s
-  ASSERT_EQ(c.Input(0, fw::kInputRegisterCount, r.data()), fw::kInputRegisterCount);
+  ASSERT_EQ(c.Input(0, fw::kInputRegistersV2, r.data()), fw::kInputRegistersV2);
   EXPECT_NEAR(UnpackFloat32(&r[fw::kInWrenchFloat + 4]), 80.0, 1.0);
   EXPECT_NE(r[fw::kInStatus] & fw::kStatusOverload, 0);
   EXPECT_EQ(r[fw::kInStatus] & fw::kStatusBridgeFault, 0);
@@ -674,7 +674,7 @@ TEST(FtdModbus, UnusableCalibrationFilesStillServeAndSayWhy) {
                       std::array<std::uint16_t, fw::kInputRegisterCount>* r) {
     Client c(ftd.port());
     if (!c.WaitSamples(50)) return false;
-    return c.Input(0, fw::kInputRegisterCount, r->data()) == fw::kInputRegisterCount;
+    return c.Input(0, fw::kInputRegistersV2, r->data()) == fw::kInputRegistersV2;
   };
   std::array<std::uint16_t, fw::kInputRegisterCount> r{};
   {  // bad A, good B: runs on B and says so

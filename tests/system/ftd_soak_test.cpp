@@ -81,8 +81,8 @@ void Poll(int port, const std::atomic<bool>& stop, PollerResult* out) {
     if (out->inconsistent++ == 0 && out->first_problem.empty()) out->first_problem = what;
   };
   while (!stop.load()) {
-    if (modbus_read_input_registers(ctx, 0, fw::kInputRegisterCount, r.data()) !=
-        static_cast<int>(fw::kInputRegisterCount)) {
+    if (modbus_read_input_registers(ctx, 0, fw::kInputRegistersV2, r.data()) !=
+        static_cast<int>(fw::kInputRegistersV2)) {
       if (out->errors++ == 0) out->first_problem = modbus_strerror(errno);
       continue;
     }

@@ -98,7 +98,16 @@ void AddOptions(CLI::App& app, Args& a) {
                  "simulated ADC: hold the sampling thread MS ms on every EVERY-th sample, "
                  "EVERY:MS (tests the late-sample counter)");
   app.add_flag("--unpaced", a.unpaced, "run the simulated ADC as fast as possible (benchmarks)");
+  app.add_option("--sim-effect", opt.sim_effects,
+                 "inject NAME[:k=v,...] into the simulated sensor (ftsim record --effect; repeat)");
+  app.add_option("--sim-profile", opt.sim_profile,
+                 "load profile under --sim-effect (ftsim record --profile; default: --sim-wrench)");
+  app.add_option("--sim-span-s", opt.sim_span_s, "span rendered with --sim-effect, s (then holds)")
+      ->check(CLI::Range(1.0, 86400.0));
+  app.add_option("--sim-speed", opt.sim_speed, "simulated seconds per wall-clock second (paced)")
+      ->check(CLI::Range(0.01, 1000.0));
   app.get_option("--sim-wrench")->excludes(app.get_option("--replay"));
+  app.get_option("--sim-effect")->excludes(app.get_option("--replay"));
 }
 
 /// Turns the program's own option texts into daemon options; throws std::invalid_argument.

@@ -1,0 +1,529 @@
+#include "firmware/health_watch.hpp"
+
+#include "firmware/overload.hpp"
+#include "firmware/status_bits.hpp"
+
+namespace ftstack::fw {
+namespace {
+
+constexpr std::int64_t kZeroClamp = std::int64_t{1} << 20;  ///< |zero point| used, LSB
+constexpr std::uint32_t kPointsHalve = 1u << 20;  ///< regression sums halve beyond this many points
+constexpr std::uint32_t kCommissionBlocks = 50;   ///< 5 s of blocks
+constexpr std::int64_t kMinStepBp = 1000;         ///< creep: a load change of ≥ 10 % of rated
+
+[[nodiscard]] std::int64_t Abs(std::int64_t v) { return v < 0 ? -v : v; }
+
+/// log2 of the power of two nearest below `n` (n ≥ 1).
+[[nodiscard]] std::uint8_t Log2Floor(std::uint32_t n) {
+  std::uint8_t k = 0;
+  while ((n >> (k + 1)) != 0) ++k;
+  return k;
+}
+
+[[nodiscard]] std::int32_t Sat32(std::int64_t v) {
+  return v > INT32_MAX ? INT32_MAX : (v < INT32_MIN ? INT32_MIN : static_cast<std::int32_t>(v));
+}
+
+[[nodiscard]] std::int32_t Median3(const std::array<std::int32_t, 3>& v) {
+  const std::int32_t a = v[0], b = v[1], c = v[2];
+  if ((a <= b && b <= c) || (c <= b && b <= a)) return b;
+  if ((b <= a && a <= c) || (c <= a && a <= b)) return a;
+  return c;
+}
+
+}  // namespace
+
+bool HealthWatch::Configure(std::uint32_t rate_hz, const WrenchLsb& rated_lsb) {
+  configured_ = false;
+  if (rate_hz < 100) return false;
+  for (const std::int32_t r : rated_lsb) {
+    if (r <= 0) return false;
+  }
+  rate_ = rate_hz;
+  rated_ = rated_lsb;
+  fast_shift_ = Log2Floor(rate_hz / 10);
+  slow_shift_ = Log2Floor(rate_hz);
+  block_ = rate_hz / 10;
+  inv_sqrt_block_q16_ = (std::int64_t{1} << 16) / ISqrt64(block_);
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    if (!tone50_[r].Configure(50, rate_hz, block_) || !tone60_[r].Configure(60, rate_hz, block_)) {
+      return false;
+    }
+  }
+  capture_stride_ = rate_hz <= 2000 ? 1 : rate_hz / 1000;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    // Turning points beyond 2 % of rated (noise makes none); cycles of 10 % of rated and more.
+    rainflow_[r].Configure(rated_lsb[r] / 50, rated_lsb[r] / 10);
+  }
+  seg_len_ = 2 * rate_hz;
+  configured_ = true;
+  SetThresholds(th_);
+  Clear();
+  Commission();
+  return true;
+}
+
+void HealthWatch::SetThresholds(const HealthThresholds& t) {
+  th_ = t;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    const std::int64_t rated = rated_[r];
+    window_[r] = rated * t.zero_window_bp / 10000;
+    limit_[r] = rated * t.zero_limit_bp / 10000;
+    band_[r] = rated * t.stability_bp / 10000;
+    move_[r] = rated / 100;  // a load change: the raw sample 1 % of rated off the fast filter
+    step_[r] = rated / 20;   // a transient worth capturing: 5 % of rated in one step
+  }
+  stable_samples_ = static_cast<std::uint32_t>(std::uint64_t{rate_} * t.stable_time_ds / 10);
+  ring_ref_mhz_ = t.ring_ref_dhz != 0 ? std::int32_t{t.ring_ref_dhz} * 100 : ring_ref_mhz_;
+}
+
+void HealthWatch::Commission() {
+  commission_blocks_ = kCommissionBlocks;
+  sigma_ref_sum_q8_ = {};
+  sigma_ref_q8_ = {};
+  ring_learned_ = 0;
+  if (th_.ring_ref_dhz == 0) ring_ref_mhz_ = 0;
+}
+
+void HealthWatch::Clear() {
+  active_ = 0;
+  error_ = {};
+  ResetReference(0, false);  // the next sample's temperature becomes the reference
+  ring_measured_ = 0;
+  for (RainflowCounter& c : rainflow_) c.Clear();
+}
+
+void HealthWatch::OnTare(std::int32_t temperature_mdegc, bool has_temperature, bool cleared) {
+  ResetReference(temperature_mdegc, has_temperature);
+  if (cleared) return;
+  tare_sample_ = static_cast<std::uint32_t>(samples_ / rate_);
+  report_.tare_temp_mdegc = has_temperature ? temperature_mdegc : 0;
+  ++report_.tare_count;
+}
+
+void HealthWatch::ResetReference(std::int32_t temperature_mdegc, bool has_temperature) {
+  ref_sample_ = samples_;
+  ref_temp_mdegc_ = temperature_mdegc;
+  ref_has_temp_ = has_temperature;
+  points_ = 0;
+  stt_ = sdd_ = 0;
+  szt_ = {};
+  szd_ = {};
+  szz_ = {};
+  dtemp_min_ = dtemp_max_ = 0;
+  stable_run_ = 0;
+  zero_count_ = 0;
+  zero_sum_ = {};
+  report_.zero_drift_lsb = {};
+  zero_last_ = {};
+  spell_checked_ = false;
+  SetFinding(HealthCause::kZeroDrift, false, {});
+  SetFinding(HealthCause::kThermalZeroDrift, false, {});
+  // The output jumps at a tare: no load change, transient or hold is judged across it.
+  ResetFilters();
+  capturing_ = false;
+  analysing_ = kAxes;
+  creep_phase_ = CreepPhase::kIdle;
+  block_moved_ = true;
+}
+
+void HealthWatch::SetFinding(HealthCause cause, bool on, const WrenchLsb& error) {
+  const std::size_t i = static_cast<std::size_t>(cause) - 1;
+  const std::uint16_t bit = static_cast<std::uint16_t>(1u << i);
+  if (on) {
+    active_ = static_cast<std::uint16_t>(active_ | bit);
+    error_[i] = error;
+  } else {
+    active_ = static_cast<std::uint16_t>(active_ & ~bit);
+    error_[i] = {};
+  }
+}
+
+void HealthWatch::Step(const HealthInput& in) {
+  if (!configured_) return;
+  ++samples_;
+  if (in.untared_valid) {
+    for (std::size_t r = 0; r < kAxes; ++r) rainflow_[r].Add(in.untared[r]);
+  }
+  if (!in.valid) {
+    ResetFilters();
+    stable_run_ = 0;
+    block_moved_ = true;
+    capturing_ = false;
+    creep_phase_ = CreepPhase::kIdle;
+  } else {
+    if (!ref_has_temp_ && in.has_temperature) {
+      ref_temp_mdegc_ = in.temperature_mdegc;
+      ref_has_temp_ = true;
+    }
+    if (!filters_ready_) {
+      for (std::size_t r = 0; r < kAxes; ++r) {
+        fast_q8_[r] = slow_q8_[r] = std::int64_t{in.tared[r]} * 256;
+      }
+      prev_ = in.tared;
+      filters_ready_ = true;
+    }
+    bool stable = true;
+    bool moving = false;
+    WrenchLsb d{};
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      const std::int64_t y_q8 = std::int64_t{in.tared[r]} * 256;
+      fast_q8_[r] += (y_q8 - fast_q8_[r]) >> fast_shift_;
+      slow_q8_[r] += (y_q8 - slow_q8_[r]) >> slow_shift_;
+      stable = stable && Abs(fast_q8_[r] - slow_q8_[r]) <= band_[r] * 256;
+      moving = moving || Abs(y_q8 - fast_q8_[r]) > move_[r] * 256;
+      const std::int64_t diff = std::int64_t{in.tared[r]} - prev_[r];
+      d[r] = static_cast<std::int32_t>(diff > ToneDetector::kMaxDiff    ? ToneDetector::kMaxDiff
+                                       : diff < -ToneDetector::kMaxDiff ? -ToneDetector::kMaxDiff
+                                                                        : diff);
+    }
+    prev_ = in.tared;
+    if (moving) block_moved_ = true;
+    UpdateZero(in, stable && !moving);
+    UpdateBlock(in, d);
+    UpdateRinging(in);
+    UpdateCreep(in, moving);
+  }
+  Publish(in);
+}
+
+void HealthWatch::UpdateZero(const HealthInput& in, bool stable) {
+  bool unloaded = stable;
+  for (std::size_t r = 0; r < kAxes && unloaded; ++r) {
+    unloaded = Abs(fast_q8_[r] >> 8) <= window_[r];
+  }
+  if (!unloaded) {
+    stable_run_ = 0;
+    zero_count_ = 0;
+    zero_sum_ = {};
+    spell_checked_ = false;
+    return;
+  }
+  if (stable_run_ < stable_samples_) {
+    ++stable_run_;
+    return;
+  }
+  for (std::size_t r = 0; r < kAxes; ++r) zero_sum_[r] += in.tared[r];
+  if (++zero_count_ < rate_) return;
+  AddZeroPoint(in);
+  zero_count_ = 0;
+  zero_sum_ = {};
+}
+
+void HealthWatch::AddZeroPoint(const HealthInput& in) {
+  std::array<std::int64_t, kAxes> z{};
+  bool jumped = false;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    z[r] = zero_sum_[r] / static_cast<std::int64_t>(zero_count_);
+    z[r] = z[r] > kZeroClamp ? kZeroClamp : (z[r] < -kZeroClamp ? -kZeroClamp : z[r]);
+    jumped = jumped || Abs(z[r] - zero_last_[r]) * 2 > limit_[r];
+  }
+  // A zero drifts slowly; a spell that starts more than half the limit away from the last zero
+  // is a small load held still (a part in the gripper), not the zero: the whole spell is left out.
+  if (!spell_checked_) {
+    spell_checked_ = true;
+    spell_rejected_ = jumped;
+  }
+  if (spell_rejected_) return;
+  const std::int64_t dt_s = static_cast<std::int64_t>((samples_ - ref_sample_) / rate_);
+  const bool temp = in.has_temperature && ref_has_temp_;
+  const std::int64_t dtemp = temp ? (std::int64_t{in.temperature_mdegc} - ref_temp_mdegc_) / 10 : 0;
+  if (points_ >= kPointsHalve) {  // forget the older half
+    points_ /= 2;
+    stt_ /= 2;
+    sdd_ /= 2;
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      szt_[r] /= 2;
+      szd_[r] /= 2;
+      szz_[r] /= 2;
+    }
+  }
+  ++points_;
+  stt_ += static_cast<Int128>(dt_s) * dt_s;
+  sdd_ += static_cast<Int128>(dtemp) * dtemp;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    zero_last_[r] = z[r];
+    report_.zero_drift_lsb[r] = static_cast<std::int32_t>(z[r]);
+    szt_[r] += static_cast<Int128>(z[r]) * dt_s;
+    szd_[r] += static_cast<Int128>(z[r]) * dtemp;
+    szz_[r] += static_cast<Int128>(z[r]) * z[r];
+  }
+  if (dtemp < dtemp_min_) dtemp_min_ = static_cast<std::int32_t>(dtemp);
+  if (dtemp > dtemp_max_) dtemp_max_ = static_cast<std::int32_t>(dtemp);
+  JudgeZero(in);
+}
+
+void HealthWatch::JudgeZero(const HealthInput& in) {
+  (void)in;
+  bool drift = false;
+  std::int64_t worst_ppm = 0;
+  Int128 explained_temp = 0, explained_time = 0, total = 0;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    drift = drift || Abs(report_.zero_drift_lsb[r]) > limit_[r];
+    total += szz_[r];
+    // Regressions through the reference (the zero is 0 there): z = b·ΔT and z = a·Δt; the sum of
+    // squares each explains is (Σ z·x)² / Σ x².
+    if (sdd_ > 0) {
+      explained_temp += szd_[r] * szd_[r] / sdd_;
+      // b in LSB per 0.01 K → ppm of rated per K.
+      const Int128 ppm = szd_[r] * 100 * 1000000 / (sdd_ * rated_[r]);
+      const std::int64_t p = static_cast<std::int64_t>(ppm);
+      if (Abs(p) > Abs(worst_ppm)) worst_ppm = p;
+    }
+    if (stt_ > 0) explained_time += szt_[r] * szt_[r] / stt_;
+  }
+  report_.thermal_ppm_per_k = Sat32(worst_ppm);
+  report_.zero_points = points_;
+  // Thermal when the temperature moved ≥ 1 K and explains ≥ 3/4 of the zero's variation, and
+  // at least as much as time does.
+  const bool thermal = dtemp_max_ - dtemp_min_ >= 100 && explained_temp * 4 >= total * 3 &&
+                       explained_temp >= explained_time;
+  SetFinding(HealthCause::kThermalZeroDrift, drift && thermal, report_.zero_drift_lsb);
+  SetFinding(HealthCause::kZeroDrift, drift && !thermal, report_.zero_drift_lsb);
+}
+
+void HealthWatch::UpdateBlock(const HealthInput& in, const WrenchLsb& d) {
+  (void)in;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    tone50_[r].Add(d[r]);
+    tone60_[r].Add(d[r]);
+    sum_d_[r] += d[r];
+    sum_d2_[r] += std::int64_t{d[r]} * d[r];
+  }
+  if (++block_pos_ < block_) return;
+  FinishBlock();
+}
+
+void HealthWatch::FinishBlock() {
+  const bool use = !block_moved_;
+  const std::int64_t n = block_;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    std::int64_t a50 = 0, a60 = 0, p50 = 0, p60 = 0;
+    tone50_[r].Finish(&a50, &p50);
+    tone60_[r].Finish(&a60, &p60);
+    if (use) {
+      // The difference's variance less the tones: what is left is broadband noise; for white
+      // noise of σ per sample the difference has 2σ².
+      const std::int64_t var_q8 =
+          (sum_d2_[r] * 256 - (sum_d_[r] * sum_d_[r] * 256) / n) / n - p50 - p60;
+      const std::int64_t sigma_q8 =
+          var_q8 <= 0 ? 0 : ISqrt64(static_cast<std::uint64_t>(var_q8) * 128);
+      if (blocks_seen_ == 0) {
+        a50_q8_[r] = a50;
+        a60_q8_[r] = a60;
+        sigma_q8_[r] = sigma_q8;
+      } else {  // averages over ≈ 8 blocks
+        a50_q8_[r] += (a50 - a50_q8_[r]) / 8;
+        a60_q8_[r] += (a60 - a60_q8_[r]) / 8;
+        sigma_q8_[r] += (sigma_q8 - sigma_q8_[r]) / 8;
+      }
+      if (commission_blocks_ > 0) sigma_ref_sum_q8_[r] += sigma_q8;
+    }
+    sum_d_[r] = 0;
+    sum_d2_[r] = 0;
+  }
+  block_pos_ = 0;
+  block_moved_ = false;
+  if (!use) return;
+  ++blocks_seen_;
+  if (commission_blocks_ > 0 && --commission_blocks_ == 0) {
+    for (std::size_t r = 0; r < kAxes; ++r)
+      sigma_ref_q8_[r] = sigma_ref_sum_q8_[r] / kCommissionBlocks;
+  }
+  if (blocks_seen_ < 8) return;  // the averages need 8 blocks
+  bool mains50 = false, mains60 = false, noisy = false;
+  std::int64_t worst50 = 0, worst60 = 0, worst_ratio = 0;
+  WrenchLsb e50{}, e60{}, en{};
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    // A tone counts above the absolute limit and above twice the RMS a tone bin reads on noise
+    // alone (2σ/√N per block, averaged).
+    const std::int64_t floor_q8 = (4 * sigma_q8_[r] * inv_sqrt_block_q16_) >> 16;
+    const std::int64_t lim_q8 = rated_[r] * th_.mains_limit_bp * 256 / 10000;
+    mains50 = mains50 || (a50_q8_[r] > lim_q8 && a50_q8_[r] > floor_q8);
+    mains60 = mains60 || (a60_q8_[r] > lim_q8 && a60_q8_[r] > floor_q8);
+    e50[r] = Sat32((a50_q8_[r] + 128) >> 8);
+    e60[r] = Sat32((a60_q8_[r] + 128) >> 8);
+    en[r] = Sat32((sigma_q8_[r] + 128) >> 8);
+    worst50 = a50_q8_[r] * 10000 / (256 * rated_[r]) > worst50
+                  ? a50_q8_[r] * 10000 / (256 * rated_[r])
+                  : worst50;
+    worst60 = a60_q8_[r] * 10000 / (256 * rated_[r]) > worst60
+                  ? a60_q8_[r] * 10000 / (256 * rated_[r])
+                  : worst60;
+    if (commission_blocks_ == 0 && sigma_ref_q8_[r] > 0) {
+      const std::int64_t ratio = sigma_q8_[r] * 100 / sigma_ref_q8_[r];
+      if (ratio > worst_ratio) worst_ratio = ratio;
+      noisy = noisy || sigma_q8_[r] * 10 > sigma_ref_q8_[r] * th_.noise_factor_d;
+    }
+  }
+  report_.mains50_bp = Sat32(worst50);
+  report_.mains60_bp = Sat32(worst60);
+  report_.noise_ratio_pct = Sat32(worst_ratio);
+  SetFinding(HealthCause::kMains50, mains50, e50);
+  SetFinding(HealthCause::kMains60, mains60, e60);
+  SetFinding(HealthCause::kNoiseFloor, noisy, en);
+}
+
+void HealthWatch::UpdateRinging(const HealthInput& in) {
+  if (refractory_ > 0) --refractory_;
+  if (analysing_ < kAxes) {  // one axis of the finished capture per sample (bounded cost)
+    AnalyseAxis(analysing_++);
+    if (analysing_ == kAxes) FinishRinging();
+    return;
+  }
+  if (!capturing_) {
+    if (refractory_ > 0) return;
+    bool jump = false;
+    for (std::size_t r = 0; r < kAxes && !jump; ++r) {
+      jump = Abs(std::int64_t{in.tared[r]} * 256 - fast_q8_[r]) > step_[r] * 256;
+    }
+    if (!jump) return;
+    capturing_ = true;
+    capture_pos_ = 0;
+    stride_count_ = 0;
+  }
+  if (stride_count_++ % capture_stride_ != 0) return;
+  for (std::size_t r = 0; r < kAxes; ++r) capture_[r][capture_pos_] = in.tared[r];
+  if (++capture_pos_ < kRingCapture) return;
+  capturing_ = false;
+  refractory_ = static_cast<std::uint32_t>(kRingCapture) * capture_stride_;
+  analysing_ = 0;  // the next six samples analyse it, one axis each
+}
+
+void HealthWatch::AnalyseAxis(std::size_t r) {
+  // Hysteresis: 4σ of the noise (the commissioning's, or the current one before it is known).
+  const std::int64_t sigma = sigma_ref_q8_[r] > 0 ? sigma_ref_q8_[r] : sigma_q8_[r];
+  const std::int32_t h = Sat32(((4 * sigma) >> 8) + 1);
+  ring_axis_[r] = MeasureRinging(capture_[r].data(), kRingCapture, rate_ / capture_stride_, h);
+  // A ringing well clear of the noise only (8 hysteresis bands): the count is then clean.
+  if (ring_axis_[r].amplitude < 8 * h) ring_axis_[r].freq_mhz = 0;
+}
+
+void HealthWatch::FinishRinging() {
+  // The axis that moved most (share of rated) carries the frequency.
+  std::size_t dom = 0;
+  std::int64_t best = -1;
+  WrenchLsb amplitude{};
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    const std::int64_t share =
+        Abs(std::int64_t{capture_[r][kRingCapture - 1]} - capture_[r][0]) * 10000 / rated_[r];
+    if (share > best) {
+      best = share;
+      dom = r;
+    }
+    amplitude[r] = ring_axis_[r].freq_mhz > 0 ? ring_axis_[r].amplitude : 0;
+  }
+  const RingingResult& main = ring_axis_[dom];
+  if (main.freq_mhz <= 0) return;
+  report_.ring_mhz = main.freq_mhz;
+  ring_last_mhz_[ring_measured_ % 3] = main.freq_mhz;
+  ++ring_measured_;
+  if (ring_ref_mhz_ == 0) {
+    ring_learn_mhz_[ring_learned_++] = main.freq_mhz;
+    if (ring_learned_ == 3) ring_ref_mhz_ = Median3(ring_learn_mhz_);
+    return;
+  }
+  if (ring_measured_ < 3) return;
+  const std::int64_t now = Median3(ring_last_mhz_);
+  const bool shifted =
+      Abs(now - ring_ref_mhz_) * 1000 > std::int64_t{ring_ref_mhz_} * th_.resonance_shift_pm;
+  SetFinding(HealthCause::kResonanceShift, shifted, amplitude);
+}
+
+void HealthWatch::UpdateCreep(const HealthInput& in, bool moving) {
+  switch (creep_phase_) {
+    case CreepPhase::kIdle:
+      if (!moving) return;
+      for (std::size_t r = 0; r < kAxes; ++r) pre_level_[r] = slow_q8_[r] >> 8;
+      creep_phase_ = CreepPhase::kMoving;
+      return;
+    case CreepPhase::kMoving:
+      if (moving) return;
+      creep_phase_ = CreepPhase::kSettling;
+      creep_count_ = rate_ / 5;  // 0.2 s
+      return;
+    case CreepPhase::kSettling:
+      if (moving) {
+        creep_phase_ = CreepPhase::kMoving;
+      } else if (--creep_count_ == 0) {
+        creep_phase_ = CreepPhase::kHold;
+        seg_sum_ = {};
+      }
+      return;
+    case CreepPhase::kHold:
+      if (moving) {  // the hold ended early: this move is the next one judged
+        for (std::size_t r = 0; r < kAxes; ++r) pre_level_[r] = fast_q8_[r] >> 8;
+        creep_phase_ = CreepPhase::kMoving;
+        return;
+      }
+      {
+        const std::size_t seg = creep_count_ / seg_len_;
+        for (std::size_t r = 0; r < kAxes; ++r) seg_sum_[seg][r] += in.tared[r];
+      }
+      if (++creep_count_ == 3 * seg_len_) FinishCreep();
+      return;
+  }
+}
+
+void HealthWatch::FinishCreep() {
+  creep_phase_ = CreepPhase::kIdle;
+  const std::int64_t n = seg_len_;
+  std::size_t dom = 0;
+  std::int64_t best = -1;
+  std::array<std::int64_t, kAxes> step{};
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    step[r] = seg_sum_[0][r] / n - pre_level_[r];
+    const std::int64_t share = Abs(step[r]) * 10000 / rated_[r];
+    if (share > best) {
+      best = share;
+      dom = r;
+    }
+  }
+  if (best < kMinStepBp) return;  // too small a load change to judge creep on
+  WrenchLsb creep{};
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    creep[r] = Sat32(CreepRemaining(seg_sum_[0][r] / n, seg_sum_[1][r] / n, seg_sum_[2][r] / n));
+  }
+  report_.creep_bp = Sat32(std::int64_t{creep[dom]} * 10000 / step[dom]);
+  // The segment means carry noise σ/√n each: a creep must also stand 6 such σ above it.
+  // (n = 20 blocks: 1/√n ≈ 1/(4·√block)).
+  const std::int64_t guard = ((6 * sigma_q8_[dom] * inv_sqrt_block_q16_) >> 16) / (4 * 256) + 1;
+  const bool creeps =
+      Abs(creep[dom]) * 10000 > Abs(step[dom]) * th_.creep_limit_bp && Abs(creep[dom]) > guard;
+  SetFinding(HealthCause::kCreep, creeps, creep);
+}
+
+void HealthWatch::Publish(const HealthInput& in) {
+  HealthReport& r = report_;
+  r.findings = active_;
+  r.ring_ref_mhz = ring_ref_mhz_;
+  r.tare_age_s = static_cast<std::uint32_t>(samples_ / rate_) - tare_sample_;
+  for (std::size_t a = 0; a < kAxes; ++a) r.cycles[a] = rainflow_[a].cycles();
+  r.slots = {};
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < kHealthCauses && k < kHealthSlots; ++i) {
+    if ((active_ & (1u << i)) == 0) continue;
+    r.slots[k].cause = static_cast<HealthCause>(i + 1);
+    r.slots[k].error_lsb = error_[i];
+    ++k;
+  }
+  const bool thermal =
+      (active_ & (1u << (static_cast<int>(HealthCause::kThermalZeroDrift) - 1))) != 0;
+  const bool zero = (active_ & (1u << (static_cast<int>(HealthCause::kZeroDrift) - 1))) != 0;
+  r.retare_suggested = thermal || zero;
+  r.retare_reason = thermal ? HealthCause::kThermalZeroDrift
+                            : (zero ? HealthCause::kZeroDrift : HealthCause::kNone);
+  if ((in.status & (kStatusBridgeFault | kStatusAdcFault | kStatusCalInvalid)) != 0) {
+    r.state = Ne107State::kFailure;
+  } else if (in.tare_pending) {
+    r.state = Ne107State::kCheckFunction;
+  } else if ((in.status & (kStatusOverload | kStatusSaturated | kStatusTempRange)) != 0) {
+    r.state = Ne107State::kOffSpecification;
+  } else if (active_ != 0) {
+    r.state = Ne107State::kMaintenanceRequired;
+  } else {
+    r.state = Ne107State::kNormal;
+  }
+}
+
+}  // namespace ftstack::fw

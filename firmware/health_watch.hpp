@@ -1,0 +1,143 @@
+// The health watch in the sampling path: zero, temperature, interference, mount and creep findings.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "firmware/health_signal.hpp"
+#include "firmware/health_types.hpp"
+#include "firmware/rainflow.hpp"
+#include "firmware/wrench.hpp"
+
+namespace ftstack::fw {
+
+/// What the watch sees of one sample.
+struct HealthInput {
+  WrenchLsb tared{};   ///< this sample's wrench before the moving average (tared when a tare is on)
+  bool valid = false;  ///< a measurement: calibrated, no bridge at a rail, no clipped arithmetic
+  std::int32_t temperature_mdegc = 0;
+  bool has_temperature = false;
+  std::uint16_t status = 0;  ///< the device's status bits of this sample (for the NE 107 state)
+  bool tare_pending = false;
+  WrenchLsb untared{};  ///< the load the body carries (no tare), also at a rail (a lower bound)
+  bool untared_valid = false;
+};
+
+/// Integer-only; no heap; the cost of one Step is bounded: a few hundred operations, plus at most
+/// one ringing analysis of kRingCapture samples (one axis on each of the six samples after a
+/// transient capture ends).
+/// Single-threaded: the sampling thread calls everything.
+class HealthWatch {
+ public:
+  static constexpr std::size_t kRingCapture = 512;  ///< samples of a transient capture
+
+  /// Rate and rated range per axis (LSB, each > 0). False (the watch stays off) otherwise, or at
+  /// a rate below 100 Hz.
+  [[nodiscard]] bool Configure(std::uint32_t rate_hz, const WrenchLsb& rated_lsb);
+  [[nodiscard]] bool configured() const { return configured_; }
+  void SetThresholds(const HealthThresholds& t);
+  [[nodiscard]] const HealthThresholds& thresholds() const { return th_; }
+  /// Learns the noise floor (over the next 5 s of blocks without load changes) and the ringing
+  /// frequency (the median of the next 3 measured, unless ring_ref_dhz gives it) anew.
+  void Commission();
+  /// Clears every finding and the zero history: the reference becomes now.
+  void Clear();
+  /// A tare completed or was removed: the zero reference becomes now, at this temperature.
+  void OnTare(std::int32_t temperature_mdegc, bool has_temperature, bool cleared);
+  void Step(const HealthInput& in);
+  [[nodiscard]] const HealthReport& report() const { return report_; }
+
+ private:
+  enum class CreepPhase : std::uint8_t { kIdle, kMoving, kSettling, kHold };
+  __extension__ using Int128 = __int128;
+
+  void ResetFilters() { filters_ready_ = false; }
+  void ResetReference(std::int32_t temperature_mdegc, bool has_temperature);
+  void UpdateZero(const HealthInput& in, bool stable);
+  void AddZeroPoint(const HealthInput& in);
+  void JudgeZero(const HealthInput& in);
+  void UpdateBlock(const HealthInput& in, const WrenchLsb& d);
+  void FinishBlock();
+  void UpdateRinging(const HealthInput& in);
+  void AnalyseAxis(std::size_t axis);
+  void FinishRinging();
+  void UpdateCreep(const HealthInput& in, bool moving);
+  void FinishCreep();
+  void SetFinding(HealthCause cause, bool on, const WrenchLsb& error);
+  void Publish(const HealthInput& in);
+
+  bool configured_ = false;
+  std::uint32_t rate_ = 0;
+  WrenchLsb rated_{};
+  HealthThresholds th_{};
+  // Thresholds in LSB (or samples), derived from th_ and the rated range.
+  std::array<std::int64_t, kAxes> window_{}, limit_{}, band_{}, move_{}, step_{};
+  std::uint32_t stable_samples_ = 0;
+  std::uint8_t fast_shift_ = 0;  ///< fast low-pass: time constant 2^k samples ≈ 0.1 s
+  std::uint8_t slow_shift_ = 0;  ///< slow low-pass ≈ 1 s
+
+  std::uint64_t samples_ = 0;
+  bool filters_ready_ = false;
+  std::array<std::int64_t, kAxes> fast_q8_{}, slow_q8_{};
+  WrenchLsb prev_{};
+
+  // Zero watch: spells, zero points (one per second of a qualified spell), regression.
+  std::uint32_t stable_run_ = 0;
+  std::array<std::int64_t, kAxes> zero_sum_{};
+  std::uint32_t zero_count_ = 0;
+  std::array<std::int64_t, kAxes> zero_last_{};  ///< the last zero point accepted
+  bool spell_checked_ = false;   ///< this spell's first zero point was compared with zero_last_
+  bool spell_rejected_ = false;  ///< … and was too far from it: a held load, not the zero
+  std::uint64_t ref_sample_ = 0;
+  std::int32_t ref_temp_mdegc_ = 0;
+  bool ref_has_temp_ = false;
+  std::uint32_t points_ = 0;
+  Int128 stt_ = 0, sdd_ = 0;  ///< Σ Δt² (s²), Σ ΔT² ((0.01 K)²)
+  std::array<Int128, kAxes> szt_{}, szd_{}, szz_{};
+  std::int32_t dtemp_min_ = 0, dtemp_max_ = 0;  ///< ΔT range seen at zero points, 0.01 K
+
+  // Interference: one block of rate/10 samples (50 and 60 Hz on exact bins).
+  std::uint32_t block_ = 0;
+  std::uint32_t block_pos_ = 0;
+  bool block_moved_ = false;
+  std::int64_t inv_sqrt_block_q16_ = 0;  ///< 2^16 / sqrt(block)
+  std::array<ToneDetector, kAxes> tone50_{}, tone60_{};
+  std::array<std::int64_t, kAxes> sum_d_{}, sum_d2_{};
+  std::array<std::int64_t, kAxes> a50_q8_{}, a60_q8_{}, sigma_q8_{};
+  std::uint32_t blocks_seen_ = 0;
+  std::array<std::int64_t, kAxes> sigma_ref_sum_q8_{}, sigma_ref_q8_{};
+  std::uint32_t commission_blocks_ = 0;  ///< blocks still to learn the noise floor from
+
+  // Mount: transient capture (axis-major) and ringing frequencies.
+  std::array<std::array<std::int32_t, kRingCapture>, kAxes> capture_{};
+  std::uint32_t capture_pos_ = 0;
+  bool capturing_ = false;
+  std::uint32_t capture_stride_ = 1;
+  std::uint32_t stride_count_ = 0;
+  std::uint32_t refractory_ = 0;
+  std::size_t analysing_ = kAxes;  ///< the capture's axis analysed next (kAxes: none pending)
+  std::array<RingingResult, kAxes> ring_axis_{};
+  std::array<std::int32_t, 3> ring_last_mhz_{};
+  std::uint32_t ring_measured_ = 0;
+  std::array<std::int32_t, 3> ring_learn_mhz_{};
+  std::uint32_t ring_learned_ = 0;
+  std::int32_t ring_ref_mhz_ = 0;
+
+  // Creep: a hold after a load change, three equal segments.
+  CreepPhase creep_phase_ = CreepPhase::kIdle;
+  std::array<std::int64_t, kAxes> pre_level_{};
+  std::array<std::array<std::int64_t, kAxes>, 3> seg_sum_{};
+  std::uint32_t creep_count_ = 0;
+  std::uint32_t seg_len_ = 0;
+
+  // Load history: rainflow cycles of the untared load per axis.
+  std::array<RainflowCounter, kAxes> rainflow_{};
+
+  // Findings.
+  std::uint16_t active_ = 0;
+  std::array<WrenchLsb, kHealthCauses> error_{};
+  std::uint32_t tare_sample_ = 0;
+  HealthReport report_{};
+};
+
+}  // namespace ftstack::fw

@@ -1,0 +1,45 @@
+// Streaming rainflow count of one load axis (four-point rule), integer, fixed-size residue.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+namespace ftstack::fw {
+
+/// Turning points are confirmed once the signal has come back by more than `gate` from its extreme
+/// (noise below the gate makes none); each new turning point closes every cycle the four-point
+/// rule finds (A B C D with |B−C| ≤ |A−B| and |B−C| ≤ |C−D|: B–C is a full cycle). Cycles with a
+/// range of at least `count_range` are counted. The residue holds kResidue points; an overflowing
+/// residue forgets its oldest point (a half cycle lost).
+class RainflowCounter {
+ public:
+  static constexpr std::size_t kResidue = 32;
+
+  void Configure(std::int32_t gate, std::int32_t count_range) {
+    gate_ = gate;
+    count_range_ = count_range;
+    Clear();
+  }
+  void Clear() {
+    n_ = 0;
+    dir_ = 0;
+    started_ = false;
+    cycles_ = 0;
+  }
+  void Add(std::int32_t v);
+  [[nodiscard]] std::uint32_t cycles() const { return cycles_; }
+
+ private:
+  void Push(std::int32_t turning_point);
+
+  std::array<std::int32_t, kResidue> residue_{};
+  std::size_t n_ = 0;
+  std::int32_t gate_ = 1;
+  std::int32_t count_range_ = 1;
+  std::int32_t extreme_ = 0;
+  int dir_ = 0;  ///< +1 rising towards extreme_, −1 falling, 0 not yet known
+  bool started_ = false;
+  std::uint32_t cycles_ = 0;
+};
+
+}  // namespace ftstack::fw
