@@ -14,7 +14,8 @@ PACKAGES=(build-essential cmake ninja-build pkg-config ccache
   libeigen3-dev libmodbus-dev libgpiod-dev gpiod
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev libfmt-dev
-  mbpoll socat gnuplot-nox chromium)
+  mbpoll socat gnuplot-nox chromium
+  calculix-ccx gmsh python3-gmsh)
 
 log() { printf '[ftstack] %s\n' "$*" >&2; }
 

@@ -1,4 +1,5 @@
 // `ftsim design` — capacities, resolution and modes of sensor bodies; sweeps against a requirement.
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -6,9 +7,11 @@
 #include <memory>
 
 #include "sim/design/explore.hpp"
+#include "sim/design/one_design.hpp"
 #include "sim/design/report.hpp"
 #include "sim/sensor_description.hpp"
 #include "tools/ftsim/commands.hpp"
+#include "tools/ftsim/design_one.hpp"
 
 namespace ftstack::tools {
 namespace {
@@ -28,6 +31,8 @@ struct DesignArgs {
   int list = 8;
   int refine_starts = 6;
   double max_radius_m = 0;
+  std::string eval;
+  OneDesignOutput one;
 };
 
 int RunSensor(const DesignArgs& a, const sim::design::DesignOptions& o,
@@ -46,16 +51,19 @@ int RunSensor(const DesignArgs& a, const sim::design::DesignOptions& o,
   if (phys->spec().allowable_strain > 0) mat.allowable_gauge_strain = phys->spec().allowable_strain;
   if (a.yield_mpa > 0) mat.yield_pa = a.yield_mpa * 1e6;
   if (a.fatigue_mpa > 0) mat.fatigue_pa = a.fatigue_mpa * 1e6;
+  sim::FlexureSensorSpec spec = phys->spec();
+  spec.body.shear_deformable = true;  // the design explorer's beams are Timoshenko beams
+  const sim::PhysicalSensorModel body(spec);
   sim::design::Candidate c;
   c.id = d.name;
-  c.model = sim::design::FromPhysicalSensor(*phys, mat, d.adc.noise_rms_mvv, d.rate_hz);
+  c.model = sim::design::FromPhysicalSensor(body, mat, d.adc.noise_rms_mvv, d.rate_hz);
   c.figures = sim::design::Evaluate(c.model, o);
   std::cout << "Material assumed: " << mat.name << " limits (yield " << mat.yield_pa / 1e6
             << " MPa, endurance " << mat.fatigue_pa / 1e6
             << " MPa) with the description's E = " << mat.e_pa / 1e9 << " GPa; read-out "
             << sim::ToString(d.adc_spec.chip) << " at " << d.rate_hz << " SPS, noise "
             << d.adc.noise_rms_mvv << " mV/V RMS per bridge\n";
-  sim::design::PrintDesign(std::cout, c, o);
+  ReportOneDesign(c, o, a.one, nullptr);
   if (req != nullptr) {
     c.check = sim::design::Check(c.model, *req);
     return sim::design::PrintRequirementVerdict(std::cout, {c}, *req, a.list) > 0 ? kExitOk
@@ -80,9 +88,21 @@ int Run(const DesignArgs& a) {
   }
   sim::design::PrintAssumptions(std::cout, so.design, so.readout);
   if (!a.sensor.empty()) return RunSensor(a, so.design, req.get());
+  if (a.eval.find(':') != std::string::npos) {
+    sim::design::Candidate c;
+    c.id = "eval";
+    c.model = sim::design::ModelFromSpec(a.eval, so.readout);
+    c.figures = sim::design::Evaluate(c.model, so.design);
+    ReportOneDesign(c, so.design, a.one, nullptr);
+    if (req == nullptr) return kExitOk;
+    c.check = sim::design::Check(c.model, *req);
+    return sim::design::PrintRequirementVerdict(std::cout, {c}, *req, a.list) > 0 ? kExitOk
+                                                                                  : kExitNotMet;
+  }
   std::cout << "Sweeping the families:\n";
   std::vector<sim::design::Candidate> cs = sim::design::Sweep(so, req.get(), &std::cout);
   int met = 1;
+  sim::design::FeCheck fe;
   if (req) {
     const int n = sim::design::RefineGuided(&cs, *req, so, a.refine_starts);
     std::cout << "Refined the " << a.refine_starts << " best guided designs (" << n
@@ -96,7 +116,21 @@ int Run(const DesignArgs& a) {
         best = &c;
       }
     }
-    if (best != nullptr) sim::design::PrintDesign(std::cout, *best, so.design);
+    if (best != nullptr && a.eval.empty()) {
+      std::cout << "Goal winner:\n";
+      ReportOneDesign(*best, so.design, a.one, &fe);
+    }
+  }
+  if (!a.eval.empty()) {  // a design named in the listing
+    const auto it =
+        std::find_if(cs.begin(), cs.end(), [&](const auto& c) { return c.id == a.eval; });
+    if (it == cs.end()) {
+      std::cerr << "ftsim design: no design " << a.eval << " in this sweep (ids as listed: H…, G…, "
+                << "R… with --require; or FAMILY:key=value,…)\n";
+      return kExitBadInput;
+    }
+    ReportOneDesign(*it, so.design, a.one, &fe);
+    return kExitOk;
   }
   std::cout << "Pareto front (tilt capacity, force capacity, force resolution, stiffness):\n";
   int shown = 0;
@@ -139,6 +173,16 @@ void AddDesignCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("--max-radius-m", a->max_radius_m,
                   "sweep: body envelope radius limit, m (default: none)");
   cmd->add_option("--refine", a->refine_starts, "guided designs refined after the sweep (6)");
+  cmd->add_option("--eval", a->eval,
+                  "one design: FAMILY:key=value,... (hub-spoke, guided) or an id of the sweep's "
+                  "listing (H012, G040, R00)");
+  cmd->add_option("--json", a->one.json_path, "--eval/--sensor/goal winner: write its figures");
+  cmd->add_flag("--fe-check", a->one.fe_check,
+                "solid FE check with gmsh + CalculiX (the --eval design, --sensor, or the goal "
+                "winner of a --require sweep)");
+  cmd->add_option("--fe-dir", a->one.fe.work_dir, "FE files go here (default fe-check)");
+  cmd->add_option("--fe-size-m", a->one.fe.element_size_m,
+                  "first FE mesh's element size, m (default: shortest member / 8)");
   cmd->callback([a, exit_code] { *exit_code = Run(*a); });
 }
 
