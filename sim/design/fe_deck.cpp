@@ -226,9 +226,13 @@ std::vector<std::map<int, std::vector<double>>> ReadFrdBlocks(std::istream& frd,
     if (!in || line.rfind(" -1", 0) != 0) continue;
     if (line.size() < 13) Fail(origin, n, "short node record");
     std::vector<double> v;
-    for (std::size_t at = 13; at + 12 <= line.size() + 0; at += 12) {
-      const double x = std::strtod(line.substr(at, 12).c_str(), nullptr);
-      if (!std::isfinite(x)) Fail(origin, n, "value is not finite");
+    for (std::size_t at = 13; at < line.size(); at += 12) {
+      const std::string field = line.substr(at, 12);
+      char* end = nullptr;
+      const double x = std::strtod(field.c_str(), &end);
+      if (end == field.c_str() || !std::isfinite(x)) {
+        Fail(origin, n, "'" + field + "' is not a finite number");
+      }
       v.push_back(x);
     }
     blocks.back()[std::atoi(line.substr(3, 10).c_str())] = v;

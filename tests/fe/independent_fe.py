@@ -84,7 +84,7 @@ def build_mesh(members, size, layers):
         xmin, ymin, zmin, xmax, ymax, zmax = gmsh.model.getBoundingBox(dim, tag)
         span = math.sqrt((xmax - xmin) ** 2 + (ymax - ymin) ** 2 + (zmax - zmin) ** 2)
         # along a member: `size`; across its section: twice as coarse (fields vary slowly there)
-        along = any(abs(span - length) < 1e-9 * length for length in lengths)
+        along = any(abs(span - length) < 1e-3 * length for length in lengths)
         n = int(math.ceil(span / (size if along else 2 * size) - 1e-9))
         gmsh.model.mesh.setTransfiniteCurve(tag, max(layers, n) + 1)
     for (dim, tag) in gmsh.model.getEntities(2):
@@ -137,12 +137,17 @@ def write_deck(path, nodes, hexes, bodies, material, n_bodies):
     with open(path, "w") as f:
         f.write("** independent FE check (tests/fe/independent_fe.py), SI units\n*NODE\n")
         for nid, p in nodes.items():
-            f.write("%d, %.15g, %.15g, %.15g\n" % (nid, p[0], p[1], p[2]))
+            # CalculiX reads at most 20 characters per field: 12 digits, round-off zeroed
+            q = [0.0 if abs(v) < 1e-15 else v for v in p]
+            f.write("%d, %.12g, %.12g, %.12g\n" % (nid, q[0], q[1], q[2]))
         for b in ref.values():
             f.write("%d, 0, 0, 0\n%d, 0, 0, 0\n" % (b, b + 1))
         f.write("*ELEMENT, TYPE=C3D20R, ELSET=SOLID\n")
         for i, h in enumerate(hexes):
             ids = [h[k] for k in GMSH_TO_CCX]
+            c = [nodes[n] for n in ids[:4]] + [nodes[ids[4]]]
+            if np.cross(c[1] - c[0], c[3] - c[0]) @ (c[4] - c[0]) < 0:  # left-handed: swap faces
+                ids = ids[4:8] + ids[0:4] + ids[12:16] + ids[8:12] + ids[16:20]
             f.write("%d, %s,\n%s\n" % (i + 1, ", ".join(map(str, ids[:15])),
                                         ", ".join(map(str, ids[15:]))))
         for b, ids in bodies.items():
@@ -221,8 +226,8 @@ def gauge_slopes(nodes, disp_steps, gauges, members):
             face = abs(q_axis @ ya) * w + abs(q_axis @ za) * h
             if -1e-9 <= s <= length + 1e-9 and (best is None or off < best[0]):
                 best = (off, min(s, length - s), length, face, min(w, h))
-        # along: up to 20 % of the member, keeping half a section depth off the clamped end
-        half = min(0.2 * best[2], best[1] - 0.5 * best[4])
+        # along: up to 20 % of the member, keeping a quarter section depth off the clamped end
+        half = min(0.2 * best[2], best[1] - 0.25 * best[4])
         r = xyz - p0
         s = r @ d
         q = r @ q_axis

@@ -72,6 +72,53 @@ int RunSensor(const DesignArgs& a, const sim::design::DesignOptions& o,
   return kExitOk;
 }
 
+/// The sweep (and refinement under a requirement), the goal winner's or a named design's full
+/// figures. Returns the number of designs meeting the requirement (1 without), -1 on bad input.
+int RunSweep(const DesignArgs& a, const sim::design::SweepOptions& so,
+             const sim::design::Requirement* req, std::vector<sim::design::Candidate>* out,
+             sim::design::FeCheck* fe, std::string* fe_id) {
+  std::cout << "Sweeping the families:\n";
+  std::vector<sim::design::Candidate>& cs = *out;
+  cs = sim::design::Sweep(so, req, &std::cout);
+  int met = 1;
+  if (req) {
+    const int n = sim::design::RefineGuided(&cs, *req, so, a.refine_starts);
+    std::cout << "Refined the " << a.refine_starts << " best guided designs (" << n
+              << " evaluations)\n";
+    met = sim::design::PrintRequirementVerdict(std::cout, cs, *req, a.list);
+    sim::design::PrintGoal(std::cout, cs, *req);
+    const sim::design::Candidate* best = nullptr;
+    for (const auto& c : cs) {
+      if (sim::design::MeetsGoal(c, *req) &&
+          (best == nullptr || c.figures.force_resolution_n < best->figures.force_resolution_n)) {
+        best = &c;
+      }
+    }
+    if (best != nullptr && a.eval.empty()) {
+      std::cout << "Goal winner:\n";
+      ReportOneDesign(*best, so.design, a.one, fe);
+      *fe_id = best->id;
+    }
+  }
+  if (!a.eval.empty()) {  // a design named in the listing
+    const auto it =
+        std::find_if(cs.begin(), cs.end(), [&](const auto& c) { return c.id == a.eval; });
+    if (it == cs.end()) {
+      std::cerr << "ftsim design: no design " << a.eval << " in this sweep (ids as listed: H…, G…, "
+                << "R… with --require; or FAMILY:key=value,…)\n";
+      return -1;
+    }
+    ReportOneDesign(*it, so.design, a.one, fe);
+    *fe_id = it->id;
+  }
+  std::cout << "Pareto front (tilt capacity, force capacity, force resolution, stiffness):\n";
+  int shown = 0;
+  for (const auto& c : cs) {
+    if (c.pareto && shown++ < a.list) sim::design::PrintDesign(std::cout, c, so.design);
+  }
+  return met;
+}
+
 int Run(const DesignArgs& a) {
   const auto t0 = std::chrono::steady_clock::now();
   sim::design::SweepOptions so;
@@ -88,59 +135,29 @@ int Run(const DesignArgs& a) {
   }
   sim::design::PrintAssumptions(std::cout, so.design, so.readout);
   if (!a.sensor.empty()) return RunSensor(a, so.design, req.get());
-  if (a.eval.find(':') != std::string::npos) {
+  std::vector<sim::design::Candidate> cs;
+  int met = 1;
+  sim::design::FeCheck fe;
+  std::string fe_id;
+  if (a.eval.find(':') != std::string::npos) {  // one design from its parameters
     sim::design::Candidate c;
     c.id = "eval";
     c.model = sim::design::ModelFromSpec(a.eval, so.readout);
     c.figures = sim::design::Evaluate(c.model, so.design);
-    ReportOneDesign(c, so.design, a.one, nullptr);
-    if (req == nullptr) return kExitOk;
-    c.check = sim::design::Check(c.model, *req);
-    return sim::design::PrintRequirementVerdict(std::cout, {c}, *req, a.list) > 0 ? kExitOk
-                                                                                  : kExitNotMet;
-  }
-  std::cout << "Sweeping the families:\n";
-  std::vector<sim::design::Candidate> cs = sim::design::Sweep(so, req.get(), &std::cout);
-  int met = 1;
-  sim::design::FeCheck fe;
-  if (req) {
-    const int n = sim::design::RefineGuided(&cs, *req, so, a.refine_starts);
-    std::cout << "Refined the " << a.refine_starts << " best guided designs (" << n
-              << " evaluations)\n";
-    met = sim::design::PrintRequirementVerdict(std::cout, cs, *req, a.list);
-    sim::design::PrintGoal(std::cout, cs, *req);
-    const sim::design::Candidate* best = nullptr;
-    for (const auto& c : cs) {
-      if (sim::design::MeetsGoal(c, *req) &&
-          (best == nullptr || c.figures.force_resolution_n < best->figures.force_resolution_n)) {
-        best = &c;
-      }
-    }
-    if (best != nullptr && a.eval.empty()) {
-      std::cout << "Goal winner:\n";
-      ReportOneDesign(*best, so.design, a.one, &fe);
-    }
-  }
-  if (!a.eval.empty()) {  // a design named in the listing
-    const auto it =
-        std::find_if(cs.begin(), cs.end(), [&](const auto& c) { return c.id == a.eval; });
-    if (it == cs.end()) {
-      std::cerr << "ftsim design: no design " << a.eval << " in this sweep (ids as listed: H…, G…, "
-                << "R… with --require; or FAMILY:key=value,…)\n";
-      return kExitBadInput;
-    }
-    ReportOneDesign(*it, so.design, a.one, &fe);
-    return kExitOk;
-  }
-  std::cout << "Pareto front (tilt capacity, force capacity, force resolution, stiffness):\n";
-  int shown = 0;
-  for (const auto& c : cs) {
-    if (c.pareto && shown++ < a.list) sim::design::PrintDesign(std::cout, c, so.design);
+    if (req) c.check = sim::design::Check(c.model, *req);
+    cs.push_back(c);
+    ReportOneDesign(cs.front(), so.design, a.one, &fe);
+    fe_id = c.id;
+    if (req) met = sim::design::PrintRequirementVerdict(std::cout, cs, *req, a.list);
+  } else {
+    met = RunSweep(a, so, req.get(), &cs, &fe, &fe_id);
+    if (met < 0) return kExitBadInput;
   }
   if (!a.report.empty()) {
     const sim::design::Catalog cat = sim::design::LoadCatalog(a.catalog);
     std::ofstream out(a.report);
-    sim::design::WriteDesignReport(out, cs, cat, req.get(), so.design);
+    sim::design::WriteDesignReport(out, cs, cat, req.get(), so.design,
+                                   fe.meshes.empty() && fe.note.empty() ? nullptr : &fe, fe_id);
     if (!out) {
       std::cerr << "ftsim design: cannot write " << a.report << "\n";
       return kExitBadInput;
