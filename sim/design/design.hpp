@@ -58,6 +58,9 @@ struct SolidMember {
   Eigen::Vector3d z_axis = Eigen::Vector3d::UnitZ();
   double width_m = 0, height_m = 0;
   int body_a = 0, body_b = 0;
+  /// End b held to body_b through springs (member-local ux uy uz in m/N, rx ry rz in rad/(N·m));
+  /// 0: rigid. The "floating" radial release of hub-spoke beams at the rim.
+  std::array<double, 6> end_b_compliance{};
 };
 
 /// Everything the evaluation needs, produced by a family (linear models, per unit wrench).

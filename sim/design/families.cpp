@@ -61,11 +61,10 @@ DesignModel FromPhysicalSensor(const PhysicalSensorModel& s, const Material& mat
   m.family = "hub-spoke";
   m.name = s.name();
   m.material = mat;
-  m.parameters = {{"beams", g.beam_count},
-                  {"hub_radius_m", g.hub_radius_m},
-                  {"rim_radius_m", g.rim_radius_m},
-                  {"beam_width_m", g.beam_width_m},
-                  {"beam_height_m", g.beam_height_m}};
+  m.parameters = {
+      {"beams", g.beam_count},          {"rim_compliance_radial_m_per_n", g.rim_compliance[0]},
+      {"hub_radius_m", g.hub_radius_m}, {"rim_radius_m", g.rim_radius_m},
+      {"beam_width_m", g.beam_width_m}, {"beam_height_m", g.beam_height_m}};
   m.stiffness = body.Stiffness();
   std::vector<Row6> gauges;
   for (const GaugeSite& site : s.spec().gauges) {
@@ -100,6 +99,7 @@ DesignModel FromPhysicalSensor(const PhysicalSensorModel& s, const Material& mat
     mb.body_b = kGround;
     mb.width_m = g.beam_width_m;
     mb.height_m = g.beam_height_m;
+    mb.end_b_compliance = g.rim_compliance;
     m.members.push_back(mb);
     SketchSegment seg{g.hub_radius_m * dir, g.rim_radius_m * dir, {}};
     for (int i = 0; i <= 8; ++i) {

@@ -37,6 +37,29 @@ void WriteSet(std::ostream& out, const std::string& name, const std::vector<int>
   }
 }
 
+/// Rigid bodies of the member ends: a member with a released end b gets a body of its own there
+/// (numbered after the model's), held to the ground by springs. Returns {body_a, body_b} per
+/// member and sets *count to the number of bodies.
+std::vector<std::array<int, 2>> EndBodies(const DesignModel& m, int* count) {
+  std::vector<std::array<int, 2>> out;
+  int next = m.body_count;
+  for (const SolidMember& mb : m.members) {
+    const bool released = std::any_of(mb.end_b_compliance.begin(), mb.end_b_compliance.end(),
+                                      [](double c) { return c > 0; });
+    if (released && mb.body_b != kGround) {
+      throw std::invalid_argument("fe model: releases are modelled only towards the ground");
+    }
+    for (int k = 3; k < 6; ++k) {
+      if (mb.end_b_compliance[static_cast<std::size_t>(k)] > 0) {
+        throw std::invalid_argument("fe model: rotational end releases are not modelled");
+      }
+    }
+    out.push_back({mb.body_a, released ? next++ : mb.body_b});
+  }
+  *count = next;
+  return out;
+}
+
 }  // namespace
 
 std::array<int, 3> MemberDivisions(const SolidMember& m, const FeMeshSize& s) {
@@ -116,9 +139,59 @@ std::map<int, Eigen::Vector3d> ReadInpNodes(std::istream& in, const std::string&
 
 int RefNode(int body, int max_mesh_node) { return max_mesh_node + 10 * body + 1; }
 
+namespace {
+
+/// A released end's body: rotation held, each member-local translation either held (an
+/// *EQUATION along that axis) or on a SPRINGA to a fixed anchor along it (stiffness 1/compliance).
+void WriteReleases(std::ostream& out, const DesignModel& m,
+                   const std::vector<std::array<int, 2>>& ends, int top) {
+  int element = 2 * top + 10;  // above every element id of the mesh (fewer elements than nodes)
+  for (std::size_t i = 0; i < m.members.size(); ++i) {
+    const int body = ends[i][1];
+    if (body < m.body_count) continue;
+    const int ref = RefNode(body, top);
+    const MemberFrame f = FrameOf(m.members[i]);
+    const Eigen::Vector3d axes[3] = {f.x, f.y, f.z};
+    out << fmt::format("*BOUNDARY\n{}, 1, 3\n", ref + 1);
+    std::array<bool, 3> dependent{};
+    for (int k = 0; k < 3; ++k) {
+      const double c = m.members[i].end_b_compliance[static_cast<std::size_t>(k)];
+      if (c > 0) {
+        out << fmt::format(
+            "*BOUNDARY\n{0}, 1, 3\n*ELEMENT,TYPE=SPRINGA,ELSET=R{1}_{2}\n{3}, {4}, {0}\n"
+            "*SPRING,ELSET=R{1}_{2}\n\n{5:.9e}\n",
+            ref + 2 + k, body, k, element++, ref, 1.0 / c);
+        continue;
+      }
+      // Held: a·u = 0, the dependent term the largest coefficient not yet dependent.
+      int lead = -1;
+      for (int j = 0; j < 3; ++j) {
+        if (!dependent[static_cast<std::size_t>(j)] && std::abs(axes[k](j)) > 1e-9 &&
+            (lead < 0 || std::abs(axes[k](j)) > std::abs(axes[k](lead)))) {
+          lead = j;
+        }
+      }
+      if (lead < 0) throw std::invalid_argument("fe model: cannot hold a released end");
+      dependent[static_cast<std::size_t>(lead)] = true;
+      std::string terms = fmt::format("{}, {}, {:.12g}", ref, lead + 1, axes[k](lead));
+      int n = 1;
+      for (int j = 0; j < 3; ++j) {
+        if (j == lead || std::abs(axes[k](j)) <= 1e-12) continue;
+        terms += fmt::format(", {}, {}, {:.12g}", ref, j + 1, axes[k](j));
+        ++n;
+      }
+      out << "*EQUATION\n" << n << "\n" << terms << "\n";
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<std::vector<int>> EndFaceNodes(const DesignModel& m,
                                            const std::map<int, Eigen::Vector3d>& nodes) {
-  std::vector<std::vector<int>> faces(static_cast<std::size_t>(m.body_count));
+  int count = 0;
+  const auto ends = EndBodies(m, &count);
+  std::vector<std::vector<int>> faces(static_cast<std::size_t>(count));
   std::vector<MemberFrame> frames;
   for (const SolidMember& mb : m.members) frames.push_back(FrameOf(mb));
   for (const auto& [id, p] : nodes) {
@@ -134,7 +207,7 @@ std::vector<std::vector<int>> EndFaceNodes(const DesignModel& m,
       }
       const double s = r.dot(f.x);
       const int body =
-          std::abs(s) < tol ? mb.body_a : (std::abs(s - f.length) < tol ? mb.body_b : -1);
+          std::abs(s) < tol ? ends[i][0] : (std::abs(s - f.length) < tol ? ends[i][1] : -1);
       if (body < 0) continue;
       if (owner >= 0 && owner != body) {
         throw std::invalid_argument("fe model: members of different bodies touch at node " +
@@ -155,10 +228,27 @@ void WriteCalculixDeck(std::ostream& out, const DesignModel& m,
       << " (SI units: m, N, Pa). Written by ftsim design --fe-check.\n"
       << "** Idealisations as the beam model: member ends clamped to rigid bodies.\n"
       << "*INCLUDE,INPUT=" << mesh_file << "\n*NODE\n";
-  for (int b = 1; b < m.body_count; ++b) {
+  int count = 0;
+  const auto ends = EndBodies(m, &count);
+  for (int b = 1; b < count; ++b) {
     out << RefNode(b, top) << ", 0, 0, 0\n" << RefNode(b, top) + 1 << ", 0, 0, 0\n";
   }
-  for (int b = 0; b < m.body_count; ++b) {
+  // Released ends: spring anchors 10 mm along each compliant member axis, from the origin.
+  for (std::size_t i = 0; i < m.members.size(); ++i) {
+    if (ends[i][1] < m.body_count) continue;
+    const MemberFrame f = FrameOf(m.members[i]);
+    const Eigen::Vector3d axes[3] = {f.x, f.y, f.z};
+    for (int k = 0; k < 3; ++k) {
+      if (m.members[i].end_b_compliance[static_cast<std::size_t>(k)] > 0) {
+        const Eigen::Vector3d p = 0.01 * axes[k];
+        out << fmt::format("{}, {:.12g}, {:.12g}, {:.12g}\n", RefNode(ends[i][1], top) + 2 + k,
+                           p.x(), p.y(), p.z());
+      }
+    }
+  }
+  for (int b = 0; b < count; ++b) {
+    // The ground may hold no face when every member reaches it through a released joint.
+    if (faces[static_cast<std::size_t>(b)].empty() && b == kGround) continue;
     if (faces[static_cast<std::size_t>(b)].empty()) {
       throw std::invalid_argument("fe model: no mesh node on the faces of body " +
                                   std::to_string(b));
@@ -168,11 +258,13 @@ void WriteCalculixDeck(std::ostream& out, const DesignModel& m,
   WriteSet(out, "PLATFORM", {RefNode(1, top), RefNode(1, top) + 1});
   out << "*MATERIAL,NAME=FLEXURE\n*ELASTIC\n"
       << fmt::format("{:.9g}, {:.6g}\n", m.material.e_pa, m.material.poisson)
-      << "*SOLID SECTION,ELSET=BODY,MATERIAL=FLEXURE\n*BOUNDARY\nB0, 1, 3\n";
-  for (int b = 1; b < m.body_count; ++b) {
+      << "*SOLID SECTION,ELSET=BODY,MATERIAL=FLEXURE\n";
+  if (!faces[kGround].empty()) out << "*BOUNDARY\nB0, 1, 3\n";
+  for (int b = 1; b < count; ++b) {
     out << fmt::format("*RIGID BODY,NSET=B{},REF NODE={},ROT NODE={}\n", b, RefNode(b, top),
                        RefNode(b, top) + 1);
   }
+  WriteReleases(out, m, ends, top);
   static constexpr const char* kAxis[] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
   for (int k = 0; k < 6; ++k) {
     out << "** unit " << kAxis[k] << " on the platform\n*STEP\n*STATIC\n*CLOAD,OP=NEW\n"

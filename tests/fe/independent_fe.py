@@ -36,12 +36,14 @@ def members_from_parameters(design):
     out = []
     if fam == "hub-spoke":
         n = int(round(p["beams"]))
+        # a floating (radially released) rim joint: each beam's rim end on a body of its own
+        floating = p.get("rim_compliance_radial_m_per_n", 0.0) > 0
         for i in range(n):
             th = 2 * math.pi * i / n
             x = np.array([math.cos(th), math.sin(th), 0.0])
             y = np.array([-math.sin(th), math.cos(th), 0.0])
             out.append((p["hub_radius_m"] * x, p["rim_radius_m"] * x, y, p["beam_width_m"],
-                        np.array([0.0, 0.0, 1.0]), p["beam_height_m"], 1, 0))
+                        np.array([0.0, 0.0, 1.0]), p["beam_height_m"], 1, 2 + i if floating else 0))
         return out
     if fam != "guided":
         raise SystemExit("unknown family " + fam)
@@ -131,9 +133,12 @@ def end_face_bodies(nodes, members):
     return body_nodes
 
 
-def write_deck(path, nodes, hexes, bodies, material, n_bodies):
+def write_deck(path, nodes, hexes, bodies, material, n_bodies, members, radial_compliance):
+    """Bodies 2… of a hub-spoke design are floating rim joints: rotation held, tangential and
+    axial translation held by equations, radial translation on a spring of 1/compliance."""
     top = max(nodes)
-    ref = {b: top + 100 + 2 * b for b in range(1, n_bodies)}
+    ref = {b: top + 100 + 4 * b for b in range(1, n_bodies)}
+    radial = {m[7]: (m[1] - m[0]) / np.linalg.norm(m[1] - m[0]) for m in members if m[7] >= 2}
     with open(path, "w") as f:
         f.write("** independent FE check (tests/fe/independent_fe.py), SI units\n*NODE\n")
         for nid, p in nodes.items():
@@ -142,6 +147,8 @@ def write_deck(path, nodes, hexes, bodies, material, n_bodies):
             f.write("%d, %.12g, %.12g, %.12g\n" % (nid, q[0], q[1], q[2]))
         for b in ref.values():
             f.write("%d, 0, 0, 0\n%d, 0, 0, 0\n" % (b, b + 1))
+        for b, r in radial.items():  # spring anchor, 20 mm out along the beam
+            f.write("%d, %.12g, %.12g, %.12g\n" % (ref[b] + 2, *(0.02 * r)))
         f.write("*ELEMENT, TYPE=C3D20R, ELSET=SOLID\n")
         for i, h in enumerate(hexes):
             ids = [h[k] for k in GMSH_TO_CCX]
@@ -159,8 +166,24 @@ def write_deck(path, nodes, hexes, bodies, material, n_bodies):
         f.write("*SOLID SECTION, ELSET=SOLID, MATERIAL=M\n")
         for b, r in ref.items():
             f.write("*RIGID BODY, NSET=FACE%d, REF NODE=%d, ROT NODE=%d\n" % (b, r, r + 1))
+        for b, r in radial.items():
+            t = np.array([-r[1], r[0], 0.0])  # tangential, in the sensor plane
+            f.write("*EQUATION\n1\n%d, 3, 1.\n" % ref[b])
+            lead = 1 if abs(t[0]) >= abs(t[1]) else 2
+            other = 3 - lead
+            if abs(t[other - 1]) > 1e-12:
+                f.write("*EQUATION\n2\n%d, %d, %.12g, %d, %d, %.12g\n"
+                        % (ref[b], lead, t[lead - 1], ref[b], other, t[other - 1]))
+            else:
+                f.write("*EQUATION\n1\n%d, %d, 1.\n" % (ref[b], lead))
+            f.write("*ELEMENT, TYPE=SPRINGA, ELSET=SPR%d\n%d, %d, %d\n*SPRING, ELSET=SPR%d\n\n%.10e\n"
+                    % (b, len(hexes) + b, ref[b], ref[b] + 2, b, 1.0 / radial_compliance))
         for k in range(6):
-            f.write("*STEP\n*STATIC\n*BOUNDARY, OP=NEW\nFACE0, 1, 3, 0.\n")
+            f.write("*STEP\n*STATIC\n*BOUNDARY, OP=NEW\n")
+            if 0 in bodies:
+                f.write("FACE0, 1, 3, 0.\n")
+            for b in radial:
+                f.write("%d, 1, 3, 0.\n%d, 1, 3, 0.\n" % (ref[b] + 1, ref[b] + 2))
             for dof in range(6):
                 node = ref[1] + (0 if dof < 3 else 1)
                 f.write("%d, %d, %d, %.6g\n" % (node, dof % 3 + 1, dof % 3 + 1,
@@ -248,7 +271,8 @@ def solve(design, members, workdir, size, layers):
     nodes, hexes = build_mesh(members, size, layers)
     bodies = end_face_bodies(nodes, members)
     n_bodies = 1 + max(max(m[6], m[7]) for m in members)
-    ref = write_deck(os.path.join(workdir, "ind.inp"), nodes, hexes, bodies, design["material"], n_bodies)
+    ref = write_deck(os.path.join(workdir, "ind.inp"), nodes, hexes, bodies, design["material"], n_bodies,
+                     members, design["parameters"].get("rim_compliance_radial_m_per_n", 0.0))
     print("  mesh %.3g mm, %d layers: %d nodes, %d C3D20R; solving…" % (1e3 * size, layers, len(nodes), len(hexes)),
           flush=True)
     with open(os.path.join(workdir, "ccx.log"), "w") as log:
