@@ -184,6 +184,12 @@ nlohmann::json FeCheckJson(const FeCheck& c) {
     std::vector<double> diag;
     for (int k = 0; k < 6; ++k) diag.push_back(s.stiffness(k, k));
     mj["stiffness_diagonal_si"] = diag;
+    nlohmann::json rows = nlohmann::json::array();
+    for (int i = 0; i < 6; ++i) {
+      rows.push_back({s.stiffness(i, 0), s.stiffness(i, 1), s.stiffness(i, 2), s.stiffness(i, 3),
+                      s.stiffness(i, 4), s.stiffness(i, 5)});
+    }
+    mj["stiffness_si"] = rows;
     nlohmann::json dom = nlohmann::json::array();
     for (const auto& [g, k] : c.dominant) {
       dom.push_back(

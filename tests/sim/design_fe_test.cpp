@@ -3,10 +3,6 @@
 // C3D20R under unit platform displacements, strains from surface displacements), the deck
 // writer without ccx, the result readers on bad files, and the HTML report's FE section.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -16,27 +12,14 @@
 
 #include "sim/design/fe_deck.hpp"
 #include "tests/support/chromium.hpp"
+#include "tests/support/run_command.hpp"
 #include "tests/support/temp_dir.hpp"
 
 namespace ftstack::sim::design {
 namespace {
 
-struct ShellRun {
-  int exit_code = -1;
-  std::string out;
-};
-
-ShellRun Shell(const std::string& cmd) {
-  ShellRun r;
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  if (p == nullptr) return r;
-  std::array<char, 4096> buf{};
-  size_t n = 0;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  const int status = pclose(p);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using ShellRun = test::CommandResult;
+ShellRun Shell(const std::string& cmd) { return test::RunCommand(cmd); }
 
 bool HaveFe() {
   return Shell("command -v ccx && command -v gmsh && /usr/bin/python3 -c 'import gmsh, numpy'")
