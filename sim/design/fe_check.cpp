@@ -117,6 +117,23 @@ FeCheck RunFeCheck(const DesignModel& m, const FeCheckOptions& o, std::ostream* 
     std::ifstream frd = OpenIn(dir / "deck.frd");
     const auto strain = ReadFrdBlocks(frd, "TOSTRAIN", (dir / "deck.frd").string());
     s.gauge_strain = GaugeStrainFromNodes(m, nodes, strain, o.fit_nodes);
+    std::ifstream frd2 = OpenIn(dir / "deck.frd");
+    const auto disp = ReadFrdBlocks(frd2, "DISP", (dir / "deck.frd").string());
+    const std::size_t every = std::max<std::size_t>(1, nodes.size() / 3000);
+    std::size_t i = 0;
+    for (const auto& [id, p] : nodes) {
+      const auto u = disp.size() > 2 ? disp[2].find(id) : disp.front().end();
+      const auto e = strain[2].find(id);
+      if (i++ % every != 0 || disp.size() <= 2 || u == disp[2].end() || e == strain[2].end() ||
+          u->second.size() < 3 || e->second.size() < 6) {
+        continue;
+      }
+      s.sample_m.push_back(p);
+      s.sample_u.emplace_back(u->second[0], u->second[1], u->second[2]);
+      const std::vector<double>& t = e->second;
+      s.sample_strain.push_back(std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2] +
+                                          2 * (t[3] * t[3] + t[4] * t[4] + t[5] * t[5])));
+    }
     s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     c.meshes.push_back(s);
     c.ran = true;

@@ -28,6 +28,10 @@ struct FeSolution {
   Mat6 stiffness = Mat6::Zero();  ///< platform, at the origin
   Eigen::MatrixXd gauge_strain;   ///< G × 6, per unit wrench
   double seconds = 0;
+  /// A sample of the mesh nodes (at most a few thousand) for a picture: position (m),
+  /// displacement under a unit Fz (m/N) and the strain magnitude |ε| there (per N).
+  std::vector<Eigen::Vector3d> sample_m, sample_u;
+  std::vector<double> sample_strain;
 };
 
 struct FeCheck {

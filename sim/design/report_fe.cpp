@@ -60,6 +60,39 @@ void RatioChart(std::ostream& o, const std::vector<RatioRow>& rows) {
       left);
 }
 
+/// The refined mesh's node sample, undeformed (grey) and deformed under Fz (coloured by the
+/// strain magnitude), in the isometric view of the strain maps.
+void DeformedShape(std::ostream& o, const FeSolution& s) {
+  if (s.sample_m.empty()) return;
+  double span = 1e-3, u_max = 0, e_max = 0;
+  for (std::size_t i = 0; i < s.sample_m.size(); ++i) {
+    span = std::max(span, s.sample_m[i].cwiseAbs().maxCoeff());
+    u_max = std::max(u_max, s.sample_u[i].norm());
+    e_max = std::max(e_max, s.sample_strain[i]);
+  }
+  const double k = 210.0 / span, magnify = u_max > 0 ? 0.2 * span / u_max : 0;
+  auto px = [&](const Eigen::Vector3d& v) { return 280 + k * (v.x() - 0.5 * v.y()); };
+  auto py = [&](const Eigen::Vector3d& v) { return 250 - k * (v.z() + 0.35 * v.y()); };
+  o << "<svg xmlns='http://www.w3.org/2000/svg' width='560' height='500'><rect width='560' "
+       "height='500' fill='#fff' stroke='#999'/>\n";
+  for (const Eigen::Vector3d& p : s.sample_m) {
+    o << fmt::format("<circle cx='{:.1f}' cy='{:.1f}' r='0.8' fill='#ccc'/>", px(p), py(p));
+  }
+  for (std::size_t i = 0; i < s.sample_m.size(); ++i) {
+    const Eigen::Vector3d q = s.sample_m[i] + magnify * s.sample_u[i];
+    const double f = e_max > 0 ? s.sample_strain[i] / e_max : 0;
+    o << fmt::format("<circle cx='{:.1f}' cy='{:.1f}' r='1.3' fill='rgb({},{},{})'/>", px(q), py(q),
+                     static_cast<int>(255 * f), static_cast<int>(90 + 110 * (1 - f)),
+                     static_cast<int>(200 * (1 - f)));
+  }
+  o << fmt::format(
+      "<text x='8' y='476' font-size='11' font-family='sans-serif'>FE nodes (sample of {}): grey "
+      "undeformed; coloured: deformed under Fz,</text><text x='8' y='490' font-size='11' "
+      "font-family='sans-serif'>displacement ×{:.3g}; colour |strain| (blue 0 … red largest)</text>"
+      "</svg>\n",
+      s.sample_m.size(), magnify);
+}
+
 }  // namespace
 
 void WriteFeCheckSection(std::ostream& o, const std::string& id, const FeCheck& c) {
@@ -78,6 +111,7 @@ void WriteFeCheckSection(std::ostream& o, const std::string& id, const FeCheck& 
   }
   const std::vector<RatioRow> rows = Rows(c);
   RatioChart(o, rows);
+  DeformedShape(o, c.meshes.back());
   o << "<p>";
   for (std::size_t i = 0; i < c.meshes.size(); ++i) {
     o << fmt::format("mesh {}: element size {:.3g} mm, {} layers, {} nodes, {:.1f} s. ", i + 1,
