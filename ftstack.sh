@@ -15,7 +15,7 @@ PACKAGES=(build-essential cmake ninja-build pkg-config ccache
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev libfmt-dev
   mbpoll socat gnuplot-nox chromium
-  calculix-ccx gmsh python3-gmsh)
+  calculix-ccx gmsh python3-gmsh python3-numpy)
 
 log() { printf '[ftstack] %s\n' "$*" >&2; }
 
