@@ -146,6 +146,7 @@ int Run(const DesignArgs& a) {
     c.figures = sim::design::Evaluate(c.model, so.design);
     if (req) c.check = sim::design::Check(c.model, *req);
     cs.push_back(c);
+    sim::design::MarkPareto(&cs);  // alone it is on the front unless outside beam theory
     ReportOneDesign(cs.front(), so.design, a.one, &fe);
     fe_id = c.id;
     if (req) met = sim::design::PrintRequirementVerdict(std::cout, cs, *req, a.list);
