@@ -12,14 +12,16 @@ BUILD_DIR=${FTSTACK_BUILD_DIR:-$ROOT/build}
 
 # Every Debian package the project needs (build, tests, reports, real Modbus/serial clients, MQTT:
 # the broker, libmosquitto, protobuf-c for Sparkplug B and the tests' independent Python decoder;
-# numpy for the independent real-recording generator and analysis under tests/).
+# numpy for the independent real-recording generator and analysis under tests/; CalculiX and
+# gmsh for the design explorer's FE check).
 PACKAGES=(build-essential cmake ninja-build pkg-config ccache
   libeigen3-dev libmodbus-dev libgpiod-dev gpiod
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev libfmt-dev
   mbpoll socat gnuplot-nox chromium
   mosquitto mosquitto-clients libmosquitto-dev libprotobuf-c-dev protobuf-c-compiler
-  protobuf-compiler python3-paho-mqtt python3-protobuf python3-numpy openssl)
+  protobuf-compiler python3-paho-mqtt python3-protobuf python3-numpy openssl
+  calculix-ccx gmsh python3-gmsh)
 
 log() { printf '[ftstack] %s\n' "$*" >&2; }
 

@@ -8,6 +8,63 @@ namespace {
 
 bool Positive(double v) { return std::isfinite(v) && v > 0; }
 
+/// 12-DOF stiffness; with `shear` each bending plane carries Φ = 12EI/(κGAL²), else Φ = 0.
+Eigen::Matrix<double, 12, 12> ElementStiffness(const BeamSection& s, double length_m, bool shear) {
+  if (!Positive(length_m)) throw std::invalid_argument("beam length must be positive and finite");
+  if (shear && !(Positive(s.shear_factor) && Positive(s.g_pa))) {
+    throw std::invalid_argument("beam section: shear factor and G must be positive and finite");
+  }
+  const double l = length_m;
+  const double l2 = l * l;
+  const double l3 = l2 * l;
+  const double ga = shear ? s.shear_factor * s.g_pa * s.area_m2 : 0.0;
+  auto phi = [&](double ei) { return shear ? 12.0 * ei / (ga * l2) : 0.0; };
+  Eigen::Matrix<double, 12, 12> k = Eigen::Matrix<double, 12, 12>::Zero();
+  auto set = [&k](int i, int j, double v) {
+    k(i, j) = v;
+    k(j, i) = v;
+  };
+  // Axial.
+  const double ea = s.e_pa * s.area_m2 / l;
+  set(0, 0, ea);
+  set(6, 6, ea);
+  set(0, 6, -ea);
+  // Torsion.
+  const double gj = s.g_pa * s.j_m4 / l;
+  set(3, 3, gj);
+  set(9, 9, gj);
+  set(3, 9, -gj);
+  // Bending in the x–y plane (v, rz): EIz.
+  const double ez = s.e_pa * s.iz_m4;
+  const double pz = phi(ez);
+  const double cz = ez / (1 + pz);
+  set(1, 1, 12 * cz / l3);
+  set(7, 7, 12 * cz / l3);
+  set(1, 7, -12 * cz / l3);
+  set(1, 5, 6 * cz / l2);
+  set(1, 11, 6 * cz / l2);
+  set(7, 5, -6 * cz / l2);
+  set(7, 11, -6 * cz / l2);
+  set(5, 5, (4 + pz) * cz / l);
+  set(11, 11, (4 + pz) * cz / l);
+  set(5, 11, (2 - pz) * cz / l);
+  // Bending in the x–z plane (w, ry): EIy; a positive ry turns +x toward −z, hence the signs.
+  const double ey = s.e_pa * s.iy_m4;
+  const double py = phi(ey);
+  const double cy = ey / (1 + py);
+  set(2, 2, 12 * cy / l3);
+  set(8, 8, 12 * cy / l3);
+  set(2, 8, -12 * cy / l3);
+  set(2, 4, -6 * cy / l2);
+  set(2, 10, -6 * cy / l2);
+  set(8, 4, 6 * cy / l2);
+  set(8, 10, 6 * cy / l2);
+  set(4, 4, (4 + py) * cy / l);
+  set(10, 10, (4 + py) * cy / l);
+  set(4, 10, (2 - py) * cy / l);
+  return k;
+}
+
 }  // namespace
 
 double RectangleTorsionConstant(double long_m, double short_m) {
@@ -38,50 +95,11 @@ BeamSection RectangularSection(double e_pa, double poisson, double width_m, doub
 }
 
 Eigen::Matrix<double, 12, 12> FrameElementStiffness(const BeamSection& s, double length_m) {
-  if (!Positive(length_m)) throw std::invalid_argument("beam length must be positive and finite");
-  const double l = length_m;
-  const double l2 = l * l;
-  const double l3 = l2 * l;
-  Eigen::Matrix<double, 12, 12> k = Eigen::Matrix<double, 12, 12>::Zero();
-  auto set = [&k](int i, int j, double v) {
-    k(i, j) = v;
-    k(j, i) = v;
-  };
-  // Axial.
-  const double ea = s.e_pa * s.area_m2 / l;
-  set(0, 0, ea);
-  set(6, 6, ea);
-  set(0, 6, -ea);
-  // Torsion.
-  const double gj = s.g_pa * s.j_m4 / l;
-  set(3, 3, gj);
-  set(9, 9, gj);
-  set(3, 9, -gj);
-  // Bending in the x–y plane (v, rz): EIz.
-  const double ez = s.e_pa * s.iz_m4;
-  set(1, 1, 12 * ez / l3);
-  set(7, 7, 12 * ez / l3);
-  set(1, 7, -12 * ez / l3);
-  set(1, 5, 6 * ez / l2);
-  set(1, 11, 6 * ez / l2);
-  set(7, 5, -6 * ez / l2);
-  set(7, 11, -6 * ez / l2);
-  set(5, 5, 4 * ez / l);
-  set(11, 11, 4 * ez / l);
-  set(5, 11, 2 * ez / l);
-  // Bending in the x–z plane (w, ry): EIy; a positive ry turns +x toward −z, hence the signs.
-  const double ey = s.e_pa * s.iy_m4;
-  set(2, 2, 12 * ey / l3);
-  set(8, 8, 12 * ey / l3);
-  set(2, 8, -12 * ey / l3);
-  set(2, 4, -6 * ey / l2);
-  set(2, 10, -6 * ey / l2);
-  set(8, 4, 6 * ey / l2);
-  set(8, 10, 6 * ey / l2);
-  set(4, 4, 4 * ey / l);
-  set(10, 10, 4 * ey / l);
-  set(4, 10, 2 * ey / l);
-  return k;
+  return ElementStiffness(s, length_m, false);
+}
+
+Eigen::Matrix<double, 12, 12> TimoshenkoElementStiffness(const BeamSection& s, double length_m) {
+  return ElementStiffness(s, length_m, true);
 }
 
 }  // namespace ftstack::sim

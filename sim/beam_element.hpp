@@ -1,5 +1,5 @@
-// 3-D Euler–Bernoulli frame element: rectangular section properties and the 12-DOF stiffness
-// matrix.
+// 3-D frame element (Euler–Bernoulli or Timoshenko): rectangular section properties and the
+// 12-DOF stiffness matrix.
 #pragma once
 
 #include <Eigen/Dense>
@@ -15,6 +15,8 @@ struct BeamSection {
   double iy_m4 = 0;  ///< second moment about local y (bending in the x–z plane, deflection w)
   double iz_m4 = 0;  ///< second moment about local z (bending in the x–y plane, deflection v)
   double j_m4 = 0;   ///< Saint-Venant torsion constant
+  /// Shear correction factor κ (shear area κ·A) for Timoshenko elements; 5/6 for a rectangle.
+  double shear_factor = 5.0 / 6.0;
 };
 
 /// Torsion constant of a solid rectangle with sides long_m ≥ short_m:
@@ -31,5 +33,11 @@ struct BeamSection {
 /// exact end stiffnesses of an Euler–Bernoulli beam with no shear deformation (Przemieniecki 1968).
 [[nodiscard]] Eigen::Matrix<double, 12, 12> FrameElementStiffness(const BeamSection& s,
                                                                   double length_m);
+
+/// The same element with shear deformation (Timoshenko; Przemieniecki 1968, §5.6): per bending
+/// plane Φ = 12·E·I/(κ·G·A·L²), lateral terms ÷ (1 + Φ), diagonal rotation terms (4 + Φ)/(1 + Φ),
+/// coupling rotation terms (2 − Φ)/(1 + Φ). Φ → 0 recovers FrameElementStiffness.
+[[nodiscard]] Eigen::Matrix<double, 12, 12> TimoshenkoElementStiffness(const BeamSection& s,
+                                                                       double length_m);
 
 }  // namespace ftstack::sim

@@ -63,7 +63,8 @@ FlexureBody::FlexureBody(const FlexureGeometry& g) : g_(g) {
   }
   section_ = RectangularSection(g.e_pa, g.poisson, g.beam_width_m, g.beam_height_m);
   length_m_ = g.rim_radius_m - g.hub_radius_m;
-  const Mat12 kl = FrameElementStiffness(section_, length_m_);
+  const Mat12 kl = g.shear_deformable ? TimoshenkoElementStiffness(section_, length_m_)
+                                      : FrameElementStiffness(section_, length_m_);
   const Mat6 k11 = kl.topLeftCorner<6, 6>();
   const Mat6 k12 = kl.topRightCorner<6, 6>();
   const Mat6 k22 = kl.bottomRightCorner<6, 6>();

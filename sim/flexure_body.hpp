@@ -29,6 +29,9 @@ struct FlexureGeometry {
   /// rx ry rz in rad/(N·m). 0 = rigid (the default: rim fixed). A radial release (ux > 0) models
   /// the thin "floating" links that let the beams slide radially in classic designs.
   std::array<double, 6> rim_compliance{};
+  /// Timoshenko beams (shear factor 5/6) instead of Euler–Bernoulli; off for the sensor models
+  /// (their calibration does not depend on it), on for the design explorer's stubby beams.
+  bool shear_deformable = false;
 };
 
 /// Faces of a beam: top = local +z, bottom = −z, plus_y = +y side, minus_y = −y side.

@@ -41,20 +41,48 @@ struct BucklingCheck {
   double critical_n = 0;
 };
 
+/// Where a gauge grid sits on the body: its centre (m), grid direction and outward surface
+/// normal (unit vectors, sensor frame), and a name such as "z force, + leaf, top".
+struct GaugeGrid {
+  std::string name;
+  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+};
+
+/// A prismatic member as a solid: end a on rigid body body_a, end b on body_b (0 ground, 1 the
+/// loaded platform, 2… intermediate stages), section width_m along y_axis × height_m along
+/// z_axis (unit vectors normal to the member). What a solid FE check meshes.
+struct SolidMember {
+  Eigen::Vector3d a_m = Eigen::Vector3d::Zero(), b_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d z_axis = Eigen::Vector3d::UnitZ();
+  double width_m = 0, height_m = 0;
+  int body_a = 0, body_b = 0;
+  /// End b held to body_b through springs (member-local ux uy uz in m/N, rx ry rz in rad/(N·m));
+  /// 0: rigid. The "floating" radial release of hub-spoke beams at the rim.
+  std::array<double, 6> end_b_compliance{};
+};
+
 /// Everything the evaluation needs, produced by a family (linear models, per unit wrench).
 struct DesignModel {
   std::string family, name;
   std::map<std::string, double> parameters;  ///< geometry for tables (m, or as named)
   Material material;
   Mat6 stiffness = Mat6::Zero();
-  Eigen::MatrixXd gauge_strain;     ///< G × 6 grid strain
-  Eigen::MatrixXd sensitivity_mvv;  ///< N × 6 bridge output, mV/V per N or N·m
-  Eigen::MatrixXd stress_normal;    ///< P × 6 normal stress (Pa) at checked section corners
-  Eigen::MatrixXd stress_shear;     ///< Q × 6 largest torsional shear (Pa) at checked sections
+  Eigen::MatrixXd gauge_strain;      ///< G × 6 grid strain
+  std::vector<GaugeGrid> gauges;     ///< G, the rows of gauge_strain
+  std::vector<SolidMember> members;  ///< the body under the model's idealisations
+  int body_count = 2;                ///< rigid bodies, ground and platform included
+  Eigen::MatrixXd sensitivity_mvv;   ///< N × 6 bridge output, mV/V per N or N·m
+  Eigen::MatrixXd stress_normal;     ///< P × 6 normal stress (Pa) at checked section corners
+  Eigen::MatrixXd stress_shear;      ///< Q × 6 largest torsional shear (Pa) at checked sections
   std::vector<BucklingCheck> buckling;
   std::vector<SketchSegment> sketch;
   double bridge_noise_mvv = 0;  ///< per bridge, RMS over the converter's bandwidth
   double native_bandwidth_hz = 0;
+  /// "" when every member is a slender beam (SlenderBeamViolation), else the first violation:
+  /// the beam figures are then not to be trusted alone and the design is not ranked.
+  std::string beam_validity;
 };
 
 /// Options of an evaluation; every assumption is a number here.

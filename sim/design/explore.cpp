@@ -140,8 +140,10 @@ void MarkPareto(std::vector<Candidate>* cs) {
   };
   for (Candidate& a : *cs) {
     const auto oa = obj(a);
-    a.pareto = true;
+    a.pareto = a.model.beam_validity.empty();  // outside beam theory: not ranked
+    if (!a.pareto) continue;
     for (const Candidate& b : *cs) {
+      if (!b.model.beam_validity.empty()) continue;
       const auto ob = obj(b);
       bool all_ge = true, one_gt = false;
       for (int k = 0; k < 4; ++k) {
@@ -253,7 +255,7 @@ GuidedParams GuidedFrom(const DesignModel& m) {
 /// utilisation: lowered by geometry that keeps moments off the force gauges). Phase 1: met designs
 /// inside the goal range by resolution, then by force range.
 double RefineScore(const Candidate& c, int phase = 1) {
-  if (!c.check.met()) return INFINITY;
+  if (!c.check.met() || !c.model.beam_validity.empty()) return INFINITY;
   if (phase == 0) return c.figures.force_range_n * c.check.gauge;
   if (c.figures.force_range_n > kGoalForceRangeN) return 1e3 + c.figures.force_range_n;
   return c.figures.force_resolution_n;
@@ -265,7 +267,9 @@ int RefineGuided(std::vector<Candidate>* cs, const Requirement& req, const Sweep
                  int starts) {
   std::vector<const Candidate*> seeds;
   for (const Candidate& c : *cs) {
-    if (c.model.family == "guided" && c.check.met()) seeds.push_back(&c);
+    if (c.model.family == "guided" && c.check.met() && c.model.beam_validity.empty()) {
+      seeds.push_back(&c);
+    }
   }
   std::sort(seeds.begin(), seeds.end(), [](const Candidate* a, const Candidate* b) {
     return RefineScore(*a) < RefineScore(*b);
@@ -322,9 +326,10 @@ int RefineGuided(std::vector<Candidate>* cs, const Requirement& req, const Sweep
 
 void PrintAssumptions(std::ostream& out, const DesignOptions& o, const Readout& r) {
   out << "Assumptions:\n"
-      << "  linear elastic Euler-Bernoulli frames (no shear deformation, no fillets or stress\n"
-      << "  concentrations, ideal clamps, rigid hub/rim/stages); stress = von Mises from the "
-         "worst\n"
+      << "  linear elastic Timoshenko frames (shear factor 5/6; members wider than long bend\n"
+      << "  with E/(1-nu^2)); no fillets or stress concentrations, ideal clamps, rigid\n"
+      << "  hub/rim/stages; members with L < 2 h (a leaf's width: L < b/2) are outside beam\n"
+      << "  theory and not ranked; stress = von Mises from the worst\n"
       << "  normal stress at section corners and the worst torsional shear (conservative);\n"
       << fmt::format(
              "  rated capacity per axis = min(gauge strain {:.0f} µε, yield / SF {:.2f}, "
@@ -377,13 +382,22 @@ int PrintRequirementVerdict(std::ostream& out, const std::vector<Candidate>& cs,
   out << fmt::format("Requirement {} (safety factor {:.2f}): {}\n", req.name, req.safety_factor,
                      req.note);
   std::vector<const Candidate*> ok;
+  int unranked = 0;
   for (const Candidate& c : cs) {
-    if (c.check.met()) ok.push_back(&c);
+    if (c.check.met() && c.model.beam_validity.empty()) ok.push_back(&c);
+    if (c.check.met() && !c.model.beam_validity.empty()) ++unranked;
   }
   std::sort(ok.begin(), ok.end(), [](const Candidate* a, const Candidate* b) {
     return a->figures.force_resolution_n < b->figures.force_resolution_n;
   });
-  out << fmt::format("{} of {} designs meet it.\n", ok.size(), cs.size());
+  out << fmt::format("{} of {} designs meet it", ok.size(), cs.size());
+  if (unranked > 0) {
+    out << fmt::format(
+        " ({} more meet it on beam figures but have members outside the slender-beam range: "
+        "not ranked)",
+        unranked);
+  }
+  out << ".\n";
   for (int i = 0; i < std::min<int>(max_listed, static_cast<int>(ok.size())); ++i) {
     const Candidate& c = *ok[static_cast<std::size_t>(i)];
     out << fmt::format(
@@ -401,7 +415,7 @@ int PrintRequirementVerdict(std::ostream& out, const std::vector<Candidate>& cs,
       if (c.model.family != fam) continue;
       lever = std::max(lever, c.figures.tilt_capacity_nm / c.figures.capacity.head<2>().minCoeff());
       if (closest == nullptr || c.check.worst() < closest->check.worst()) closest = &c;
-      if (!c.check.met()) continue;
+      if (!c.check.met() || !c.model.beam_validity.empty()) continue;
       ++met;
       if (finest == nullptr || c.figures.force_resolution_n < finest->figures.force_resolution_n) {
         finest = &c;
@@ -434,7 +448,8 @@ int PrintRequirementVerdict(std::ostream& out, const std::vector<Candidate>& cs,
 }
 
 bool MeetsGoal(const Candidate& c, const Requirement& req) {
-  return req.safety_factor >= 1.5 && c.check.met() && c.figures.force_range_n <= kGoalForceRangeN &&
+  return req.safety_factor >= 1.5 && c.check.met() && c.model.beam_validity.empty() &&
+         c.figures.force_range_n <= kGoalForceRangeN &&
          c.figures.force_resolution_n <= kGoalForceResolutionN;
 }
 
@@ -462,7 +477,7 @@ void PrintGoal(std::ostream& out, const std::vector<Candidate>& cs, const Requir
     return;
   }
   for (const Candidate& c : cs) {
-    if (c.check.met() &&
+    if (c.check.met() && c.model.beam_validity.empty() &&
         (best == nullptr || c.figures.force_range_n < best->figures.force_range_n)) {
       best = &c;
     }

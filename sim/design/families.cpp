@@ -15,6 +15,38 @@ Eigen::MatrixXd Stack(const std::vector<Row6>& rows) {
   return m;
 }
 
+/// Centre, grid direction and normal of a gauge on a FlexureBody beam (frame of the body).
+GaugeGrid GridOf(const FlexureGeometry& g, const GaugeSite& site) {
+  const double th = (g.first_beam_deg + 360.0 * site.beam / g.beam_count) * kPi / 180.0;
+  const Eigen::Vector3d x(std::cos(th), std::sin(th), 0), y(-std::sin(th), std::cos(th), 0);
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d n = z, s_axis = y;
+  double half = 0;
+  static constexpr const char* kFace[] = {"top", "bottom", "+y side", "-y side"};
+  switch (site.face) {
+    case BeamFace::kTop:
+      n = z, s_axis = y, half = 0.5 * g.beam_height_m;
+      break;
+    case BeamFace::kBottom:
+      n = -z, s_axis = y, half = 0.5 * g.beam_height_m;
+      break;
+    case BeamFace::kPlusY:
+      n = y, s_axis = z, half = 0.5 * g.beam_width_m;
+      break;
+    case BeamFace::kMinusY:
+      n = -y, s_axis = z, half = 0.5 * g.beam_width_m;
+      break;
+  }
+  GaugeGrid grid;
+  grid.point_m = (g.hub_radius_m + site.position_m) * x + half * n + site.offset_m * s_axis;
+  const double a = site.angle_deg * kPi / 180.0;
+  grid.direction = std::cos(a) * x + std::sin(a) * s_axis;
+  grid.normal = n;
+  grid.name = "beam " + std::to_string(site.beam) + ", " + kFace[static_cast<int>(site.face)] +
+              ", " + std::to_string(static_cast<int>(std::lround(site.angle_deg))) + " deg";
+  return grid;
+}
+
 }  // namespace
 
 double ReadoutNoiseMvv(const Readout& r) {
@@ -29,14 +61,17 @@ DesignModel FromPhysicalSensor(const PhysicalSensorModel& s, const Material& mat
   m.family = "hub-spoke";
   m.name = s.name();
   m.material = mat;
-  m.parameters = {{"beams", g.beam_count},
-                  {"hub_radius_m", g.hub_radius_m},
-                  {"rim_radius_m", g.rim_radius_m},
-                  {"beam_width_m", g.beam_width_m},
-                  {"beam_height_m", g.beam_height_m}};
+  m.parameters = {
+      {"beams", g.beam_count},          {"rim_compliance_radial_m_per_n", g.rim_compliance[0]},
+      {"hub_radius_m", g.hub_radius_m}, {"rim_radius_m", g.rim_radius_m},
+      {"beam_width_m", g.beam_width_m}, {"beam_height_m", g.beam_height_m}};
   m.stiffness = body.Stiffness();
   std::vector<Row6> gauges;
-  for (const GaugeSite& site : s.spec().gauges) gauges.push_back(body.StrainMatrix(site).row(0));
+  for (const GaugeSite& site : s.spec().gauges) {
+    gauges.push_back(body.StrainMatrix(site).row(0));
+    m.gauges.push_back(GridOf(g, site));
+  }
+  m.beam_validity = SlenderBeamViolation(body.beam_length_m(), g.beam_width_m, g.beam_height_m);
   m.gauge_strain = Stack(gauges);
   m.sensitivity_mvv = s.Report().sensitivity_mvv;
   std::vector<Row6> normal;
@@ -57,6 +92,15 @@ DesignModel FromPhysicalSensor(const PhysicalSensorModel& s, const Material& mat
     m.buckling.push_back({-ends.row(0), kPi * kPi * sc.e_pa * i_min / std::pow(0.5 * length, 2)});
     const double th = (g.first_beam_deg + 360.0 * b / g.beam_count) * kPi / 180.0;
     const Eigen::Vector3d dir(std::cos(th), std::sin(th), 0);
+    SolidMember mb;
+    mb.a_m = g.hub_radius_m * dir;
+    mb.b_m = g.rim_radius_m * dir;
+    mb.body_a = kPlatform;
+    mb.body_b = kGround;
+    mb.width_m = g.beam_width_m;
+    mb.height_m = g.beam_height_m;
+    mb.end_b_compliance = g.rim_compliance;
+    m.members.push_back(mb);
     SketchSegment seg{g.hub_radius_m * dir, g.rim_radius_m * dir, {}};
     for (int i = 0; i <= 8; ++i) {
       std::array<Row6, 4> rows;
@@ -87,6 +131,7 @@ DesignModel HubSpoke(const HubSpokeParams& p, const Readout& r) {
   spec.body.first_beam_deg = 0;
   spec.body.e_pa = p.material.e_pa;
   spec.body.poisson = p.material.poisson;
+  spec.body.shear_deformable = true;
   spec.gauge.resistance_ohm = 350;
   spec.gauge.gauge_factor = r.gauge_factor;
   spec.rated = Wrench::Ones();

@@ -1,6 +1,8 @@
 #include "sim/design/frame.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -35,6 +37,32 @@ double RectangleTorsionShearPerNm(double side1_m, double side2_m) {
   const double r = b / a;
   return 3.0 / (8.0 * a * b * b) *
          (1 + 0.6095 * r + 0.8865 * r * r - 1.8023 * r * r * r + 0.9100 * r * r * r * r);
+}
+
+double PlateFactor(double length_m, double width_m, double height_m, double poisson) {
+  return std::max(width_m, height_m) > length_m ? 1.0 / (1.0 - poisson * poisson) : 1.0;
+}
+
+std::string SlenderBeamViolation(double length_m, double width_m, double height_m) {
+  const double t = std::min(width_m, height_m);
+  const double b = std::max(width_m, height_m);
+  char buf[96];
+  if (b >= 5 * t) {  // a leaf: slender through its thickness, a deep beam in its plane
+    if (length_m < 2 * t) {
+      std::snprintf(buf, sizeof buf, "L/t = %.2f < 2", length_m / t);
+      return buf;
+    }
+    if (length_m < 0.5 * b) {
+      std::snprintf(buf, sizeof buf, "L/b = %.2f < 0.5", length_m / b);
+      return buf;
+    }
+    return "";
+  }
+  if (length_m < 2 * b) {
+    std::snprintf(buf, sizeof buf, "L/h = %.2f < 2", length_m / b);
+    return buf;
+  }
+  return "";
 }
 
 int FrameSolution::DofOf(const Anchor& a) const {
@@ -73,7 +101,17 @@ FrameSolution::FrameSolution(FrameModel model) : m_(std::move(model)) {
     ElementData& d = el_[e];
     d.length = (q - p).norm();
     d.section = RectangularSection(m_.e_pa, m_.poisson, fe.width_m, fe.height_m);
-    d.k_local = FrameElementStiffness(d.section, d.length);
+    if (m_.shear_deformable) {
+      // The plate factor stiffens bending through the thin side; for a leaf that is local y
+      // (height is the thickness) — a wide member with height > width is not a leaf.
+      const double member = fe.member_length_m > 0 ? fe.member_length_m : d.length;
+      d.plate = fe.width_m >= fe.height_m ? PlateFactor(member, fe.width_m, fe.height_m, m_.poisson)
+                                          : 1.0;
+      d.section.iy_m4 *= d.plate;
+      d.k_local = TimoshenkoElementStiffness(d.section, d.length);
+    } else {
+      d.k_local = FrameElementStiffness(d.section, d.length);
+    }
     const Eigen::Matrix3d r = ElementRotation(p, q, fe.z_hint);
     const std::array<Mat6, 2> map{EndMap(fe.a, r), EndMap(fe.b, r)};
     maps.push_back(map);
@@ -151,6 +189,13 @@ Row6 FrameSolution::AxialStrain(int element, double s_m, double y_m, double z_m)
   const BeamSection& sc = Section(element);
   return (sec.row(0) / sc.area_m2 + sec.row(4) * (z_m / sc.iy_m4) - sec.row(5) * (y_m / sc.iz_m4)) /
          sc.e_pa;
+}
+
+Row6 FrameSolution::NormalStress(int element, double s_m, double y_m, double z_m) const {
+  const SectionRows sec = SectionAt(element, s_m);
+  const BeamSection& sc = Section(element);
+  const double iy = sc.iy_m4 / el_.at(static_cast<std::size_t>(element)).plate;
+  return sec.row(0) / sc.area_m2 + sec.row(4) * (z_m / iy) - sec.row(5) * (y_m / sc.iz_m4);
 }
 
 }  // namespace ftstack::sim::design

@@ -1,4 +1,5 @@
-// Rigid bodies joined by Euler–Bernoulli beams: assembly, one factorisation, per-unit-wrench maps.
+// Rigid bodies joined by Timoshenko (or Euler–Bernoulli) beams: assembly, one factorisation,
+// per-unit-wrench maps, and the check that every member is a beam at all.
 #pragma once
 
 #include <Eigen/Dense>
@@ -33,6 +34,8 @@ struct FrameElement {
   std::string label;  ///< e.g. "z-stage A upper leaf"
   /// Effective buckling length of the member this element belongs to (0: no buckling check).
   double buckling_length_m = 0;
+  /// Length of the member this element is part of (for the plate factor); 0: the element's own.
+  double member_length_m = 0;
 };
 
 /// A linear spring from free node `node` to the ground, global 6×6 stiffness.
@@ -47,7 +50,20 @@ struct FrameModel {
   std::vector<FrameElement> elements;
   std::vector<NodeSpring> springs;
   double e_pa = 0, poisson = 0.3;
+  /// Timoshenko elements (shear factor 5/6) and the plate factor: a member wider than it is long
+  /// bends through its thickness with E/(1 − ν²) (anticlastic curvature held flat). false: the
+  /// classic Euler–Bernoulli beam with E.
+  bool shear_deformable = true;
 };
+
+/// Plate factor of a member: 1/(1 − ν²) when its larger section side exceeds its length, else 1.
+[[nodiscard]] double PlateFactor(double length_m, double width_m, double height_m, double poisson);
+
+/// Whether a prismatic member is in the range where beam theory (with the shear correction)
+/// holds: L ≥ 2·h for the larger section side h, except for a leaf (b ≥ 5·t), which needs
+/// L ≥ 2·t through its thickness and L ≥ 0.5·b in its plane (there the shear correction carries
+/// a deep beam). Returns "" when it is, else what fails, e.g. "L/h = 1.20 < 2".
+[[nodiscard]] std::string SlenderBeamViolation(double length_m, double width_m, double height_m);
 
 /// Section resultants per unit wrench (rows N, Vy, Vz, T, My, Mz), units N and N·m per N or N·m.
 using SectionRows = Mat6;
@@ -68,6 +84,8 @@ class FrameSolution {
   [[nodiscard]] SectionRows SectionAt(int element, double s_m) const;
   /// Normal strain (grid along the beam) at local section point (y_m, z_m), per unit wrench.
   [[nodiscard]] Row6 AxialStrain(int element, double s_m, double y_m, double z_m) const;
+  /// Normal stress (Pa) at the same point, per unit wrench.
+  [[nodiscard]] Row6 NormalStress(int element, double s_m, double y_m, double z_m) const;
   /// Global position of end a / b.
   [[nodiscard]] Eigen::Vector3d EndPoint(int element, bool end_b) const;
   /// Displacement of every DOF per unit wrench (rows: 6 per moving body, then 6 per free node).
@@ -76,7 +94,8 @@ class FrameSolution {
  private:
   struct ElementData {
     double length = 0;
-    BeamSection section;
+    BeamSection section;  ///< iy_m4 already divided by (1 − ν²) for a plate
+    double plate = 1;     ///< plate factor of bending through the height
     Eigen::Matrix<double, 12, 12> k_local;
     Eigen::Matrix<double, 12, 6> end_forces;  ///< local end forces per unit wrench
   };

@@ -81,6 +81,7 @@ FrameModel GuidedFrame(const GuidedParams& p) {
           el.z_hint = s.c;
           el.label = std::string(s.name) + "-stage leaf";
           el.buckling_length_m = 0.5 * p.leaf_length_m;  // clamped–clamped
+          el.member_length_m = p.leaf_length_m;
           f.elements.push_back(el);
           prev = next;
         }
@@ -109,26 +110,48 @@ DesignModel Guided(const GuidedParams& p, const Readout& r) {
   const double k_bridge = 1000.0 * r.gauge_factor / 4.0;
   auto strain = [&](int leaf, double s_m, double z_sign) {
     const auto [e, s] = LeafPoint(p, leaf, s_m);
-    const double t = stages[static_cast<std::size_t>(leaf / 4)].thickness_m;
+    const Stage& stage = stages[static_cast<std::size_t>(leaf / 4)];
+    const double t = stage.thickness_m;
     const Row6 row = sol.AxialStrain(e, s, 0.0, z_sign * 0.5 * t);
     gauges.push_back(row);
+    const Eigen::Vector3d outer = sol.EndPoint(leaf * p.elements_per_leaf, false);
+    const Eigen::Vector3d inner =
+        sol.EndPoint(leaf * p.elements_per_leaf + p.elements_per_leaf - 1, true);
+    GaugeGrid g;
+    g.direction = (inner - outer).normalized();
+    g.normal = z_sign * stage.c;
+    g.point_m = outer + g.direction * s_m + 0.5 * t * g.normal;
+    g.name = std::string(stage.name) + (s_m < 0.25 * p.leaf_length_m ? " force" : " moment") +
+             ((leaf % 4) / 2 == 0 ? ", + side" : ", - side") +
+             (leaf % 2 == 0 ? " upper leaf" : " lower leaf") + (z_sign > 0 ? ", top" : ", bottom");
+    m.gauges.push_back(g);
     return row;
   };
   const double root = p.gauge_frac * p.leaf_length_m;
   const double mid = 0.5 * p.leaf_length_m;
+  // Gauge rows, in this order (one statement per gauge: the order is part of the contract):
+  // per stage z, x, y the force bridge — + side upper leaf at the root, top then bottom face, then
+  // the − side upper leaf likewise; then per stage the moment bridge — the + side parallelogram's
+  // upper leaf at mid-leaf, top then bottom, then its lower leaf likewise.
   for (int st = 0; st < 3; ++st) {
-    // Force bridge: + side and − side upper leaves at the root, top and bottom faces.
+    // Force bridge: bending adds (top − bottom face of each leaf), the two sides add.
     const int a = LeafIndex(st, 0, 0);
     const int b = LeafIndex(st, 1, 0);
-    bridges.push_back(k_bridge * (strain(a, root, 1) - strain(a, root, -1) + strain(b, root, 1) -
-                                  strain(b, root, -1)));
+    const Row6 at = strain(a, root, 1);
+    const Row6 ab = strain(a, root, -1);
+    const Row6 bt = strain(b, root, 1);
+    const Row6 bb = strain(b, root, -1);
+    bridges.push_back(k_bridge * (at - ab + bt - bb));
   }
   for (int st = 0; st < 3; ++st) {
-    // Moment bridge: axial push–pull of the two leaves of the + side parallelogram, mid-leaf.
+    // Moment bridge: push–pull of the two leaves adds, their bending cancels.
     const int u = LeafIndex(st, 0, 0);
     const int d = LeafIndex(st, 0, 1);
-    bridges.push_back(k_bridge * (strain(u, mid, 1) - strain(d, mid, 1) + strain(u, mid, -1) -
-                                  strain(d, mid, -1)));
+    const Row6 ut = strain(u, mid, 1);
+    const Row6 ub = strain(u, mid, -1);
+    const Row6 dt = strain(d, mid, 1);
+    const Row6 db = strain(d, mid, -1);
+    bridges.push_back(k_bridge * (ut + ub - dt - db));
   }
   m.gauge_strain = Eigen::MatrixXd(static_cast<Eigen::Index>(gauges.size()), 6);
   for (std::size_t i = 0; i < gauges.size(); ++i)
@@ -147,7 +170,7 @@ DesignModel Guided(const GuidedParams& p, const Readout& r) {
       for (double y : {-0.5, 0.5}) {
         for (double z : {-0.5, 0.5}) {
           m.stress_normal.row(e * 8 + row++) =
-              sc.e_pa * sol.AxialStrain(e, s, y * fe.width_m, z * fe.height_m);
+              sol.NormalStress(e, s, y * fe.width_m, z * fe.height_m);
         }
       }
     }
@@ -169,6 +192,26 @@ DesignModel Guided(const GuidedParams& p, const Readout& r) {
                               sol.AxialStrain(e, s, -0.5 * p.leaf_width_m, 0)});
     }
     m.sketch.push_back(seg);
+  }
+  m.body_count = sol.model().body_count;
+  for (int leaf = 0; leaf < 12; ++leaf) {
+    const FrameElement& first =
+        sol.model().elements[static_cast<std::size_t>(leaf * p.elements_per_leaf)];
+    const FrameElement& last = sol.model().elements[static_cast<std::size_t>(
+        leaf * p.elements_per_leaf + p.elements_per_leaf - 1)];
+    SolidMember mb;
+    mb.a_m = sol.EndPoint(leaf * p.elements_per_leaf, false);
+    mb.b_m = sol.EndPoint(leaf * p.elements_per_leaf + p.elements_per_leaf - 1, true);
+    mb.body_a = first.a.body;
+    mb.body_b = last.b.body;
+    mb.z_axis = first.z_hint;
+    mb.width_m = first.width_m;
+    mb.height_m = first.height_m;
+    m.members.push_back(mb);
+  }
+  for (const Stage& st : stages) {
+    const std::string v = SlenderBeamViolation(p.leaf_length_m, p.leaf_width_m, st.thickness_m);
+    if (!v.empty() && m.beam_validity.empty()) m.beam_validity = st.name + (" stage leaves: " + v);
   }
   m.bridge_noise_mvv = ReadoutNoiseMvv(r);
   m.native_bandwidth_hz = 0.5 * r.adc.rate_hz;

@@ -210,7 +210,8 @@ std::vector<const Candidate*> Showcase(const std::vector<Candidate>& ds, const R
 }  // namespace
 
 void WriteDesignReport(std::ostream& o, const std::vector<Candidate>& ds, const Catalog& cat,
-                       const Requirement* req, const DesignOptions& opt) {
+                       const Requirement* req, const DesignOptions& opt, const FeCheck* fe,
+                       const std::string& fe_id) {
   const Trend t = FitTrend(cat, true);
   const Trend all = FitTrend(cat, false);
   o << "<!DOCTYPE html><html><head><meta charset='utf-8'><title>ftsim design</title><style>"
@@ -286,6 +287,7 @@ void WriteDesignReport(std::ostream& o, const std::vector<Candidate>& ds, const 
     }
     o << "</div></div>\n";
   }
+  if (fe != nullptr) WriteFeCheckSection(o, fe_id, *fe);
   o << "</body></html>\n";
 }
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -117,6 +118,45 @@ TEST(DesignCli, SensorDescriptionIsEvaluated) {
   ASSERT_EQ(run.exit_code, 0) << run.out;
   EXPECT_NE(run.out.find("capacity alone"), std::string::npos);
   EXPECT_NE(run.out.find("rigid tool 2.00 kg"), std::string::npos);
+}
+
+// --eval FAMILY:key=value --json: every gauge printed and written in the documented order; the
+// z-stage force gauge (row 0) against the guided-leaf hand formula (Fz/4 per leaf, S-bending:
+// ε = (Fz/4)·(L/2 − s)·(t/2)/(E·I) at s = 0.1·L from the root; shear adds 0.3 % here).
+TEST(DesignCli, EvalPrintsAndWritesEveryGauge) {
+  test::TempDir dir("design_cli");
+  const std::string json = dir.path().string() + "/d.json";
+  const CliRun run = Ftsim(
+      "--eval guided:leaf_length_m=0.04,leaf_width_m=0.03,leaf_thickness_z_m=0.0012,"
+      "separation_m=0.06 --json " +
+      json);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find(" 23  y moment, + side lower leaf, bottom"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("beam theory: every member is a slender beam"), std::string::npos);
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j.at("gauges").size(), 24u);
+  EXPECT_EQ(j.at("gauges")[0].at("name"), "z force, + side upper leaf, top");
+  const double e = 197e9, b = 0.03, t = 0.0012, l = 0.04, s = 0.1 * l;
+  const double hand = 0.25 * (0.5 * l - s) * 0.5 * t / (e * b * t * t * t / 12);
+  const double got = j.at("gauges")[0].at("strain_per_unit_wrench")[2].get<double>();
+  EXPECT_NEAR(std::abs(got), hand, 0.02 * hand);
+  const auto& k = j.at("stiffness_si");
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) {
+      const double a = k[r][c].get<double>(), bt = k[c][r].get<double>();
+      EXPECT_NEAR(a, bt, 1e-6 * std::abs(k[r][r].get<double>()) + 1e-9) << r << "," << c;
+    }
+  }
+  EXPECT_EQ(j.at("capacity").at("binding").size(), 6u);
+  const CliRun bad = Ftsim("--eval guided:leaf_lenght_m=0.04");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.out.find("no parameter 'leaf_lenght_m'"), std::string::npos) << bad.out;
+  const CliRun nan = Ftsim("--eval hub-spoke:beam_width_m=nan");
+  EXPECT_EQ(nan.exit_code, 2);
+  const CliRun missing = Ftsim("--eval H99999");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.out.find("no design H99999"), std::string::npos) << missing.out;
 }
 
 // --max-radius-m: no swept or refined design leaves the envelope.

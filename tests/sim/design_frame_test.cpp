@@ -31,6 +31,7 @@ TEST(DesignFrame, CantileverMatchesClosedForm) {
   FrameModel f;
   f.e_pa = kE;
   f.poisson = kNu;
+  f.shear_deformable = false;
   f.nodes_m.push_back({-0.3 * l, 0, 0});
   f.elements.push_back(Beam({kGround, -1, {-l, 0, 0}}, {-1, 0, {}}, w, h));
   f.elements.push_back(Beam({-1, 0, {}}, {kPlatform, -1, {0, 0, 0}}, w, h));
@@ -53,6 +54,7 @@ TEST(DesignFrame, ParallelogramMatchesClosedForm) {
   FrameModel f;
   f.e_pa = kE;
   f.poisson = kNu;
+  f.shear_deformable = false;
   for (double z : {0.5 * d, -0.5 * d}) {
     f.elements.push_back(Beam({kGround, -1, {-l, 0, z}}, {kPlatform, -1, {0, 0, z}}, w, t));
   }
@@ -82,6 +84,7 @@ TEST(DesignFrame, HubSpokeMatchesFlexureBody) {
   FrameModel f;
   f.e_pa = kE;
   f.poisson = kNu;
+  f.shear_deformable = false;
   for (int i = 0; i < 4; ++i) {
     const double th = i * std::numbers::pi / 2;
     const Eigen::Vector3d dir(std::cos(th), std::sin(th), 0);
@@ -95,6 +98,135 @@ TEST(DesignFrame, HubSpokeMatchesFlexureBody) {
   const GaugeSite site{1, 0.01, BeamFace::kTop, 0, 0};
   const Row6 ref = body.StrainMatrix(site).row(0);
   EXPECT_LT((s.AxialStrain(1, 0.01, 0, 0.5 * g.beam_height_m) - ref).norm(), 1e-9 * ref.norm());
+}
+
+// Timoshenko cantilever (Timoshenko & Gere): tip deflection P·L³/(3EI) + P·L/(κGA), κ = 5/6,
+// tip rotation under a tip moment M·L/(EI) unchanged, root strain M·c/(EI) unchanged (statics).
+// A stubby beam (L/h = 2) so that shear is 14 % of the deflection and a 1 % slip would show.
+TEST(DesignFrame, TimoshenkoCantileverMatchesClosedForm) {
+  const double l = 0.02, w = 0.006, h = 0.01;
+  FrameModel f;
+  f.e_pa = kE;
+  f.poisson = kNu;
+  f.nodes_m.push_back({-0.6 * l, 0, 0});
+  f.elements.push_back(Beam({kGround, -1, {-l, 0, 0}}, {-1, 0, {}}, w, h));
+  f.elements.push_back(Beam({-1, 0, {}}, {kPlatform, -1, {0, 0, 0}}, w, h));
+  const FrameSolution s(f);
+  const double iy = w * h * h * h / 12, iz = h * w * w * w / 12;
+  const double kga = 5.0 / 6.0 * kE / (2 * (1 + kNu)) * w * h;
+  const Mat6& c = s.Compliance();
+  const double wz = l * l * l / (3 * kE * iy) + l / kga;
+  const double wy = l * l * l / (3 * kE * iz) + l / kga;
+  EXPECT_NEAR(c(2, 2), wz, 1e-9 * wz);
+  EXPECT_NEAR(c(1, 1), wy, 1e-9 * wy);
+  EXPECT_GT((l / kga) / wz, 0.1);  // the shear term matters here
+  EXPECT_NEAR(c(4, 4), l / (kE * iy), 1e-9 * c(4, 4));
+  EXPECT_NEAR(c(0, 0), l / (kE * w * h), 1e-9 * c(0, 0));
+  const Row6 eps = s.AxialStrain(0, 0.0, 0, 0.5 * h);
+  EXPECT_NEAR(std::abs(eps(2)), l * 0.5 * h / (kE * iy), 1e-9 * std::abs(eps(2)));
+}
+
+// A leaf wider than it is long bends through its thickness as a plate: E/(1 − ν²) in the bending
+// term (not in shear or in the in-plane bending), and its surface strain is σ(1 − ν²)/E.
+TEST(DesignFrame, WideLeafUsesThePlateFactor) {
+  const double l = 0.02, b = 0.05, t = 0.001;
+  FrameModel f;
+  f.e_pa = kE;
+  f.poisson = kNu;
+  f.elements.push_back(Beam({kGround, -1, {-l, 0, 0}}, {kPlatform, -1, {0, 0, 0}}, b, t));
+  const FrameSolution s(f);
+  const double ep = kE / (1 - kNu * kNu);
+  const double iy = b * t * t * t / 12, iz = t * b * b * b / 12;
+  const double kga = 5.0 / 6.0 * kE / (2 * (1 + kNu)) * b * t;
+  const double wz = l * l * l / (3 * ep * iy) + l / kga;
+  const double wy = l * l * l / (3 * kE * iz) + l / kga;
+  EXPECT_NEAR(s.Compliance()(2, 2), wz, 1e-9 * wz);
+  EXPECT_NEAR(s.Compliance()(1, 1), wy, 1e-9 * wy);
+  const double eps = l * 0.5 * t / (ep * iy);
+  EXPECT_NEAR(std::abs(s.AxialStrain(0, 0, 0, 0.5 * t)(2)), eps, 1e-9 * eps);
+  const double sigma = l * 0.5 * t / iy;
+  EXPECT_NEAR(std::abs(s.NormalStress(0, 0, 0, 0.5 * t)(2)), sigma, 1e-9 * sigma);
+}
+
+// FlexureBody's Timoshenko path against the frame's (two assemblies, one element formula each
+// tested above), and the slender-beam flag: L/h = 3.5 passes, L/h = 1.2 is flagged.
+TEST(DesignFrame, HubSpokeTimoshenkoAndSlenderFlag) {
+  FlexureGeometry g;
+  g.beam_count = 3;
+  g.hub_radius_m = 0.015;
+  g.rim_radius_m = 0.027;
+  g.beam_width_m = 0.008;
+  g.beam_height_m = 0.01;
+  g.e_pa = kE;
+  g.poisson = kNu;
+  g.shear_deformable = true;
+  const FlexureBody body(g);
+  FrameModel f;
+  f.e_pa = kE;
+  f.poisson = kNu;
+  for (int i = 0; i < 3; ++i) {
+    const double th = i * 2 * std::numbers::pi / 3;
+    const Eigen::Vector3d dir(std::cos(th), std::sin(th), 0);
+    f.elements.push_back(Beam({kPlatform, -1, g.hub_radius_m * dir},
+                              {kGround, -1, g.rim_radius_m * dir}, g.beam_width_m,
+                              g.beam_height_m));
+  }
+  const FrameSolution s(f);
+  EXPECT_LT((s.Stiffness() - body.Stiffness()).norm(), 1e-9 * body.Stiffness().norm());
+  g.shear_deformable = false;
+  EXPECT_GT(FlexureBody(g).Stiffness()(2, 2), 1.2 * body.Stiffness()(2, 2));  // L/h = 1.2
+  const Readout r;
+  HubSpokeParams p;
+  p.hub_radius_m = 0.015;
+  p.rim_radius_m = 0.05;
+  EXPECT_EQ(HubSpoke(p, r).beam_validity, "");
+  p.rim_radius_m = 0.027;
+  EXPECT_EQ(HubSpoke(p, r).beam_validity, "L/h = 1.20 < 2");
+  GuidedParams q;
+  q.leaf_length_m = 0.01;
+  q.leaf_width_m = 0.05;
+  EXPECT_EQ(Guided(q, r).beam_validity, "z stage leaves: L/b = 0.20 < 0.5");
+}
+
+// Gauge rows by position: row i of the guided family's gauge matrix is the gauge its documented
+// place names (computed here from the frame, not through the family's lambda), whatever order the
+// compiler evaluates function arguments in.
+TEST(DesignFrame, GuidedGaugeRowsAreInTheDocumentedOrder) {
+  GuidedParams p;
+  const DesignModel m = Guided(p, Readout{});
+  const FrameSolution sol(GuidedFrame(p));
+  ASSERT_EQ(m.gauge_strain.rows(), 24);
+  ASSERT_EQ(m.gauges.size(), 24u);
+  const double root = p.gauge_frac * p.leaf_length_m, mid = 0.5 * p.leaf_length_m;
+  for (int st = 0; st < 3; ++st) {
+    const double t = st == 0 ? p.leaf_thickness_z_m : p.leaf_thickness_m;
+    // Leaf index stage·4 + side·2 + leaf (one element per leaf).
+    const int plus_upper = st * 4, minus_upper = st * 4 + 2, plus_lower = st * 4 + 1;
+    const Row6 force[4] = {sol.AxialStrain(plus_upper, root, 0, 0.5 * t),
+                           sol.AxialStrain(plus_upper, root, 0, -0.5 * t),
+                           sol.AxialStrain(minus_upper, root, 0, 0.5 * t),
+                           sol.AxialStrain(minus_upper, root, 0, -0.5 * t)};
+    const Row6 moment[4] = {sol.AxialStrain(plus_upper, mid, 0, 0.5 * t),
+                            sol.AxialStrain(plus_upper, mid, 0, -0.5 * t),
+                            sol.AxialStrain(plus_lower, mid, 0, 0.5 * t),
+                            sol.AxialStrain(plus_lower, mid, 0, -0.5 * t)};
+    for (int k = 0; k < 4; ++k) {
+      const Row6 got_f = m.gauge_strain.row(4 * st + k);
+      const Row6 got_m = m.gauge_strain.row(12 + 4 * st + k);
+      EXPECT_LT((got_f - force[k]).norm(), 1e-12 * force[k].norm()) << "stage " << st << " " << k;
+      EXPECT_LT((got_m - moment[k]).norm(), 1e-12 * moment[k].norm()) << "stage " << st << " " << k;
+    }
+    // The grid of row 0 of each stage lies on the + side upper leaf's top face near its outer
+    // root: along the leaf axis, at the + compliant-axis offset d/2 + t/2.
+    const GaugeGrid& g = m.gauges[static_cast<std::size_t>(4 * st)];
+    const Eigen::Vector3d c = st == 0
+                                  ? Eigen::Vector3d::UnitZ()
+                                  : (st == 1 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY());
+    EXPECT_NEAR(g.point_m.dot(c), 0.5 * p.separation_m + 0.5 * t, 1e-12);
+    EXPECT_NEAR(g.normal.dot(c), 1.0, 1e-12);
+  }
+  // Under Fz the z-stage top and bottom faces at the root are equal and opposite.
+  EXPECT_NEAR(m.gauge_strain(0, 2), -m.gauge_strain(1, 2), 1e-9 * std::abs(m.gauge_strain(0, 2)));
 }
 
 // Exact beam elements: splitting each leaf into 5 elements changes nothing (mesh refinement).
