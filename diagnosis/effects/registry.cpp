@@ -1,53 +1,53 @@
-// The effect vocabulary: name → fit function, in spec order.
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <limits>
+// The effect plug-ins, one registration line per family, in the vocabulary's order.
 #include <vector>
 
-#include "diagnosis/effects/common.hpp"
-#include "diagnosis/signal.hpp"
+#include "diagnosis/effects/families.hpp"
 
 namespace ftstack::diag {
 
-using namespace fx;  // NOLINT(google-build-using-namespace): the effects' private helpers
+using namespace fx;  // NOLINT(google-build-using-namespace): the families' fit functions
+using K = EffectKind;
 
 const std::vector<EffectSpec>& Effects() {
   static const std::vector<EffectSpec> kEffects = {
-      {"zero_offset", &FitZeroOffset},
-      {"zero_drift", &FitZeroDrift},
-      {"thermal_zero_drift", &FitThermalZeroPlain},
-      {"thermal_span_drift", &FitThermalSpan},
-      {"excitation_drift", &FitExcitation, &RefitExcitation, 2},
-      {"creep", &FitBy<&CreepSearch>, &RefitBy<&CreepSearch>, 4},
-      {"hysteresis", &FitHysteresisFamily, &RefitHysteresis, 2},
-      {"bridge_nonlinearity", &FitBridgeNonlinearity},
-      {"geometric_nonlinearity", &FitGeometric},
-      {"load_stiffening", &FitLoadStiffening},
-      {"misalignment", &FitMisalignment},
-      {"gain_error", &FitGainError},
-      {"time_skew", &FitTimeSkew},
-      {"saturation", &FitSaturation},
-      {"overload_shift", &FitOverloadShift},
-      {"mains_interference", &FitMains},
-      {"resonance", &FitBy<&ResonanceSearch>, &RefitBy<&ResonanceSearch>, 8},
+      {.kind = K::kZeroOffset, .fit = &FitZeroOffset},
+      {.kind = K::kZeroDrift,
+       .traits = kTimeBased | kDriftInTime | kRefineOnlyIfBetter,
+       .fit = &FitZeroDrift,
+       .refine_claim = &RefineWithThermalLag},
+      {.kind = K::kThermalZeroDrift,
+       .traits = kTimeBased | kNeedsTemperature,
+       .fit = &FitThermalZeroPlain,
+       .refine_claim = &RefineWithThermalLag},
+      {.kind = K::kThermalSpanDrift,
+       .traits = kTimeBased | kNeedsTemperature,
+       .fit = &FitThermalSpan},
+      {.kind = K::kExcitationDrift,
+       .traits = kTimeBased,
+       .fit = &FitExcitation,
+       .refit = &RefitExcitation,
+       .cost = 2},
+      {.kind = K::kCreep, .fit = &FitBy<&CreepSearch>, .refit = &RefitBy<&CreepSearch>, .cost = 4},
+      {.kind = K::kHysteresis,
+       .traits = kLoadHistory,
+       .fit = &FitHysteresisFamily,
+       .refit = &RefitHysteresis,
+       .cost = 2},
+      {.kind = K::kBridgeNonlinearity, .fit = &FitBridgeNonlinearity},
+      {.kind = K::kGeometricNonlinearity, .fit = &FitGeometric},
+      {.kind = K::kLoadStiffening, .fit = &FitLoadStiffening},
+      {.kind = K::kMisalignment, .fit = &FitMisalignment},
+      {.kind = K::kGainError, .fit = &FitGainError},
+      {.kind = K::kTimeSkew, .fit = &FitTimeSkew},
+      {.kind = K::kSaturation, .fit = &FitSaturation},
+      {.kind = K::kOverloadShift, .traits = kTimeBased, .fit = &FitOverloadShift},
+      {.kind = K::kMainsInterference, .fit = &FitMains},
+      {.kind = K::kResonance,
+       .fit = &FitBy<&ResonanceSearch>,
+       .refit = &RefitBy<&ResonanceSearch>,
+       .cost = 8},
   };
   return kEffects;
-}
-
-std::optional<EffectFit> FitNear(const EffectSpec& spec, const Context& cx, const Series& target,
-                                 const EffectFit* near, bool uncertainty) {
-  if (spec.refit != nullptr && near != nullptr && near->name == spec.name) {
-    return spec.refit(cx, target, *near, uncertainty);
-  }
-  return spec.fit(cx, target);
-}
-
-const EffectSpec* FindEffect(const std::string& name) {
-  for (const auto& e : Effects()) {
-    if (name == e.name) return &e;
-  }
-  return nullptr;
 }
 
 }  // namespace ftstack::diag

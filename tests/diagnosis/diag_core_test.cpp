@@ -4,9 +4,11 @@
 #include <cmath>
 #include <random>
 
-#include "diagnosis/diagnose.hpp"
+#include "diagnosis/engine/diagnose.hpp"
+#include "diagnosis/engine/signal.hpp"
+#include "diagnosis/filters/lowpass.hpp"
 #include "diagnosis/report/html_report.hpp"
-#include "diagnosis/signal.hpp"
+#include "diagnosis/report/json_report.hpp"
 #include "tests/diagnosis/diag_fixture.hpp"
 
 namespace ftstack::diag {
