@@ -31,3 +31,11 @@ std::optional<EffectFit> FitBridgeNonlinearity(const Context& cx, const Series& 
 }
 
 }  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec BridgeNonlinearityPlugin() {
+  return {.kind = EffectKind::kBridgeNonlinearity, .fit = &fx::FitBridgeNonlinearity};
+}
+
+}  // namespace ftstack::diag

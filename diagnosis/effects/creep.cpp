@@ -87,7 +87,7 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Series& target, co
   // The searches read every search_stride-th row: the lagged load is kept only there (memory: a
   // compact buffer instead of n × N); the final fits stream it over every row.
   const std::vector<int> rows = StrideRows(cx);
-  const int st = cx.search_stride;
+  const int row_step = cx.search_stride;
   Mat lp;
   auto sse_for = [&](double log_tau, bool gamma) {
     LowPassLoadRows(cx, std::exp(log_tau), rows, &lp);
@@ -95,12 +95,12 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Series& target, co
       return FitChannels(
                  cx, target, 2,
                  [&](int i, int c, double* x) {
-                   x[0] = lp(i / st, c);
+                   x[0] = lp(i / row_step, c);
                    x[1] = cx.load(i, c);
                  },
-                 nullptr, nullptr, st)
+                 nullptr, nullptr, row_step)
                  .sse_w *
-             st;
+             row_step;
     }
     return SearchSse(cx, target, lp, true);
   };
@@ -171,16 +171,16 @@ namespace {
 /// lp2 compact (row i at i / search_stride: LowPassLoadRows on StrideRows); whitened SSE scaled
 /// to the full count.
 double SearchTwo(const Context& cx, const Series& target, const Mat& lp1, const Mat& lp2) {
-  const int st = cx.search_stride;
+  const int row_step = cx.search_stride;
   return FitChannels(
              cx, target, 2,
              [&](int i, int c, double* x) {
-               x[0] = lp1(i / st, c);
-               x[1] = lp2(i / st, c);
+               x[0] = lp1(i / row_step, c);
+               x[1] = lp2(i / row_step, c);
              },
-             nullptr, nullptr, st)
+             nullptr, nullptr, row_step)
              .sse_w *
-         st;
+         row_step;
 }
 
 /// Coarse 2-D search of (log τ1 < log τ2) over pairs of a 13-point log grid on [lo, hi]: every grid
@@ -189,11 +189,11 @@ double SearchTwo(const Context& cx, const Series& target, const Mat& lp1, const 
 void CoarsePair(const Context& cx, const Series& target, double lo, double hi, double* l1,
                 double* l2) {
   // At most ~20 000 rows per grid column: the coarse pair only has to land in the right basin.
-  const int st = std::max(cx.search_stride, static_cast<int>(cx.n_train / 20000));
+  const int row_step = std::max(cx.search_stride, static_cast<int>(cx.n_train / 20000));
   std::vector<double> grid;
   for (int j = 0; j <= 12; ++j) grid.push_back(lo + (hi - lo) * j / 12.0);
   std::vector<int> rows;
-  for (int i = 0; i < cx.n; i += st) {
+  for (int i = 0; i < cx.n; i += row_step) {
     if (cx.train[static_cast<std::size_t>(i)]) rows.push_back(i);
   }
   const auto m = static_cast<Eigen::Index>(rows.size());
@@ -329,9 +329,9 @@ void CreepOimlR60(const Context& cx, const std::vector<double>& tau,
     const Mat cov = f.cov[static_cast<std::size_t>(c)] * (f.sse(c) / dof);
     Mat var = ja * cov * ja.transpose();
     for (std::size_t k = 0; k < K; ++k) {
-      const double st = std::isfinite(tau_sigma[k]) ? tau_sigma[k] : 0.0;
+      const double tau_sd = std::isfinite(tau_sigma[k]) ? tau_sigma[k] : 0.0;
       var += jt.col(static_cast<Eigen::Index>(k)) *
-             jt.col(static_cast<Eigen::Index>(k)).transpose() * st * st;
+             jt.col(static_cast<Eigen::Index>(k)).transpose() * tau_sd * tau_sd;
     }
     c30(c) = 100.0 * v[0];
     c2030(c) = 100.0 * v[1];
@@ -432,3 +432,14 @@ bool FitCreepTwo(const Context& cx, const Series& target, double log_tau1, doubl
 }
 
 }  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec CreepPlugin() {
+  return {.kind = EffectKind::kCreep,
+          .fit = &fx::FitBy<&fx::CreepSearch>,
+          .refit = &fx::RefitBy<&fx::CreepSearch>,
+          .cost = 4};
+}
+
+}  // namespace ftstack::diag

@@ -107,3 +107,15 @@ std::optional<EffectFit> RefitExcitation(const Context& cx, const Series& target
 }
 
 }  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec ExcitationDriftPlugin() {
+  return {.kind = EffectKind::kExcitationDrift,
+          .traits = kTimeBased,
+          .fit = &fx::FitExcitation,
+          .refit = &fx::RefitExcitation,
+          .cost = 2};
+}
+
+}  // namespace ftstack::diag

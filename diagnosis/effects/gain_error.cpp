@@ -29,3 +29,9 @@ std::optional<EffectFit> FitGainError(const Context& cx, const Series& target) {
 }
 
 }  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec GainErrorPlugin() { return {.kind = EffectKind::kGainError, .fit = &fx::FitGainError}; }
+
+}  // namespace ftstack::diag

@@ -89,3 +89,11 @@ std::optional<EffectFit> FitGeometric(const Context& cx, const Series& target) {
 }
 
 }  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec GeometricNonlinearityPlugin() {
+  return {.kind = EffectKind::kGeometricNonlinearity, .fit = &fx::FitGeometric};
+}
+
+}  // namespace ftstack::diag

@@ -242,3 +242,15 @@ std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Series& 
 
 }  // namespace
 }  // namespace ftstack::diag
+
+namespace ftstack::diag {
+
+EffectSpec HysteresisPlugin() {
+  return {.kind = EffectKind::kHysteresis,
+          .traits = kLoadHistory,
+          .fit = &FitHysteresisFamily,
+          .refit = &RefitHysteresis,
+          .cost = 2};
+}
+
+}  // namespace ftstack::diag

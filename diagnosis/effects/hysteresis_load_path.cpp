@@ -1,4 +1,4 @@
-// hysteresis in the load path (issue 12): rate-independent operators on each reference wrench
+// hysteresis in the load path: rate-independent operators on each reference wrench
 // axis, seen by the bridges through the sensor's own sensitivity (cx.sens) — one operator of a
 // searched width, or a Prandtl–Ishlinskii sum of play operators of fixed widths (general shape).
 #include <algorithm>
@@ -277,8 +277,8 @@ std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Series& targ
         "Preisach: weighted sum of 28 relays (thresholds on 8 quantiles of the axis's load) on "
         "each wrench axis, through the sensitivity";
   }
-  // Final weights from every st-th training row too (the operators' states change only at load
-  // reversals and threshold crossings, so little is lost on long records); predictions on all.
+  // Final weights from every row_step-th training row too (the operators' states change only at
+  // load reversals and threshold crossings, so little is lost on long records); predictions on all.
   const AxisFit fit = Solve(cx, runs, best);
   EffectFit e;
   e.name = "hysteresis";

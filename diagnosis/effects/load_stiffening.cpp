@@ -81,3 +81,11 @@ std::optional<EffectFit> FitLoadStiffening(const Context& cx, const Series& targ
 }
 
 }  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec LoadStiffeningPlugin() {
+  return {.kind = EffectKind::kLoadStiffening, .fit = &fx::FitLoadStiffening};
+}
+
+}  // namespace ftstack::diag

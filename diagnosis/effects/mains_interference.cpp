@@ -106,11 +106,11 @@ std::string AddMainsHarmonics(const Context& cx, const Series& target, double f0
         },
         pred, nullptr, stride);
   };
-  const int st = cx.search_stride;
+  const int row_step = cx.search_stride;
   std::vector<double> kept{f0};
   std::vector<int> order{1};
   std::string note;
-  double sse = fit(kept, nullptr, st).sse_w * st;
+  double sse = fit(kept, nullptr, row_step).sse_w * row_step;
   for (int h = 2; h <= 5; ++h) {
     const double fa = Alias(h * f0, cx.rate_hz);
     bool clash = fa < resolution || fa > nyq - resolution;
@@ -122,7 +122,7 @@ std::string AddMainsHarmonics(const Context& cx, const Series& target, double f0
     }
     std::vector<double> trial = kept;
     trial.push_back(fa);
-    const double s = fit(trial, nullptr, st).sse_w * st;
+    const double s = fit(trial, nullptr, row_step).sse_w * row_step;
     // The same penalty as every variant choice: ln(n_train·N) per parameter (2 per channel).
     if (sse - s <= 2.0 * cx.nc * Penalty(cx)) continue;
     sse = s;
@@ -162,3 +162,11 @@ std::string AddMainsHarmonics(const Context& cx, const Series& target, double f0
 }
 
 }  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec MainsInterferencePlugin() {
+  return {.kind = EffectKind::kMainsInterference, .fit = &fx::FitMains};
+}
+
+}  // namespace ftstack::diag

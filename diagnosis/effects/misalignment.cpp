@@ -92,3 +92,11 @@ std::optional<EffectFit> FitMisalignment(const Context& cx, const Series& target
 }
 
 }  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec MisalignmentPlugin() {
+  return {.kind = EffectKind::kMisalignment, .fit = &fx::FitMisalignment};
+}
+
+}  // namespace ftstack::diag

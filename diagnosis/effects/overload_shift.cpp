@@ -86,3 +86,11 @@ std::optional<EffectFit> FitOverloadShift(const Context& cx, const Series& targe
 }
 
 }  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec OverloadShiftPlugin() {
+  return {.kind = EffectKind::kOverloadShift, .traits = kTimeBased, .fit = &fx::FitOverloadShift};
+}
+
+}  // namespace ftstack::diag

@@ -1,52 +1,39 @@
-// The effect plug-ins, one registration line per family, in the vocabulary's order.
+// The effect plug-ins, in the vocabulary's order: one line per family, X(Family) for the plug-in
+// `EffectSpec FamilyPlugin()` defined at the end of effects/family.cpp (its kind, traits and fit
+// functions). A new family is one new file and one line here.
 #include <vector>
 
-#include "diagnosis/effects/families.hpp"
+#include "diagnosis/engine/effect.hpp"
 
 namespace ftstack::diag {
 
-using namespace fx;  // NOLINT(google-build-using-namespace): the families' fit functions
-using K = EffectKind;
+#define FTSTACK_EFFECT_FAMILIES(X) \
+  X(ZeroOffset)                    \
+  X(ZeroDrift)                     \
+  X(ThermalZeroDrift)              \
+  X(ThermalSpanDrift)              \
+  X(ExcitationDrift)               \
+  X(Creep)                         \
+  X(Hysteresis)                    \
+  X(BridgeNonlinearity)            \
+  X(GeometricNonlinearity)         \
+  X(LoadStiffening)                \
+  X(Misalignment)                  \
+  X(GainError)                     \
+  X(TimeSkew)                      \
+  X(Saturation)                    \
+  X(OverloadShift)                 \
+  X(MainsInterference)             \
+  X(Resonance)
+
+#define FTSTACK_DECLARE_PLUGIN(Family) EffectSpec Family##Plugin();
+FTSTACK_EFFECT_FAMILIES(FTSTACK_DECLARE_PLUGIN)
+#undef FTSTACK_DECLARE_PLUGIN
 
 const std::vector<EffectSpec>& Effects() {
-  static const std::vector<EffectSpec> kEffects = {
-      {.kind = K::kZeroOffset, .fit = &FitZeroOffset},
-      {.kind = K::kZeroDrift,
-       .traits = kTimeBased | kDriftInTime | kRefineOnlyIfBetter,
-       .fit = &FitZeroDrift,
-       .refine_claim = &RefineWithThermalLag},
-      {.kind = K::kThermalZeroDrift,
-       .traits = kTimeBased | kNeedsTemperature,
-       .fit = &FitThermalZeroPlain,
-       .refine_claim = &RefineWithThermalLag},
-      {.kind = K::kThermalSpanDrift,
-       .traits = kTimeBased | kNeedsTemperature,
-       .fit = &FitThermalSpan},
-      {.kind = K::kExcitationDrift,
-       .traits = kTimeBased,
-       .fit = &FitExcitation,
-       .refit = &RefitExcitation,
-       .cost = 2},
-      {.kind = K::kCreep, .fit = &FitBy<&CreepSearch>, .refit = &RefitBy<&CreepSearch>, .cost = 4},
-      {.kind = K::kHysteresis,
-       .traits = kLoadHistory,
-       .fit = &FitHysteresisFamily,
-       .refit = &RefitHysteresis,
-       .cost = 2},
-      {.kind = K::kBridgeNonlinearity, .fit = &FitBridgeNonlinearity},
-      {.kind = K::kGeometricNonlinearity, .fit = &FitGeometric},
-      {.kind = K::kLoadStiffening, .fit = &FitLoadStiffening},
-      {.kind = K::kMisalignment, .fit = &FitMisalignment},
-      {.kind = K::kGainError, .fit = &FitGainError},
-      {.kind = K::kTimeSkew, .fit = &FitTimeSkew},
-      {.kind = K::kSaturation, .fit = &FitSaturation},
-      {.kind = K::kOverloadShift, .traits = kTimeBased, .fit = &FitOverloadShift},
-      {.kind = K::kMainsInterference, .fit = &FitMains},
-      {.kind = K::kResonance,
-       .fit = &FitBy<&ResonanceSearch>,
-       .refit = &RefitBy<&ResonanceSearch>,
-       .cost = 8},
-  };
+#define FTSTACK_PLUGIN(Family) Family##Plugin(),
+  static const std::vector<EffectSpec> kEffects = {FTSTACK_EFFECT_FAMILIES(FTSTACK_PLUGIN)};
+#undef FTSTACK_PLUGIN
   return kEffects;
 }
 

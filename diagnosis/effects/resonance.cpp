@@ -113,15 +113,15 @@ double FitRingingAll(const Context& cx, const Series& target, double f, double z
 std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target,
                                          const EffectFit* near, bool uncertainty) {
   const double nyq = 0.5 * cx.rate_hz;
-  // The searches keep the ringing only where they read it (the window's rows, or every st-th row,
-  // of their channels); the final fit streams it over every row (memory: no n × N buffer).
+  // The searches keep the ringing only where they read it (the window's rows, or every row_step-th
+  // row, of their channels); the final fit streams it over every row (memory: no n × N buffer).
   Mat h;
   // Coarse search on the two channels with the most residual energy, on all rows or (long records)
   // the window with the most load-step energy.
   const std::vector<int> coarse = StrongestTwo(cx, target);
   const auto [w0, w1] = CoarseWindow(cx, coarse);
   bool windowed = false;
-  int st = cx.search_stride;
+  int row_step = cx.search_stride;
   const auto in_range = [&](double f, double z) {
     return f > 0.05 && f < 0.98 * nyq && z > 1e-4 && z <= 2.0;
   };
@@ -131,14 +131,14 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target
       RingingAt(cx, f, z, chans, w0, w1 - w0, 1, &h);
       return WindowSse(cx, target, h, chans, w0, w1);
     }
-    RingingAt(cx, f, z, chans, 0, cx.n, st, &h);
+    RingingAt(cx, f, z, chans, 0, cx.n, row_step, &h);
     std::vector<int> col(static_cast<std::size_t>(cx.nc), 0);  // channel → column of h
     for (std::size_t k = 0; k < chans.size(); ++k)
       col[static_cast<std::size_t>(chans[k])] = static_cast<int>(k);
     const auto r = FitChannels(
         cx, target, 1,
-        [&](int i, int c, double* x) { x[0] = h(i / st, col[static_cast<std::size_t>(c)]); },
-        nullptr, &chans, st);
+        [&](int i, int c, double* x) { x[0] = h(i / row_step, col[static_cast<std::size_t>(c)]); },
+        nullptr, &chans, row_step);
     double s = 0.0;
     for (int c : chans) s += r.sse(c) * cx.weight(c);
     return s;
@@ -146,67 +146,69 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target
   const std::vector<int> all = AllChannels(cx);
   std::vector<double> fgrid = ResonanceGrid(cx);
   const double zgrid[] = {0.01, 0.03, 0.1, 0.3};
-  double bf = 0.0;
-  double bz = 0.0;
-  double bs = std::numeric_limits<double>::infinity();
+  double best_freq = 0.0;
+  double best_zeta = 0.0;
+  double best_sse = std::numeric_limits<double>::infinity();
   const bool warm = near != nullptr && near->search_state.size() >= 2;
   if (warm) {
-    bf = std::exp(near->search_state[0]);
-    bz = std::exp(near->search_state[1]);
-    if (in_range(bf, bz)) bs = 0.0;  // only its finiteness is used below: no filter pass needed
+    best_freq = std::exp(near->search_state[0]);
+    best_zeta = std::exp(near->search_state[1]);
+    if (in_range(best_freq, best_zeta))
+      best_sse = 0.0;  // only its finiteness is used below: no filter pass needed
     fgrid.clear();
   }
   windowed = w1 - w0 < cx.n;  // the coarse grid and the first round
   for (double f : fgrid) {
     for (double z : zgrid) {
       const double s = sse_for(f, z, coarse);
-      if (s < bs) {
-        bs = s;
-        bf = f;
-        bz = z;
+      if (s < best_sse) {
+        best_sse = s;
+        best_freq = f;
+        best_zeta = z;
       }
     }
   }
-  if (!std::isfinite(bs)) return std::nullopt;
+  if (!std::isfinite(best_sse)) return std::nullopt;
   // Alternate golden refinements in log f and log ζ on the coarse channels (a refit starts near
   // its optimum: only the finer second round).
-  double lf = std::log(bf);
-  double lz = std::log(bz);
+  double log_freq = std::log(best_freq);
+  double log_zeta = std::log(best_zeta);
   for (int round = warm ? 1 : 0; round < 2; ++round) {
     const std::vector<int>& chans = coarse;  // all channels only in the final fit
     if (round == 1) {
-      st = std::max(1, st / 2);
+      row_step = std::max(1, row_step / 2);
       windowed = false;
     }
     std::vector<double> g1;
-    for (int j = -2; j <= 2; ++j) g1.push_back(lf + 0.04 * j / (round + 1));
-    lf = MinimizeOnGrid([&](double v) { return sse_for(std::exp(v), std::exp(lz), chans); }, g1, 7,
-                        nullptr);
+    for (int j = -2; j <= 2; ++j) g1.push_back(log_freq + 0.04 * j / (round + 1));
+    log_freq = MinimizeOnGrid(
+        [&](double v) { return sse_for(std::exp(v), std::exp(log_zeta), chans); }, g1, 7, nullptr);
     std::vector<double> g2;
-    for (int j = -2; j <= 2; ++j) g2.push_back(lz + 0.3 * j / (round + 1));
-    lz = MinimizeOnGrid([&](double v) { return sse_for(std::exp(lf), std::exp(v), chans); }, g2, 7,
-                        nullptr);
+    for (int j = -2; j <= 2; ++j) g2.push_back(log_zeta + 0.3 * j / (round + 1));
+    log_zeta = MinimizeOnGrid(
+        [&](double v) { return sse_for(std::exp(log_freq), std::exp(v), chans); }, g2, 7, nullptr);
   }
   EffectFit e;
   e.name = "resonance";
   e.n_params = cx.nc + 2;
   ChannelFit cf;
-  const double f = std::exp(lf);
-  const double z = std::exp(lz);
+  const double f = std::exp(log_freq);
+  const double z = std::exp(log_zeta);
   e.train_sse_w = FitRingingAll(cx, target, f, z, &cf, &e.pred);
   e.params["freq_hz"] = f;
   e.params["damping_ratio"] = z;
   e.params["damped_freq_hz"] = f * std::sqrt(std::max(0.0, 1.0 - z * z));
   if (uncertainty) {
-    e.sigma["freq_hz"] = JsonNum(
-        f * CurvatureSigma([&](double v) { return sse_for(std::exp(v), z, all); }, lf, 0.002));
+    e.sigma["freq_hz"] =
+        JsonNum(f * CurvatureSigma([&](double v) { return sse_for(std::exp(v), z, all); }, log_freq,
+                                   0.002));
     e.sigma["damping_ratio"] = JsonNum(
-        z * CurvatureSigma([&](double v) { return sse_for(f, std::exp(v), all); }, lz, 0.02));
+        z * CurvatureSigma([&](double v) { return sse_for(f, std::exp(v), all); }, log_zeta, 0.02));
   }
   PutChannelCoef(cx, cf, 0, "participation", &e);
   h = Mat();
   e.variant = "one mode";
-  e.search_state = {lf, lz};
+  e.search_state = {log_freq, log_zeta};
   const bool near_two = warm && near->search_state.size() >= 4;
   const std::string second =
       near == nullptr || near_two
@@ -241,24 +243,25 @@ std::vector<double> ResidualLines(const Context& cx, const Series& r, double f1_
 
 /// Puts both modes' parameters and 1-σ into *e, mode 1 the lower frequency (log f, log ζ and their
 /// σ per fitted mode m; participations from column m of cf). Returns the fitted index of mode 2.
-int PutModes(const Context& cx, const ChannelFit& cf, const double* lf, const double* lz,
-             const double* slf, const double* slz, EffectFit* e) {
-  const int lo = lf[0] <= lf[1] ? 0 : 1;
+int PutModes(const Context& cx, const ChannelFit& cf, const double* log_freq,
+             const double* log_zeta, const double* slf, const double* slz, EffectFit* e) {
+  const int lo = log_freq[0] <= log_freq[1] ? 0 : 1;
   const char* fkey[2] = {"freq_hz", "freq2_hz"};
   const char* zkey[2] = {"damping_ratio", "damping_ratio2"};
   const char* pkey[2] = {"participation", "participation2"};
   for (int k = 0; k < 2; ++k) {
     const int m = k == 0 ? lo : 1 - lo;
-    const double f_hz = std::exp(lf[m]);
-    const double z = std::exp(lz[m]);
+    const double f_hz = std::exp(log_freq[m]);
+    const double z = std::exp(log_zeta[m]);
     e->params[fkey[k]] = f_hz;
     e->sigma[fkey[k]] = JsonNum(f_hz * slf[m]);
     e->params[zkey[k]] = z;
     e->sigma[zkey[k]] = JsonNum(z * slz[m]);
     PutChannelCoef(cx, cf, m, pkey[k], e);
   }
-  const double z_lo = std::exp(lz[lo]);
-  e->params["damped_freq_hz"] = std::exp(lf[lo]) * std::sqrt(std::max(0.0, 1.0 - z_lo * z_lo));
+  const double z_lo = std::exp(log_zeta[lo]);
+  e->params["damped_freq_hz"] =
+      std::exp(log_freq[lo]) * std::sqrt(std::max(0.0, 1.0 - z_lo * z_lo));
   return 1 - lo;
 }
 
@@ -269,48 +272,49 @@ bool ModeInRange(const Context& cx, double f_hz, double zeta, double other_hz) {
          Apart(f_hz, other_hz);
 }
 
-/// The two modes' (log f, log ζ) in lf, lz (mode 1 given in lf[0], lz[0]): mode 2 on a grid at the
-/// residual's `lines` (or from `start`), then golden refinements of each with the other held, on
-/// the `coarse` channels. False when no mode 2 is in range.
+/// The two modes' (log f, log ζ) in log_freq, log_zeta (mode 1 given in log_freq[0], log_zeta[0]):
+/// mode 2 on a grid at the residual's `lines` (or from `start`), then golden refinements of each
+/// with the other held, on the `coarse` channels. False when no mode 2 is in range.
 bool SearchModes(const Context& cx, const Series& target, const std::vector<int>& coarse,
-                 const std::vector<double>& lines, const double* start, double* lf, double* lz) {
-  // The searches keep each mode's ringing only where they read it (every st-th row of the coarse
-  // channels, compact: RingingAt); the profile curvatures hold the other mode over every row in
-  // single precision; the joint fit and the prediction stream both (memory: no n × N double).
+                 const std::vector<double>& lines, const double* start, double* log_freq,
+                 double* log_zeta) {
+  // The searches keep each mode's ringing only where they read it (every row_step-th row of the
+  // coarse channels, compact: RingingAt); the profile curvatures hold the other mode over every row
+  // in single precision; the joint fit and the prediction stream both (memory: no n × N double).
   Mat h[2];
-  int st = cx.search_stride;
+  int row_step = cx.search_stride;
   std::vector<int> col(static_cast<std::size_t>(cx.nc), 0);  // channel → column of h[m]
   for (std::size_t k = 0; k < coarse.size(); ++k) {
     col[static_cast<std::size_t>(coarse[k])] = static_cast<int>(k);
   }
   // Whitened training SSE on the coarse channels with mode m at (f, ζ) and the other mode's
-  // ringing held in h[1 − m] (every st-th row).
+  // ringing held in h[1 − m] (every row_step-th row).
   auto sse = [&](int m, double f_hz, double zeta) {
-    if (!ModeInRange(cx, f_hz, zeta, std::exp(lf[1 - m])))
+    if (!ModeInRange(cx, f_hz, zeta, std::exp(log_freq[1 - m])))
       return std::numeric_limits<double>::infinity();
-    RingingAt(cx, f_hz, zeta, coarse, 0, cx.n, st, &h[m]);
+    RingingAt(cx, f_hz, zeta, coarse, 0, cx.n, row_step, &h[m]);
     const ChannelFit r = FitChannels(
         cx, target, 2,
         [&](int i, int c, double* x) {
           const int k = col[static_cast<std::size_t>(c)];
-          x[0] = h[0](i / st, k);
-          x[1] = h[1](i / st, k);
+          x[0] = h[0](i / row_step, k);
+          x[1] = h[1](i / row_step, k);
         },
-        nullptr, &coarse, st);
+        nullptr, &coarse, row_step);
     double s = 0.0;
     for (int c : coarse) s += r.sse(c) * cx.weight(c);
     return s;
   };
   const auto hold = [&](int m) {  // the held mode's ringing at the current stride
-    RingingAt(cx, std::exp(lf[m]), std::exp(lz[m]), coarse, 0, cx.n, st, &h[m]);
+    RingingAt(cx, std::exp(log_freq[m]), std::exp(log_zeta[m]), coarse, 0, cx.n, row_step, &h[m]);
   };
   hold(0);
   // Coarse: mode 2 on a grid around each residual line, mode 1 held at its one-mode optimum.
   double best = std::numeric_limits<double>::infinity();
   if (start != nullptr) {
-    lf[1] = start[0];
-    lz[1] = start[1];
-    best = sse(1, std::exp(lf[1]), std::exp(lz[1]));
+    log_freq[1] = start[0];
+    log_zeta[1] = start[1];
+    best = sse(1, std::exp(log_freq[1]), std::exp(log_zeta[1]));
   }
   for (double line : lines) {
     for (double m : {0.92, 1.0, 1.08}) {
@@ -318,8 +322,8 @@ bool SearchModes(const Context& cx, const Series& target, const std::vector<int>
         const double s = sse(1, line * m, z);
         if (s < best) {
           best = s;
-          lf[1] = std::log(line * m);
-          lz[1] = std::log(z);
+          log_freq[1] = std::log(line * m);
+          log_zeta[1] = std::log(z);
         }
       }
     }
@@ -328,19 +332,19 @@ bool SearchModes(const Context& cx, const Series& target, const std::vector<int>
   // Golden refinements of log f and log ζ of mode 2, then mode 1 (the other held): twice, or once
   // (the finer round) from a refit's start.
   for (int round = start != nullptr ? 1 : 0; round < 2; ++round) {
-    if (round == 1) st = std::max(1, st / 2);
+    if (round == 1) row_step = std::max(1, row_step / 2);
     for (int m : {1, 0}) {
       hold(1 - m);
       std::vector<double> g1;
       std::vector<double> g2;
       for (int j = -2; j <= 2; ++j) {
-        g1.push_back(lf[m] + 0.04 * j / (round + 1));
-        g2.push_back(lz[m] + 0.3 * j / (round + 1));
+        g1.push_back(log_freq[m] + 0.04 * j / (round + 1));
+        g2.push_back(log_zeta[m] + 0.3 * j / (round + 1));
       }
-      lf[m] = MinimizeOnGrid([&](double v) { return sse(m, std::exp(v), std::exp(lz[m])); }, g1, 7,
-                             nullptr);
-      lz[m] = MinimizeOnGrid([&](double v) { return sse(m, std::exp(lf[m]), std::exp(v)); }, g2, 7,
-                             nullptr);
+      log_freq[m] = MinimizeOnGrid(
+          [&](double v) { return sse(m, std::exp(v), std::exp(log_zeta[m])); }, g1, 7, nullptr);
+      log_zeta[m] = MinimizeOnGrid(
+          [&](double v) { return sse(m, std::exp(log_freq[m]), std::exp(v)); }, g2, 7, nullptr);
     }
   }
   return true;
@@ -348,12 +352,12 @@ bool SearchModes(const Context& cx, const Series& target, const std::vector<int>
 
 /// 1-σ of each mode's log f and log ζ (slf, slz) from the profile curvature of the whitened
 /// training SSE on every channel and row, the other mode held at its optimum.
-void ModeCurvatures(const Context& cx, const Series& target, const double* lf, const double* lz,
-                    double* slf, double* slz) {
+void ModeCurvatures(const Context& cx, const Series& target, const double* log_freq,
+                    const double* log_zeta, double* slf, double* slz) {
   for (int m : {0, 1}) {
     Series held(cx.n, cx.nc);
-    const double f_held = std::exp(lf[1 - m]);
-    const double z_held = std::exp(lz[1 - m]);
+    const double f_held = std::exp(log_freq[1 - m]);
+    const double z_held = std::exp(log_zeta[1 - m]);
     ForRinging(cx, &f_held, &z_held, 1,
                [&](int i, int c, const double* hv) { held(i, c) = static_cast<float>(hv[0]); });
     auto sse_all = [&](double f_hz, double zeta) {
@@ -367,10 +371,10 @@ void ModeCurvatures(const Context& cx, const Series& target, const double* lf, c
       });
       return sums.Solve(cx).sse_w;
     };
-    slf[m] = CurvatureSigma([&](double v) { return sse_all(std::exp(v), std::exp(lz[m])); }, lf[m],
-                            0.002);
-    slz[m] = CurvatureSigma([&](double v) { return sse_all(std::exp(lf[m]), std::exp(v)); }, lz[m],
-                            0.02);
+    slf[m] = CurvatureSigma([&](double v) { return sse_all(std::exp(v), std::exp(log_zeta[m])); },
+                            log_freq[m], 0.002);
+    slz[m] = CurvatureSigma([&](double v) { return sse_all(std::exp(log_freq[m]), std::exp(v)); },
+                            log_zeta[m], 0.02);
   }
 }
 
@@ -385,16 +389,16 @@ std::string AddResonanceMode(const Context& cx, const Series& target, double f1_
     if (start == nullptr && (lines = ResidualLines(cx, resid, f1_hz)).empty()) return "";
     coarse = StrongestTwo(cx, resid);
   }
-  double lf[2] = {std::log(f1_hz), 0.0};
-  double lz[2] = {std::log(zeta1), 0.0};
-  if (!SearchModes(cx, target, coarse, lines, start, lf, lz)) return "";
+  double log_freq[2] = {std::log(f1_hz), 0.0};
+  double log_zeta[2] = {std::log(zeta1), 0.0};
+  if (!SearchModes(cx, target, coarse, lines, start, log_freq, log_zeta)) return "";
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   double slf[2] = {kNaN, kNaN};
   double slz[2] = {kNaN, kNaN};
-  if (uncertainty) ModeCurvatures(cx, target, lf, lz, slf, slz);
+  if (uncertainty) ModeCurvatures(cx, target, log_freq, log_zeta, slf, slz);
   // The joint fit and each mode's whitened energy on the training rows, streamed.
-  const double f12[2] = {std::exp(lf[0]), std::exp(lf[1])};
-  const double z12[2] = {std::exp(lz[0]), std::exp(lz[1])};
+  const double f12[2] = {std::exp(log_freq[0]), std::exp(log_freq[1])};
+  const double z12[2] = {std::exp(log_zeta[0]), std::exp(log_zeta[1])};
   ChannelSums sums(cx, 2);
   Mat hh = Mat::Zero(2, cx.nc);  // Σ h_j² over the training rows per channel
   ForRinging(cx, f12, z12, 2, [&](int i, int c, const double* hv) {
@@ -416,7 +420,7 @@ std::string AddResonanceMode(const Context& cx, const Series& target, double f1_
   const double e1 = mode_energy(0);
   const double e2 = mode_energy(1);
   const double share = std::min(e1, e2) / std::max(e1 + e2, 1e-300);
-  const double f2_hz = std::exp(lf[1]);
+  const double f2_hz = std::exp(log_freq[1]);
   // Materiality: the weaker mode must carry ≥ 1 % of the ringing's whitened energy (10 % of its
   // amplitude), else a small mismatch of one mode would be named a second one.
   if (gain <= 0.0 || share < 0.01) {
@@ -425,7 +429,7 @@ std::string AddResonanceMode(const Context& cx, const Series& target, double f1_
         "%% of the ringing)",
         f2_hz, gain, 100.0 * share);
   }
-  const int hi = PutModes(cx, cf, lf, lz, slf, slz, e);
+  const int hi = PutModes(cx, cf, log_freq, log_zeta, slf, slz, e);
   e->variant = "two modes";
   e->n_params = p;
   e->train_sse_w = cf.sse_w;
@@ -437,11 +441,22 @@ std::string AddResonanceMode(const Context& cx, const Series& target, double f1_
         x[1] = hv[1];
       },
       &e->pred);
-  e->search_state = {lf[0], lz[0], lf[1], lz[1]};
+  e->search_state = {log_freq[0], log_zeta[0], log_freq[1], log_zeta[1]};
   return Fmt(
       "; a second mode at %.2f Hz (damping ratio %.3f) from the residual spectrum, kept: "
       "training BIC lower by %.1f, %.0f %% of the ringing's energy in the weaker mode",
-      std::exp(lf[hi]), std::exp(lz[hi]), gain, 100.0 * share);
+      std::exp(log_freq[hi]), std::exp(log_zeta[hi]), gain, 100.0 * share);
 }
 
 }  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec ResonancePlugin() {
+  return {.kind = EffectKind::kResonance,
+          .fit = &fx::FitBy<&fx::ResonanceSearch>,
+          .refit = &fx::RefitBy<&fx::ResonanceSearch>,
+          .cost = 8};
+}
+
+}  // namespace ftstack::diag

@@ -87,3 +87,11 @@ std::optional<EffectFit> FitSaturation(const Context& cx, const Series& target) 
 }
 
 }  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec SaturationPlugin() {
+  return {.kind = EffectKind::kSaturation, .fit = &fx::FitSaturation};
+}
+
+}  // namespace ftstack::diag

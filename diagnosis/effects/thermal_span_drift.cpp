@@ -81,3 +81,13 @@ std::optional<EffectFit> FitThermalSpan(const Context& cx, const Series& target)
 }
 
 }  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec ThermalSpanDriftPlugin() {
+  return {.kind = EffectKind::kThermalSpanDrift,
+          .traits = kTimeBased | kNeedsTemperature,
+          .fit = &fx::FitThermalSpan};
+}
+
+}  // namespace ftstack::diag

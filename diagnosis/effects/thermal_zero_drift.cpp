@@ -113,3 +113,14 @@ std::optional<EffectFit> RefineWithThermalLag(const Context& cx, const Series& t
 }
 
 }  // namespace ftstack::diag
+
+namespace ftstack::diag {
+
+EffectSpec ThermalZeroDriftPlugin() {
+  return {.kind = EffectKind::kThermalZeroDrift,
+          .traits = kTimeBased | kNeedsTemperature,
+          .fit = &fx::FitThermalZeroPlain,
+          .refine_claim = &RefineWithThermalLag};
+}
+
+}  // namespace ftstack::diag

@@ -14,11 +14,11 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Series& target) {
   const auto& d = *cx.data;
   auto predict = [&](double delay, Series* out) {
     double sse = 0.0;
-    const int st = out == nullptr ? cx.search_stride : 1;
+    const int row_step = out == nullptr ? cx.search_stride : 1;
     for (int c = 0; c < cx.nc; ++c) {
       const double* s = cx.load.col(c).data();  // load = sim − zero: the same differences
       double acc = 0.0;
-      for (int i = 0; i < cx.n; i += st) {
+      for (int i = 0; i < cx.n; i += row_step) {
         const bool tr = cx.train[static_cast<std::size_t>(i)] != 0;
         if (!tr && out == nullptr) continue;
         const double v = InterpolateNear(d.t_s.data(), s, static_cast<std::size_t>(cx.n),
@@ -28,7 +28,7 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Series& target) {
         if (out != nullptr) (*out)(i, c) = static_cast<float>(v);
         if (tr) acc += (target(i, c) - v) * (target(i, c) - v);
       }
-      sse += acc * cx.weight(c) * st;
+      sse += acc * cx.weight(c) * row_step;
     }
     return sse;
   };
@@ -71,3 +71,9 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Series& target) {
 }
 
 }  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec TimeSkewPlugin() { return {.kind = EffectKind::kTimeSkew, .fit = &fx::FitTimeSkew}; }
+
+}  // namespace ftstack::diag

@@ -13,14 +13,14 @@ namespace ftstack::diag::fx {
 // Smooth functions of time per channel (hat splines), knots chosen by BIC on training rows.
 std::optional<EffectFit> FitZeroDrift(const Context& cx, const Series& target) {
   const double duration = cx.data->t_s.back() - cx.data->t_s.front();
-  // Per channel hat-spline fit with k intervals on every st-th training row.
-  auto fit_k = [&](int k, int st, std::vector<Vec>* beta) {
+  // Per channel hat-spline fit with k intervals on every row_step-th training row.
+  auto fit_k = [&](int k, int row_step, std::vector<Vec>* beta) {
     const HatBasis hb = MakeHat(cx, k);
     double sse_w = 0.0;
     beta->clear();
     for (int c = 0; c < cx.nc; ++c) {
       NormalEq ne(k + 1);
-      for (int i = 0; i < cx.n; i += st) {
+      for (int i = 0; i < cx.n; i += row_step) {
         if (!cx.train[static_cast<std::size_t>(i)]) continue;
         int j = 0;
         double fr = 0.0;
@@ -30,7 +30,7 @@ std::optional<EffectFit> FitZeroDrift(const Context& cx, const Series& target) {
         ne.AddSparse(idx, val, 2, target(i, c));
       }
       const auto r = ne.Solve();
-      sse_w += r.sse * cx.weight(c) * st;
+      sse_w += r.sse * cx.weight(c) * row_step;
       beta->push_back(r.beta);
     }
     return sse_w;
@@ -93,3 +93,14 @@ std::optional<EffectFit> FitZeroDrift(const Context& cx, const Series& target) {
 }
 
 }  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec ZeroDriftPlugin() {
+  return {.kind = EffectKind::kZeroDrift,
+          .traits = kTimeBased | kDriftInTime | kRefineOnlyIfBetter,
+          .fit = &fx::FitZeroDrift,
+          .refine_claim = &RefineWithThermalLag};
+}
+
+}  // namespace ftstack::diag

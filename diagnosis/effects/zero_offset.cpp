@@ -27,3 +27,11 @@ std::optional<EffectFit> FitZeroOffset(const Context& cx, const Series& target) 
 }
 
 }  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec ZeroOffsetPlugin() {
+  return {.kind = EffectKind::kZeroOffset, .fit = &fx::FitZeroOffset};
+}
+
+}  // namespace ftstack::diag

@@ -62,8 +62,9 @@ enum EffectTrait : unsigned {
   kRefineOnlyIfBetter = 1U << 4U,
 };
 
-/// An effect plug-in: its kind in the vocabulary, its traits and its fit functions. The registry
-/// (diagnosis/effects/registry.cpp) holds one per family; the engine knows effects only by these.
+/// An effect plug-in: its kind in the vocabulary, its traits and its fit functions. Each family's
+/// file defines one (`EffectSpec FamilyPlugin()`), the registry (diagnosis/effects/registry.cpp)
+/// lists them; the engine knows effects only by these.
 struct EffectSpec {
   EffectKind kind = EffectKind::kNone;
   unsigned traits = kNoTraits;  ///< EffectTrait bits
@@ -74,7 +75,8 @@ struct EffectSpec {
   /// The vocabulary's name of `kind` (the report's and the confounders' key).
   const char* name = EffectOf(kind).name.data();
 
-  [[nodiscard]] bool Has(unsigned trait) const { return (traits & trait) != 0U; }
+  /// Whether the plug-in has every EffectTrait bit of `trait`.
+  [[nodiscard]] bool Has(unsigned trait) const { return (traits & trait) == trait; }
 };
 
 /// spec.refit near *near when both exist, else spec.fit.

@@ -41,12 +41,12 @@ void RingingAt(const Context& cx, double f_hz, double zeta, const std::vector<in
   out->resize((m + step - 1) / step, static_cast<Eigen::Index>(chans.size()));
   SecondOrderLowPassStream s(cx.data->t_s.data() + i0, static_cast<std::size_t>(m), f_hz, zeta,
                              in.data(), in.size(), restart != nullptr ? restart + i0 : nullptr);
-  const auto st = static_cast<std::size_t>(step);
+  const auto row_step = static_cast<std::size_t>(step);
   while (s.Next()) {
-    std::size_t j = (st - s.begin() % st) % st;  // the window's first kept row
-    for (; j < s.size(); j += st) {
+    std::size_t j = (row_step - s.begin() % row_step) % row_step;  // the window's first kept row
+    for (; j < s.size(); j += row_step) {
       const std::size_t rel = s.begin() + j;
-      const auto r = static_cast<Eigen::Index>(rel / st);
+      const auto r = static_cast<Eigen::Index>(rel / row_step);
       for (std::size_t k = 0; k < chans.size(); ++k) {
         (*out)(r, static_cast<Eigen::Index>(k)) =
             s.col(k)[j] - cx.load(i0 + static_cast<int>(rel), chans[k]);
@@ -91,8 +91,8 @@ double SearchSse(const Context& cx, const Series& target, const Mat& feature, bo
   // FitChannels with one feature, unrolled: the sums of NormalEq::Add with unit weight and the
   // arithmetic of NormalEq::Solve for p = 1 (Jacobi scaling, 1e-12 on the scaled diagonal), so the
   // value is the same to the last bit, without a per-row call or a covariance per channel.
-  const int st = cx.search_stride;
-  const int step = compact ? 1 : st;  // feature rows per searched row
+  const int row_step = cx.search_stride;
+  const int step = compact ? 1 : row_step;  // feature rows per searched row
   double sse_w = 0.0;
   for (int c = 0; c < cx.nc; ++c) {
     const double* x = feature.col(c).data();
@@ -100,7 +100,7 @@ double SearchSse(const Context& cx, const Series& target, const Mat& feature, bo
     double sxx = 0.0;
     double sxy = 0.0;
     double syy = 0.0;
-    for (int i = 0, r = 0; i < cx.n; i += st, r += step) {
+    for (int i = 0, r = 0; i < cx.n; i += row_step, r += step) {
       if (!cx.train[static_cast<std::size_t>(i)]) continue;
       const double yi = y[i];
       sxy += x[r] * yi;
@@ -109,11 +109,11 @@ double SearchSse(const Context& cx, const Series& target, const Mat& feature, bo
     }
     const double d = sxx > 0 ? 1.0 / std::sqrt(sxx) : 1.0;
     const double scaled = d * sxx * d + 1e-12;
-    const double bs = d * sxy / scaled;
-    const double beta = d * bs;
+    const double beta_scaled = d * sxy / scaled;
+    const double beta = d * beta_scaled;
     sse_w += std::max(0.0, syy - beta * sxy) * cx.weight(c);
   }
-  return sse_w * st;
+  return sse_w * row_step;
 }
 
 std::vector<int> StrideRows(const Context& cx) {

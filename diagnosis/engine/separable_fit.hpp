@@ -134,8 +134,8 @@ const std::uint8_t* Restarts(const Context& cx);
 /// search_stride-th row and scaled back to the full count: the objective of parameter searches.
 /// `feature` is n × N, or compact (`compact`: its row r is row r·search_stride, StrideRows).
 double SearchSse(const Context& cx, const Series& target, const Mat& feature, bool compact = false);
-/// Rows 0, st, 2·st, … below cx.n for st = cx.search_stride: the rows a search reads, and the rows
-/// of a compact search buffer (row i is at i / st).
+/// Rows 0, row_step, 2·row_step, … below cx.n for row_step = cx.search_stride: the rows a search
+/// reads, and the rows of a compact search buffer (row i is at i / row_step).
 std::vector<int> StrideRows(const Context& cx);
 /// out(r, c) = LP_τ[load_c] at row rows[r] (rows increasing): the first-order lag of the load,
 /// restarting per segment, kept only at `rows` (memory: rows × N instead of n × N; the same values

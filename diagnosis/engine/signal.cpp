@@ -69,8 +69,8 @@ NormalEq::Result NormalEq::Solve() const {
   Eigen::MatrixXd as = d.asDiagonal() * a * d.asDiagonal();
   for (int i = 0; i < p_; ++i) as(i, i) += 1e-12;
   Eigen::LDLT<Eigen::MatrixXd> ldlt(as);
-  const Eigen::VectorXd bs = ldlt.solve(d.asDiagonal() * xty_);
-  r.beta = d.asDiagonal() * bs;
+  const Eigen::VectorXd beta_scaled = ldlt.solve(d.asDiagonal() * xty_);
+  r.beta = d.asDiagonal() * beta_scaled;
   r.cov_unit = d.asDiagonal() * ldlt.solve(Eigen::MatrixXd::Identity(p_, p_)) * d.asDiagonal();
   r.sse = std::max(0.0, yty_ - r.beta.dot(xty_));
   return r;
