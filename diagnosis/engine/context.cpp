@@ -30,23 +30,16 @@ void FindSpectralLines(Context& cx) {
 
 namespace {
 
-/// The context from the residual and the sim's outputs (n × N each, mV/V): `sim` becomes the load.
-Context Build(const DiagData& d, Series resid, Mat sim, double block_s,
-              const Eigen::VectorXd* sigma) {
-  Context cx;
-  cx.data = &d;
-  cx.n = static_cast<int>(d.rows());
-  cx.nc = d.channels();
-  cx.resid = std::move(resid);
-  cx.rate_hz = d.rate_hz();
-  cx.dt = 1.0 / cx.rate_hz;
-  cx.uniform = true;
+/// Whether the clock is uniform to 1e-6 relative at the median rate.
+bool UniformClock(const DiagData& d, double dt) {
   for (std::size_t i = 1; i < d.t_s.size(); ++i) {
-    if (std::fabs(d.t_s[i] - d.t_s[i - 1] - cx.dt) > 1e-6 * cx.dt + 1e-9) {
-      cx.uniform = false;
-      break;
-    }
+    if (std::fabs(d.t_s[i] - d.t_s[i - 1] - dt) > 1e-6 * dt + 1e-9) return false;
   }
+  return true;
+}
+
+/// The robust noise per channel (or the given one) and its weights.
+void EstimateNoise(Context& cx, const Mat& sim, const Eigen::VectorXd* sigma) {
   cx.sigma.resize(cx.nc);
   cx.weight.resize(cx.nc);
   for (int c = 0; c < cx.nc; ++c) {
@@ -58,7 +51,11 @@ Context Build(const DiagData& d, Series resid, Mat sim, double block_s,
     cx.sigma(c) = s;
     cx.weight(c) = 1.0 / (s * s);
   }
-  // Hold-out: interleaved blocks of about block_s (≥ 20 rows, ≥ 30 blocks), every third held out.
+}
+
+/// Segment restarts and the hold-out split: interleaved blocks of about block_s (≥ 20 rows, ≥ 30
+/// blocks), every third held out; blocks restart at every segment boundary.
+void SplitHoldOut(Context& cx, const DiagData& d, double block_s) {
   auto rows_per_block = static_cast<std::size_t>(std::max(20.0, std::round(block_s * cx.rate_hz)));
   rows_per_block = std::min(rows_per_block, std::max<std::size_t>(4, d.rows() / 30));
   cx.block_s = static_cast<double>(rows_per_block) * cx.dt;
@@ -73,7 +70,6 @@ Context Build(const DiagData& d, Series resid, Mat sim, double block_s,
       }
     }
   }
-  // Blocks restart at every segment boundary (a short last block is closed there).
   std::size_t block = 0;
   std::size_t in_block = 0;
   for (std::size_t i = 0; i < d.rows(); ++i) {
@@ -89,7 +85,11 @@ Context Build(const DiagData& d, Series resid, Mat sim, double block_s,
       ++cx.n_hold;
     }
   }
-  // Zero and sensitivity of the sim by regression on the wrench.
+}
+
+/// Zero and sensitivity of the sim by regression on the wrench; the load (sim − zero) and its
+/// range.
+void SplitSim(Context& cx, const DiagData& d, Mat sim) {
   cx.zero = Vec::Zero(cx.nc);
   cx.sens = Mat::Zero(cx.nc, 6);
   if (d.has_wrench()) {
@@ -111,18 +111,38 @@ Context Build(const DiagData& d, Series resid, Mat sim, double block_s,
   cx.load_range.resize(cx.nc);
   for (int c = 0; c < cx.nc; ++c)
     cx.load_range(c) = cx.load.col(c).maxCoeff() - cx.load.col(c).minCoeff();
-  if (d.has_temp()) {
-    double lo = d.temp_c.front();
-    double hi = lo;
-    for (double v : d.temp_c) {
-      lo = std::min(lo, v);
-      hi = std::max(hi, v);
-    }
-    if (hi - lo > 1e-6) {
-      cx.dtemp.resize(d.rows());
-      for (std::size_t i = 0; i < d.rows(); ++i) cx.dtemp[i] = d.temp_c[i] - 20.0;
-    }
+}
+
+/// temp − 20 °C per row where the temperature changes at all (else empty).
+void SetTemperature(Context& cx, const DiagData& d) {
+  if (!d.has_temp()) return;
+  double lo = d.temp_c.front();
+  double hi = lo;
+  for (double v : d.temp_c) {
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
   }
+  if (hi - lo > 1e-6) {
+    cx.dtemp.resize(d.rows());
+    for (std::size_t i = 0; i < d.rows(); ++i) cx.dtemp[i] = d.temp_c[i] - 20.0;
+  }
+}
+
+/// The context from the residual and the sim's outputs (n × N each, mV/V): `sim` becomes the load.
+Context Build(const DiagData& d, Series resid, Mat sim, double block_s,
+              const Eigen::VectorXd* sigma) {
+  Context cx;
+  cx.data = &d;
+  cx.n = static_cast<int>(d.rows());
+  cx.nc = d.channels();
+  cx.resid = std::move(resid);
+  cx.rate_hz = d.rate_hz();
+  cx.dt = 1.0 / cx.rate_hz;
+  cx.uniform = UniformClock(d, cx.dt);
+  EstimateNoise(cx, sim, sigma);
+  SplitHoldOut(cx, d, block_s);
+  SplitSim(cx, d, std::move(sim));
+  SetTemperature(cx, d);
   FindSpectralLines(cx);
   return cx;
 }

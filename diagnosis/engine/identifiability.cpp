@@ -250,6 +250,36 @@ double JointBeyond(const Context& cx, const Series& target, const EffectFit& fit
   return *delta / (2.0 * std::sqrt(std::max(spread, 1e-300)));
 }
 
+namespace {
+
+/// Tests whether one confounder, fitted in `n_params` parameters, leaves the effect identified
+/// (CheckConfounders' test); *z_rest gets the effect's z beyond it.
+using BeyondFn =
+    std::function<bool(const std::function<Series(const Series&)>&, int n_params, double* z_rest)>;
+
+/// The drift in time (the kDriftInTime effect) as a confounder of a temperature-driven effect where
+/// the temperature is monotone in time: its sentence, and its name in out->with, when it confounds.
+std::string DriftInTimeConfounds(const Context& cx, const Series& target, const BeyondFn& beyond,
+                                 Confounding* out) {
+  const double rho = SpearmanWithTime(cx.data->temp_c);
+  const EffectSpec* drift = FindEffectWith(kDriftInTime);
+  if (!(std::fabs(rho) > 0.95) || drift == nullptr) return "";
+  const auto in_time = [&](const Series& y) {
+    auto f = drift->fit(cx, y);
+    return f ? std::move(f->pred) : Series(Series::Zero(cx.n, cx.nc));
+  };
+  double z_rest = 0.0;
+  const auto probe = drift->fit(cx, target);
+  if (!probe || beyond(in_time, probe->n_params, &z_rest)) return "";
+  out->with.emplace_back(drift->name);
+  return Fmt(
+      "the temperature is monotone in time (Spearman rho = %.2f), and a drift in time explains it "
+      "as well (beyond it z = %.1f)",
+      rho, z_rest);
+}
+
+}  // namespace
+
 Confounding CheckConfounders(const Context& cx, const Series& target, const EffectFit& fit,
                              double z_claim) {
   Confounding out;
@@ -272,8 +302,8 @@ Confounding CheckConfounders(const Context& cx, const Series& target, const Effe
   // alone, penalised for its parameters as the ranking does (Δχ² − p·ln n_hold), scores clearly
   // below the effect: a simpler explanation is not confounded by a far richer one.
   // Memory: the confounder alone is scored here and formed again in JointBeyond, not held.
-  auto beyond = [&](const std::function<Series(const Series&)>& confounder, int confounder_params,
-                    double* z_rest) {
+  const BeyondFn beyond = [&](const std::function<Series(const Series&)>& confounder,
+                              int confounder_params, double* z_rest) {
     const Sums s_alone = [&] {
       const Series alone = confounder(target);
       return Score(cx, target, &alone);
@@ -312,23 +342,8 @@ Confounding CheckConfounders(const Context& cx, const Series& target, const Effe
     words.push_back(ConfounderWords("load_polynomial", kLoadTerms) + BeyondWords(z_poly, z_alone));
   }
   if (spec->Has(kNeedsTemperature) && d.has_temp()) {
-    const double rho = SpearmanWithTime(d.temp_c);
-    const EffectSpec* drift = FindEffectWith(kDriftInTime);
-    if (std::fabs(rho) > 0.95 && drift != nullptr) {
-      const auto in_time = [&](const Series& y) {
-        auto f = drift->fit(cx, y);
-        return f ? std::move(f->pred) : Series(Series::Zero(cx.n, cx.nc));
-      };
-      double z_rest = 0.0;
-      const auto probe = drift->fit(cx, target);
-      if (probe && !beyond(in_time, probe->n_params, &z_rest)) {
-        out.with.emplace_back(drift->name);
-        words.push_back(
-            Fmt("the temperature is monotone in time (Spearman rho = %.2f), and a "
-                "drift in time explains it as well (beyond it z = %.1f)",
-                rho, z_rest));
-      }
-    }
+    std::string sentence = DriftInTimeConfounds(cx, target, beyond, &out);
+    if (!sentence.empty()) words.push_back(std::move(sentence));
   }
   for (std::size_t i = 0; i < words.size(); ++i) {
     out.words += (i == 0 ? "" : "; ") + words[i];
