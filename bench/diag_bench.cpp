@@ -6,8 +6,9 @@
 #include <vector>
 
 #include "bench/diag_jitter_data.hpp"
-#include "diagnosis/diagnose.hpp"
-#include "diagnosis/signal.hpp"
+#include "diagnosis/engine/diagnose.hpp"
+#include "diagnosis/engine/signal.hpp"
+#include "diagnosis/filters/lowpass.hpp"
 #include "sim/record.hpp"
 
 namespace {

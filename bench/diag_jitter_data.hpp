@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include "diagnosis/data.hpp"
+#include "diagnosis/engine/data.hpp"
 
 namespace ftstack::bench {
 

@@ -12,7 +12,8 @@
 #   ftstack_sim*         physics simulator, rigs, recordings          -> hal_if, hal, meas, calfile, sim
 #   ftstack_daemon       ftd's daemon (board and host)                -> hal_if, hal, fw, meas, calfile
 #   ftstack_daemon_sim   ftd's simulated backend (host only)          -> the daemon's + sim, daemon
-#   ftstack_diagnosis    sim-vs-real diagnosis engine                 -> meas
+#   ftstack_diagnosis_filters  the diagnosis's closed-form filters    -> nothing of ours
+#   ftstack_diagnosis    sim-vs-real diagnosis engine and effects     -> meas, diag_filters
 #   ftstack_diagnosis_report  its HTML/JSON reports                   -> meas, diag
 #   ftstack_diagnosis_eval    scorecard, demo, model prediction       -> diag, sim (and below)
 # Every ftstack_* library has one of these layers (a library without one fails configuration).
@@ -115,6 +116,8 @@ function(_ftstack_layer_of target out)
     set(${out} "daemon" PARENT_SCOPE)
   elseif(target STREQUAL "ftstack_daemon_sim")
     set(${out} "daemon_sim" PARENT_SCOPE)
+  elseif(target STREQUAL "ftstack_diagnosis_filters")
+    set(${out} "diag_filters" PARENT_SCOPE)
   elseif(target STREQUAL "ftstack_diagnosis")
     set(${out} "diag" PARENT_SCOPE)
   elseif(target STREQUAL "ftstack_diagnosis_report")
@@ -138,9 +141,10 @@ function(ftstack_check_layers)
   set(allowed_sim "hal_if;hal;meas;calfile;sim")
   set(allowed_daemon "hal_if;hal;fw;meas;calfile")
   set(allowed_daemon_sim "hal_if;hal;fw;meas;calfile;sim;daemon")
-  set(allowed_diag "meas")
-  set(allowed_diag_report "meas;diag")
-  set(allowed_diag_eval "hal_if;hal;meas;calfile;sim;diag")
+  set(allowed_diag_filters "")
+  set(allowed_diag "meas;diag_filters")
+  set(allowed_diag_report "meas;diag_filters;diag")
+  set(allowed_diag_eval "hal_if;hal;meas;calfile;sim;diag_filters;diag")
   get_property(libs GLOBAL PROPERTY FTSTACK_LIBRARIES)
   get_property(programs GLOBAL PROPERTY FTSTACK_PROGRAMS)
   foreach(lib IN LISTS libs programs)

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "diagnosis/data.hpp"
+#include "diagnosis/engine/data.hpp"
 
 namespace ftstack::diag {
 

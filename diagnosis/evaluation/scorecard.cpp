@@ -7,7 +7,7 @@
 #include <map>
 #include <string_view>
 
-#include "diagnosis/diagnose.hpp"
+#include "diagnosis/engine/diagnose.hpp"
 #include "measurement/effect_vocabulary.hpp"
 #include "sim/record.hpp"
 

@@ -1,4 +1,5 @@
 #include "diagnosis/report/html_report.hpp"
+#include "measurement/wrench.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,8 +10,6 @@
 
 namespace ftstack::diag {
 namespace {
-
-constexpr const char* kWrenchNames[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
 
 std::string Esc(const std::string& s) {
   std::string o;
@@ -344,7 +343,7 @@ std::string HtmlPlots(const DiagData& data, const Report& r) {
     if (!r.load_region.is_null() && r.load_region.contains("range")) {
       const std::string comp = r.load_region["component"].get<std::string>();
       for (int j = 0; j < 6; ++j) {
-        if (comp == kWrenchNames[j]) k = j;
+        if (comp == kWrenchAxisNames[j]) k = j;
       }
     }
     PlotSeries sc{{}, res.y, "#888", "residual", true};
@@ -354,8 +353,8 @@ std::string HtmlPlots(const DiagData& data, const Report& r) {
       sc.x[i] = data.wrench(static_cast<Eigen::Index>(i), k);
     sm.x = sc.x;
     PlotSpec p3;
-    p3.title = std::string("Residual of b") + std::to_string(c) + " against " + kWrenchNames[k];
-    p3.x_label = std::string(kWrenchNames[k]) + (k < 3 ? " (N)" : " (N·m)");
+    p3.title = std::string("Residual of b") + std::to_string(c) + " against " + kWrenchAxisNames[k];
+    p3.x_label = std::string(kWrenchAxisNames[k]) + (k < 3 ? " (N)" : " (N·m)");
     p3.y_label = "mV/V";
     h += "<h2>Residual against load</h2>" + SvgPlot(p3, {sc, sm});
   }

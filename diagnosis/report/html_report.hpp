@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/diagnose.hpp"
+#include "diagnosis/engine/diagnose.hpp"
 
 namespace ftstack::diag {
 

@@ -4,13 +4,35 @@
 #include <cmath>
 #include <random>
 
-#include "diagnosis/diagnose.hpp"
+#include "diagnosis/engine/diagnose.hpp"
+#include "diagnosis/engine/effect.hpp"
+#include "diagnosis/engine/signal.hpp"
+#include "diagnosis/filters/lowpass.hpp"
 #include "diagnosis/report/html_report.hpp"
-#include "diagnosis/signal.hpp"
+#include "diagnosis/report/json_report.hpp"
 #include "tests/diagnosis/diag_fixture.hpp"
 
 namespace ftstack::diag {
 namespace {
+
+// The registry holds one plug-in per effect of the vocabulary (docs/spec/diagnosis.md), in its
+// order, each named by its kind; the engine's trait look-ups find the effects the spec describes.
+TEST(DiagRegistry, OnePluginPerVocabularyEffectInOrder) {
+  const auto& effects = Effects();
+  ASSERT_EQ(effects.size() + 1, kEffectVocabulary.size());
+  for (std::size_t i = 0; i < effects.size(); ++i) {
+    EXPECT_EQ(effects[i].kind, kEffectVocabulary[i + 1].kind);
+    EXPECT_EQ(std::string(effects[i].name), kEffectVocabulary[i + 1].name);
+    EXPECT_NE(effects[i].fit, nullptr) << effects[i].name;
+    EXPECT_EQ(FindEffect(effects[i].name), &effects[i]);
+  }
+  ASSERT_NE(FindEffectWith(kDriftInTime), nullptr);
+  EXPECT_STREQ(FindEffectWith(kDriftInTime)->name, "zero_drift");
+  EXPECT_TRUE(FindEffect("hysteresis")->Has(kLoadHistory));
+  EXPECT_TRUE(FindEffect("thermal_span_drift")->Has(kNeedsTemperature | kTimeBased));
+  EXPECT_FALSE(FindEffect("creep")->Has(kTimeBased));
+  EXPECT_EQ(FindEffect("undetermined"), nullptr);
+}
 
 constexpr double kNoise = 1e-4;
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/data.hpp"
+#include "diagnosis/engine/data.hpp"
 #include "sim/default_sensor.hpp"
 
 namespace ftstack::diag::testing {

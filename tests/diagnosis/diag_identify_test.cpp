@@ -9,8 +9,9 @@
 #include <random>
 #include <vector>
 
-#include "diagnosis/diagnose.hpp"
-#include "diagnosis/identifiability.hpp"
+#include "diagnosis/engine/diagnose.hpp"
+#include "diagnosis/engine/identifiability.hpp"
+#include "diagnosis/report/json_report.hpp"
 
 namespace ftstack::diag {
 namespace {

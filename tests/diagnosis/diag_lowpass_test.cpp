@@ -12,8 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/lowpass_kernels.hpp"
-#include "diagnosis/signal.hpp"
+#include "diagnosis/engine/signal.hpp"
+#include "diagnosis/filters/lowpass.hpp"
+#include "diagnosis/filters/lowpass_kernels.hpp"
 
 namespace ftstack::diag {
 namespace {

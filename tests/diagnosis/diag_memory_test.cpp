@@ -9,9 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/diagnose.hpp"
-#include "diagnosis/effects/common.hpp"
-#include "diagnosis/signal.hpp"
+#include "diagnosis/effects/families.hpp"
+#include "diagnosis/engine/diagnose.hpp"
+#include "diagnosis/engine/signal.hpp"
+#include "diagnosis/filters/lowpass.hpp"
 #include "measurement/recording.hpp"
 #include "tests/diagnosis/diag_fixture.hpp"
 

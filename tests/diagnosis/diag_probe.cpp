@@ -3,7 +3,8 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "diagnosis/diagnose.hpp"
+#include "diagnosis/engine/diagnose.hpp"
+#include "diagnosis/report/json_report.hpp"
 #include "tests/diagnosis/diag_fixture.hpp"
 
 int main(int argc, char** argv) {

@@ -10,8 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/diagnose.hpp"
+#include "diagnosis/engine/diagnose.hpp"
 #include "diagnosis/report/html_report.hpp"
+#include "diagnosis/report/json_report.hpp"
 #include "tests/support/chromium.hpp"
 
 namespace ftstack::diag {

@@ -4,7 +4,8 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "diagnosis/diagnose.hpp"
+#include "diagnosis/engine/diagnose.hpp"
+#include "diagnosis/report/json_report.hpp"
 #include "sim/record.hpp"
 
 int main(int argc, char** argv) {

@@ -7,9 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/data.hpp"
-#include "diagnosis/effects.hpp"
-#include "diagnosis/signal.hpp"
+#include "diagnosis/engine/data.hpp"
+#include "diagnosis/engine/effect.hpp"
+#include "diagnosis/engine/signal.hpp"
+#include "diagnosis/filters/lowpass.hpp"
 #include "measurement/recording.hpp"
 
 namespace ftstack::diag {

@@ -10,11 +10,12 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/diagnose.hpp"
+#include "diagnosis/engine/diagnose.hpp"
 #include "diagnosis/evaluation/demo.hpp"
 #include "diagnosis/evaluation/model_prediction.hpp"
 #include "diagnosis/evaluation/scorecard.hpp"
 #include "diagnosis/report/html_report.hpp"
+#include "diagnosis/report/json_report.hpp"
 
 namespace {
 

@@ -1,0 +1,109 @@
+// The effect families' fit functions (diagnosis/effects/, one file per family) as the registry and
+// the families' variants call them.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "diagnosis/engine/effect.hpp"
+#include "diagnosis/engine/separable_fit.hpp"
+
+namespace ftstack::diag {
+
+/// thermal_zero_drift against a given temperature history dtemp (°C from 20 °C, one per row):
+/// r_c = a_c + k_c·dtemp (effects.cpp).
+[[nodiscard]] std::optional<EffectFit> FitThermalZeroOn(const Context& cx, const Series& target,
+                                                        const std::vector<double>& dtemp);
+/// thermal_zero_drift with a first-order lag τ ≥ 0 between the thermometer and the gauges:
+/// dtemp is replaced by LP_τ[dtemp] (restarting per segment), τ found by grid + golden search on
+/// the training rows (effects/thermal_lag.cpp).
+[[nodiscard]] std::optional<EffectFit> FitThermalZeroLagged(const Context& cx,
+                                                            const Series& target);
+
+/// A claimed thermal_zero_drift or zero_drift refined to thermal_zero_drift with a thermometer lag
+/// (FitThermalZeroLagged), or nullopt when the data has no temperature or the lag does not pay for
+/// itself (the plain model wins): the RefineFn of both.
+[[nodiscard]] std::optional<EffectFit> RefineWithThermalLag(const Context& cx,
+                                                            const Series& target);
+
+/// hysteresis as one rate-independent operator (Dahl or play, width searched) per bridge.
+[[nodiscard]] std::optional<EffectFit> FitHysteresisOperator(const Context& cx,
+                                                             const Series& target);
+/// hysteresis in the load path: one operator (Dahl or play, width searched) or a
+/// Prandtl–Ishlinskii sum of plays of fixed widths on each reference wrench axis, mapped to the
+/// bridges by the sensitivity cx.sens (effects/hysteresis_axes.cpp).
+[[nodiscard]] std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Series& target);
+/// hysteresis of general rate-independent shape: the one-operator fit or a Preisach superposition
+/// of relays (thresholds on 8 quantiles of each bridge's load, weights fitted per bridge; this
+/// class contains Prandtl–Ishlinskii sums of play operators), whichever has the lower training
+/// BIC (effects/hysteresis_pi.cpp).
+[[nodiscard]] std::optional<EffectFit> FitHysteresisFamily(const Context& cx, const Series& target);
+/// hysteresis refitted near an earlier fit (RefitFn): only the sub-family (load-path operators,
+/// one operator per bridge, or Preisach per bridge) that fit came from.
+[[nodiscard]] std::optional<EffectFit> RefitHysteresis(const Context& cx, const Series& target,
+                                                       const EffectFit& near, bool uncertainty);
+
+}  // namespace ftstack::diag
+
+namespace ftstack::diag::fx {
+
+std::optional<EffectFit> FitZeroOffset(const Context& cx, const Series& target);
+std::optional<EffectFit> FitZeroDrift(const Context& cx, const Series& target);
+std::optional<EffectFit> FitThermalZeroPlain(const Context& cx, const Series& target);
+std::optional<EffectFit> FitThermalSpan(const Context& cx, const Series& target);
+std::optional<EffectFit> FitExcitation(const Context& cx, const Series& target);
+/// excitation_drift refitted near an earlier fit (RefitFn): near's knot count and its neighbours.
+std::optional<EffectFit> RefitExcitation(const Context& cx, const Series& target,
+                                         const EffectFit& near, bool uncertainty);
+/// creep: the one-τ search on the full log grid (near == nullptr) or in a window of ±0.5 in log τ
+/// around near's τ (τ1 when near is two-τ; the full range when the optimum lands on the window's
+/// edge), then the two-τ variant: searched in full alone, from near's pair when near is two-τ,
+/// not at all when near is one-τ (effects/creep.cpp).
+std::optional<EffectFit> CreepSearch(const Context& cx, const Series& target, const EffectFit* near,
+                                     bool uncertainty);
+/// creep with two time constants τ1 < τ2 (effects/creep_family.cpp): τ2 searched with τ1 at the
+/// one-τ optimum `log_tau1`, then τ1 and τ2 refined in turn; replaces *best (and fills tau,
+/// tau_sigma, the channel fit and whether a gain term is in it) only when its training BIC is
+/// below `best_bic`. Returns whether it did.
+/// `start` (log τ1, log τ2), when given, replaces the coarse pair search and one refinement round
+/// (a refit near an earlier two-τ fit).
+bool FitCreepTwo(const Context& cx, const Series& target, double log_tau1, double best_bic,
+                 EffectFit* best, std::vector<double>* tau, std::vector<double>* tau_sigma,
+                 ChannelFit* best_f, bool* best_gamma, const double* start = nullptr,
+                 bool uncertainty = true);
+/// The fitted creep model (time constants tau, channel fit f with a_k per τ then γ when `gamma`)
+/// in OIML R 60's terms: e->standard["oiml_r60"] (docs/spec/diagnosis.md).
+void CreepOimlR60(const Context& cx, const std::vector<double>& tau,
+                  const std::vector<double>& tau_sigma, const ChannelFit& f, bool gamma,
+                  EffectFit* e);
+std::optional<EffectFit> FitGainError(const Context& cx, const Series& target);
+std::optional<EffectFit> FitBridgeNonlinearity(const Context& cx, const Series& target);
+std::optional<EffectFit> FitGeometric(const Context& cx, const Series& target);
+std::optional<EffectFit> FitLoadStiffening(const Context& cx, const Series& target);
+std::optional<EffectFit> FitMisalignment(const Context& cx, const Series& target);
+std::optional<EffectFit> FitTimeSkew(const Context& cx, const Series& target);
+std::optional<EffectFit> FitSaturation(const Context& cx, const Series& target);
+std::optional<EffectFit> FitOverloadShift(const Context& cx, const Series& target);
+std::optional<EffectFit> FitMains(const Context& cx, const Series& target);
+/// Adds harmonics 2..5 of the fitted mains fundamental f0 to *e (effects/mains_family.cpp): each
+/// at h·f0 or, above Nyquist, at its alias, kept when it lowers the training SSE by more than the
+/// BIC penalty of its 2 coefficients per channel; refits pred jointly with the fundamental and
+/// puts h<k>_amplitude_mvv (σ) and h<k>_seen_at_hz. Returns a clause for the evidence.
+std::string AddMainsHarmonics(const Context& cx, const Series& target, double f0, EffectFit* e);
+/// resonance: a coarse grid at the residual's lines (a log grid without any) then golden
+/// refinements of (f, ζ), and the second-mode search (near == nullptr); or the refinements only,
+/// from near's mode(s), a second mode only when near has one (effects/timing.cpp).
+std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target,
+                                         const EffectFit* near, bool uncertainty);
+/// The two-mode variant of a one-mode resonance fit *e at (f1_hz, zeta1) (effects/
+/// resonance_family.cpp): mode 2 searched at the lines of the residual spectrum, both refined in
+/// turn and fitted jointly (a participation per channel and mode); replaces *e (variant "two
+/// modes", mode 1 the lower frequency) only when the training BIC is lower and the weaker mode
+/// carries ≥ 1 % of the ringing's whitened energy. Returns a clause for the evidence.
+/// `start` (log f2, log ζ2), when given, replaces the search at the residual's lines (a refit);
+/// e->search_state gets (log f, log ζ) of mode 1 then mode 2 when the second mode is kept.
+std::string AddResonanceMode(const Context& cx, const Series& target, double f1_hz, double zeta1,
+                             EffectFit* e, const double* start = nullptr, bool uncertainty = true);
+
+}  // namespace ftstack::diag::fx

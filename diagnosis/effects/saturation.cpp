@@ -1,0 +1,97 @@
+// saturation: a bridge's output clipped at a level.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <vector>
+
+#include "diagnosis/effects/families.hpp"
+#include "diagnosis/engine/signal.hpp"
+
+namespace ftstack::diag::fx {
+
+std::optional<EffectFit> FitSaturation(const Context& cx, const Series& target) {
+  // Real = sim + residual; a clipping limit shows up as the extremes of the real outputs.
+  double hi = -std::numeric_limits<double>::infinity();
+  double lo = std::numeric_limits<double>::infinity();
+  double sim_hi = hi;
+  double sim_lo = lo;
+  for (int c = 0; c < cx.nc; ++c) {
+    for (int i = 0; i < cx.n; ++i) {
+      const double s = cx.sim_mvv(i, c);
+      const double r = s + target(i, c);
+      hi = std::max(hi, r);
+      lo = std::min(lo, r);
+      sim_hi = std::max(sim_hi, s);
+      sim_lo = std::min(sim_lo, s);
+    }
+  }
+  // Clipping needs the sim to go beyond what the real file ever reads.
+  if (sim_hi <= hi && sim_lo >= lo) return std::nullopt;
+  auto predict = [&](double l, double h, Series* out) {
+    double sse = 0.0;
+    for (int c = 0; c < cx.nc; ++c) {
+      double acc = 0.0;
+      for (int i = 0; i < cx.n; ++i) {
+        const double s = cx.sim_mvv(i, c);
+        const double v = std::clamp(s, l, h) - s;
+        if (out != nullptr) (*out)(i, c) = v;
+        if (cx.train[static_cast<std::size_t>(i)]) acc += (target(i, c) - v) * (target(i, c) - v);
+      }
+      sse += acc * cx.weight(c);
+    }
+    return sse;
+  };
+  const double range = std::max(sim_hi - sim_lo, 1e-9);
+  auto refine = [&](double start, bool upper, double other) {
+    std::vector<double> grid;
+    for (int j = -4; j <= 4; ++j) grid.push_back(start + 0.01 * range * j);
+    return MinimizeOnGrid(
+        [&](double v) { return upper ? predict(other, v, nullptr) : predict(v, other, nullptr); },
+        grid, 12, nullptr);
+  };
+  const double h1 = refine(hi, true, -std::numeric_limits<double>::infinity());
+  const double l1 = refine(lo, false, h1);
+  const double lim = std::max(std::fabs(lo), std::fabs(hi));
+  EffectFit e;
+  e.name = "saturation";
+  e.pred.resize(cx.n, cx.nc);
+  const double sse_sym = predict(-lim, lim, nullptr);
+  const double sse_asym = predict(l1, h1, nullptr);
+  if (sse_sym + Penalty(cx) <= sse_asym + 2 * Penalty(cx)) {
+    e.variant = "symmetric limit";
+    e.n_params = 1;
+    e.train_sse_w = predict(-lim, lim, &e.pred);
+    e.params["limit"] = lim;
+  } else {
+    e.variant = "asymmetric limits";
+    e.n_params = 2;
+    e.train_sse_w = predict(l1, h1, &e.pred);
+    e.params["limit"] = std::max(std::fabs(l1), std::fabs(h1));
+    e.params["limit_low"] = l1;
+    e.params["limit_high"] = h1;
+  }
+  e.sigma["limit"] = cx.sigma.maxCoeff() / 2.0;
+  e.channels = ActiveChannels(cx, e.pred);
+  int pinned = 0;
+  const double l = e.params["limit"].get<double>();
+  for (int c = 0; c < cx.nc; ++c) {
+    for (int i = 0; i < cx.n; ++i) {
+      if (std::fabs(cx.sim_mvv(i, c)) > l) ++pinned;
+    }
+  }
+  e.evidence = Fmt(
+      "%d samples where the sim exceeds %.4g mV/V read back pinned at the limit (sim reaches %.4g)",
+      pinned, l, std::max(std::fabs(sim_lo), std::fabs(sim_hi)));
+  return e;
+}
+
+}  // namespace ftstack::diag::fx
+
+namespace ftstack::diag {
+
+EffectSpec SaturationPlugin() {
+  return {.kind = EffectKind::kSaturation, .fit = &fx::FitSaturation};
+}
+
+}  // namespace ftstack::diag

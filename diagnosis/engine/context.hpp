@@ -1,0 +1,75 @@
+// The diagnosis context: the residual, its noise, the hold-out split and what every effect shares,
+// and the hold-out scores of a prediction.
+#pragma once
+
+#include <Eigen/Dense>
+#include <cstdint>
+#include <vector>
+
+#include "diagnosis/engine/data.hpp"
+
+namespace ftstack::diag {
+
+/// A per-row series of every channel (n × N, mV/V) held in single precision: the residual, the
+/// fits' targets and their predictions. Memory: 4 bytes a value (at 10^6 rows × 8 channels, 32 MB
+/// instead of 64 MB); the rounding, 6e-8 of the value, is far below the noise of any recording.
+/// Every sum over a Series is accumulated in double.
+using Series = Eigen::MatrixXf;
+
+/// Everything the effect models share, computed once from the data.
+struct Context {
+  const DiagData* data = nullptr;
+  int n = 0;                        ///< rows
+  int nc = 0;                       ///< channels
+  Series resid;                     ///< n × N real − sim, mV/V
+  Eigen::VectorXd sigma;            ///< robust noise per channel, mV/V
+  Eigen::VectorXd weight;           ///< 1/σ² per channel
+  std::vector<std::uint8_t> train;  ///< 1 = row used for fitting, 0 = held out
+  std::size_t n_train = 0;
+  std::size_t n_hold = 0;
+  double block_s = 0.0;        ///< length of the interleaved hold-out blocks
+  Eigen::VectorXd zero;        ///< sim at zero wrench per channel (regression intercept), mV/V
+  Eigen::MatrixXd load;        ///< n × N: sim − zero (the load-induced part)
+  Eigen::MatrixXd sens;        ///< N × 6 sim sensitivity d(mV/V)/d(wrench) by regression
+  Eigen::VectorXd load_range;  ///< per channel max − min of load, mV/V
+  std::vector<double> dtemp;   ///< temp − 20 °C; empty without temperature
+  bool uniform = true;         ///< sampling uniform to 1e-6 relative
+  double dt = 0.0;             ///< median sample interval, s
+  double rate_hz = 0.0;
+  int search_stride =
+      1;  ///< row step used inside nonlinear parameter searches (final fits use all)
+  /// 1 at the first row of every segment after the first (DiagData::segment): stateful models
+  /// restart there and hold-out blocks never straddle it. Empty for one recording.
+  std::vector<std::uint8_t> restart;
+  int segments = 1;             ///< number of joined recordings
+  std::vector<double> peak_hz;  ///< prominent lines of the residual spectrum, strongest first
+  std::vector<double> peak_ratio;
+
+  /// The sim's output of row i, channel c, mV/V (load + zero: the data's sim_mvv may be released).
+  [[nodiscard]] double sim_mvv(int i, int c) const { return load(i, c) + zero(c); }
+};
+
+/// Builds the context: residual, noise, hold-out blocks (every third block of ~block_s).
+/// `sigma` (one per channel), when given, replaces the robust noise estimate.
+[[nodiscard]] Context MakeContext(const DiagData& d, double block_s = 0.5,
+                                  const Eigen::VectorXd* sigma = nullptr);
+/// The same, taking the memory of d->real_mvv and d->sim_mvv for the residual and the load (both
+/// are left empty; d->released_channels keeps their width). Memory: two n × N matrices fewer.
+[[nodiscard]] Context MakeContext(DiagData* d, double block_s = 0.5,
+                                  const Eigen::VectorXd* sigma = nullptr);
+/// Replaces the context's noise per channel (and what depends on it: weights, spectral lines);
+/// the same as MakeContext with `sigma`, without the data's bridge matrices.
+void SetNoise(Context* cx, const Eigen::VectorXd& sigma);
+
+/// Whitened sums over train or hold-out rows.
+struct Sums {
+  double train_sse = 0.0;
+  double hold_sse = 0.0;
+  double hold_pp = 0.0;  ///< Σ (pred)²/σ² on hold-out rows
+};
+[[nodiscard]] Sums Score(const Context& cx, const Series& target, const Series* pred);
+/// Score(cx, target, &(a + b)) without the n × N sum (the same sums, element by element).
+[[nodiscard]] Sums ScoreSum(const Context& cx, const Series& target, const Series& a,
+                            const Series& b);
+
+}  // namespace ftstack::diag

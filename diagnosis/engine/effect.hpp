@@ -1,0 +1,96 @@
+// What an effect is to the engine: a fitted effect (EffectFit) and its plug-in (EffectSpec).
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "diagnosis/engine/context.hpp"
+#include "measurement/effect_vocabulary.hpp"
+
+namespace ftstack::diag {
+
+/// A fitted effect: its prediction of the residual and what to report.
+struct EffectFit {
+  std::string name;
+  std::string variant;  ///< which parametrisation won inside the effect
+  int n_params = 0;
+  Series pred;  ///< n × N predicted residual, mV/V
+  nlohmann::json params = nlohmann::json::object();
+  nlohmann::json sigma = nlohmann::json::object();  ///< 1-σ uncertainty of params (same keys)
+  std::vector<int> channels;                        ///< channels the effect acts on
+  /// Figures in a standard's terms computed from the fitted shape, by standard (e.g. "oiml_r60").
+  nlohmann::json standard = nlohmann::json::object();
+  std::string evidence;
+  double train_sse_w = 0.0;  ///< whitened training SSE after the fit
+  /// The nonlinear parameters as the search left them (a RefitFn's start; not reported).
+  std::vector<double> search_state;
+};
+
+using FitFn = std::optional<EffectFit> (*)(const Context&, const Series& target);
+/// Refits an effect near an earlier fit of the same effect: `near`'s nonlinear parameters start a
+/// local search (a full search only when the optimum leaves the local window) and its variant
+/// class is kept. The pair stage's partner fits and backfits use it: there the target differs from
+/// the one `near` was fitted to by another effect's prediction, not by a new shape. Without
+/// `uncertainty` the nonlinear parameters' 1-σ are not computed (null): for intermediate fits
+/// whose parameters only start the next one, never for a fit that is reported.
+using RefitFn = std::optional<EffectFit> (*)(const Context&, const Series& target,
+                                             const EffectFit& near, bool uncertainty);
+
+/// A claimed effect's refinement after the ranking, fitted to what the other claimed effects leave:
+/// the refined fit, or nullopt where the refinement does not apply to the data.
+using RefineFn = std::optional<EffectFit> (*)(const Context&, const Series& target);
+
+/// What the engine reads about an effect instead of its name (bits of EffectSpec::traits).
+enum EffectTrait : unsigned {
+  kNoTraits = 0U,
+  /// Its shape is a function of time (or of a temperature that may be monotone in time): tested
+  /// against per-recording offsets, a function of the load and its history, a load polynomial.
+  kTimeBased = 1U << 0U,
+  /// A rate-independent function of the load's history (hysteresis): where every load is held once
+  /// an offset per load or per recording mimics it; per-hold offsets and a load polynomial are of
+  /// its own kind and are not tested against it.
+  kLoadHistory = 1U << 1U,
+  /// Driven by the recorded temperature: tested against the drift in time (kDriftInTime) where the
+  /// temperature is monotone in time.
+  kNeedsTemperature = 1U << 2U,
+  /// The plain drift in time: the alternative the engine tests temperature-driven effects against.
+  kDriftInTime = 1U << 3U,
+  /// refine_claim replaces the claimed fit only when it scores better on the held-out rows
+  /// (penalised like the ranking); without it, whenever it applies.
+  kRefineOnlyIfBetter = 1U << 4U,
+};
+
+/// An effect plug-in: its kind in the vocabulary, its traits and its fit functions. Each family's
+/// file defines one (`EffectSpec FamilyPlugin()`), the registry (diagnosis/effects/registry.cpp)
+/// lists them; the engine knows effects only by these.
+struct EffectSpec {
+  EffectKind kind = EffectKind::kNone;
+  unsigned traits = kNoTraits;  ///< EffectTrait bits
+  FitFn fit = nullptr;
+  RefitFn refit = nullptr;  ///< nullptr: the effect has no costly search; fit() is used
+  int cost = 1;  ///< relative cost of a fit: when fits run in parallel, costlier ones start first
+  RefineFn refine_claim = nullptr;  ///< nullptr: a claim is reported as ranked
+  /// The vocabulary's name of `kind` (the report's and the confounders' key).
+  const char* name = EffectOf(kind).name.data();
+
+  /// Whether the plug-in has every EffectTrait bit of `trait`.
+  [[nodiscard]] bool Has(unsigned trait) const { return (traits & trait) == trait; }
+};
+
+/// spec.refit near *near when both exist, else spec.fit.
+[[nodiscard]] std::optional<EffectFit> FitNear(const EffectSpec& spec, const Context& cx,
+                                               const Series& target, const EffectFit* near,
+                                               bool uncertainty = true);
+
+/// Every effect of the vocabulary except `none`, in spec order (the registry).
+[[nodiscard]] const std::vector<EffectSpec>& Effects();
+/// The effect named `name`, or nullptr.
+[[nodiscard]] const EffectSpec* FindEffect(const std::string& name);
+/// The first effect with every bit of `traits`, or nullptr.
+[[nodiscard]] const EffectSpec* FindEffectWith(unsigned traits);
+/// Whether the effect of `fit` has `trait` (false for an effect the registry does not hold).
+[[nodiscard]] bool HasTrait(const EffectFit& fit, unsigned trait);
+
+}  // namespace ftstack::diag

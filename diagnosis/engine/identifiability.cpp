@@ -1,0 +1,358 @@
+#include "diagnosis/engine/identifiability.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <map>
+
+#include "diagnosis/engine/debug.hpp"
+#include "diagnosis/engine/signal.hpp"
+
+namespace ftstack::diag {
+namespace {
+
+using Mat = Eigen::MatrixXd;
+
+/// Offsets per channel and group from the training rows' mean of `target`; groups without a
+/// training row predict 0.
+Series GroupOffsets(const Context& cx, const Series& target, const std::vector<int>& group,
+                    int groups) {
+  Mat sum = Mat::Zero(groups, cx.nc);
+  std::vector<double> count(static_cast<std::size_t>(groups), 0.0);
+  for (int i = 0; i < cx.n; ++i) {
+    if (cx.train[static_cast<std::size_t>(i)] == 0) continue;
+    const int g = group[static_cast<std::size_t>(i)];
+    sum.row(g) += target.row(i).cast<double>();
+    count[static_cast<std::size_t>(g)] += 1.0;
+  }
+  Series pred(cx.n, cx.nc);
+  for (int i = 0; i < cx.n; ++i) {
+    const int g = group[static_cast<std::size_t>(i)];
+    const double k = count[static_cast<std::size_t>(g)];
+    pred.row(i) = k > 0 ? Eigen::RowVectorXf((sum.row(g) / k).cast<float>())
+                        : Eigen::RowVectorXf::Zero(cx.nc);
+  }
+  return pred;
+}
+
+/// Number of terms of LoadPolynomial: 1, the 6 wrench components, their 21 products (the
+/// report's words say 28).
+constexpr int kLoadTerms = 28;
+
+/// Per channel, target ≈ a quadratic polynomial of the reference wrench (each component scaled by
+/// its peak), fitted on the training rows: a smooth function of the load, ramps included.
+Series LoadPolynomial(const Context& cx, const Series& target) {
+  const auto& w = cx.data->wrench;
+  Eigen::Matrix<double, 6, 1> scale;
+  for (int k = 0; k < 6; ++k) scale(k) = std::max<double>(w.col(k).cwiseAbs().maxCoeff(), 1e-300);
+  auto terms = [&](int i, double* x) {
+    int j = 0;
+    x[j++] = 1.0;
+    double u[6];
+    for (int k = 0; k < 6; ++k) x[j++] = u[k] = w(i, k) / scale(k);
+    for (int k = 0; k < 6; ++k) {
+      for (int l = k; l < 6; ++l) x[j++] = u[k] * u[l];
+    }
+  };
+  Series pred(cx.n, cx.nc);
+  double x[kLoadTerms];
+  for (int c = 0; c < cx.nc; ++c) {
+    NormalEq ne(kLoadTerms);
+    for (int i = 0; i < cx.n; i += cx.search_stride) {
+      if (!cx.train[static_cast<std::size_t>(i)]) continue;
+      terms(i, x);
+      ne.Add(x, target(i, c));
+    }
+    const Eigen::VectorXd beta = ne.Solve().beta;
+    for (int i = 0; i < cx.n; ++i) {
+      terms(i, x);
+      pred(i, c) = static_cast<float>(Eigen::Map<const Eigen::VectorXd>(x, kLoadTerms).dot(beta));
+    }
+  }
+  return pred;
+}
+
+/// Held-out improvement of `pred` on `target` and its significance (in noise standard deviations
+/// of Σ 2·r·p over the held-out rows).
+void Improvement(const Context& cx, const Series& target, const Series& pred, double* delta,
+                 double* z) {
+  const Sums s0 = Score(cx, target, nullptr);
+  const Sums s1 = Score(cx, target, &pred);
+  *delta = s0.hold_sse - s1.hold_sse;
+  *z = *delta / (2.0 * std::sqrt(std::max(s1.hold_pp, 1e-300)));
+}
+
+double SpearmanWithTime(const std::vector<double>& temp) {
+  const std::size_t n = temp.size();
+  std::vector<std::size_t> idx(n);
+  for (std::size_t i = 0; i < n; ++i) idx[i] = i;
+  std::sort(idx.begin(), idx.end(),
+            [&](std::size_t a, std::size_t b) { return temp[a] < temp[b]; });
+  std::vector<double> rank(n);
+  for (std::size_t r = 0; r < n; ++r) rank[idx[r]] = static_cast<double>(r);
+  const double mean = 0.5 * static_cast<double>(n - 1);
+  double sxy = 0.0;
+  double sxx = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    sxy += (rank[i] - mean) * (static_cast<double>(i) - mean);
+    sxx += (static_cast<double>(i) - mean) * (static_cast<double>(i) - mean);
+  }
+  return sxx > 0 ? sxy / sxx : 0.0;
+}
+
+std::string Fmt(const char* f, double a, double b) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, f, a, b);
+  return buf;
+}
+
+/// What a confounder is, in words ("… explains it as well" follows).
+std::string ConfounderWords(const std::string& what, int groups) {
+  if (what == "segment_offsets")
+    return Fmt("one offset per joined recording (%.0f segments)", groups, 0);
+  if (what == "load_function")
+    return Fmt("one offset per distinct static load (%.0f loads)", groups, 0);
+  if (what == "load_polynomial") {
+    return Fmt("a quadratic function of the reference wrench per channel (%.0f terms)", groups, 0);
+  }
+  return Fmt("one offset per load hold (%.0f holds: a function of the load's history)", groups, 0);
+}
+
+/// The rest of a confounding sentence: the effect's held-out improvement beyond the confounder.
+std::string BeyondWords(double z_rest, double z_alone) {
+  return Fmt(
+      " explains it as well: beyond that, the effect improves the held-out rows by z = %.1f "
+      "only (alone z = %.1f)",
+      z_rest, z_alone);
+}
+
+/// Wrench of every row quantised to 0.5 % of each axis's range.
+std::vector<std::array<long long, 6>> LoadKeys(const DiagData& d, int n) {
+  std::array<double, 6> step{};
+  for (int a = 0; a < 6; ++a) {
+    const double range = d.wrench.col(a).maxCoeff() - d.wrench.col(a).minCoeff();
+    step[static_cast<std::size_t>(a)] = range > 0 ? 0.005 * range : 1.0;
+  }
+  std::vector<std::array<long long, 6>> keys(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    for (int a = 0; a < 6; ++a) {
+      keys[static_cast<std::size_t>(i)][static_cast<std::size_t>(a)] =
+          std::llround(d.wrench(i, a) / step[static_cast<std::size_t>(a)]);
+    }
+  }
+  return keys;
+}
+
+/// One group per load hold (a run of ≥ 0.25 s at one quantised load) together with the movement
+/// that leads into it; a new group also at every segment start.
+std::vector<int> HoldGroups(const Context& cx, int* groups) {
+  const auto keys = LoadKeys(*cx.data, cx.n);
+  const int min_run = std::max(3, static_cast<int>(std::lround(0.25 * cx.rate_hz)));
+  std::vector<int> g(static_cast<std::size_t>(cx.n), 0);
+  int id = 0;
+  int run = 1;
+  bool counted = false;  // the current run already opened a group
+  for (int i = 1; i < cx.n; ++i) {
+    const bool restart = !cx.restart.empty() && cx.restart[static_cast<std::size_t>(i)] != 0;
+    if (restart) {
+      ++id;
+      run = 1;
+      counted = true;
+    } else if (keys[static_cast<std::size_t>(i)] == keys[static_cast<std::size_t>(i - 1)]) {
+      ++run;
+    } else {
+      run = 1;
+      counted = false;
+    }
+    if (run >= min_run && !counted) {
+      counted = true;
+      // The hold began min_run − 1 rows ago: the group changes after the previous hold.
+      if (i > min_run) ++id;
+      for (int k = std::max(0, i - min_run + 1); k <= i; ++k) g[static_cast<std::size_t>(k)] = id;
+    }
+    g[static_cast<std::size_t>(i)] = id;
+  }
+  *groups = id + 1;
+  if (*groups < 2 || *groups * 20 > cx.n) {
+    *groups = 0;
+    return {};
+  }
+  return g;
+}
+
+}  // namespace
+
+std::vector<int> ConfounderGroups(const Context& cx, const std::string& name, int* groups) {
+  const DiagData& d = *cx.data;
+  std::vector<int> g;
+  *groups = 0;
+  if (name == "hold_offsets") return d.has_wrench() ? HoldGroups(cx, groups) : g;
+  if (name == "segment_offsets") {
+    if (cx.segments < 2 || d.segment.size() != static_cast<std::size_t>(cx.n)) return g;
+    *groups = cx.segments;
+    return d.segment;
+  }
+  if (name == "load_function" && d.has_wrench()) {
+    const auto keys = LoadKeys(d, cx.n);
+    std::map<std::array<long long, 6>, int> seen;
+    g.resize(static_cast<std::size_t>(cx.n));
+    for (int i = 0; i < cx.n; ++i) {
+      g[static_cast<std::size_t>(i)] =
+          seen.emplace(keys[static_cast<std::size_t>(i)], static_cast<int>(seen.size()))
+              .first->second;
+    }
+    if (seen.size() < 2 || static_cast<int>(seen.size()) * 20 > cx.n) return {};
+    *groups = static_cast<int>(seen.size());
+  }
+  return g;
+}
+
+/// The joint model (the confounder fitted to what the effect leaves, the effect refitted to what
+/// the confounder leaves, 3 times from the effect's fit) against the confounder alone (s_alone):
+/// the held-out improvement *delta and its z. Memory: one n × N work buffer; the confounder alone
+/// is formed again for the spread instead of held.
+double JointBeyond(const Context& cx, const Series& target, const EffectFit& fit,
+                   const EffectSpec& spec, const std::function<Series(const Series&)>& confounder,
+                   const Sums& s_alone, double* delta) {
+  Series eff;  // the effect's refit (empty: the effect's own prediction, fit.pred)
+  bool eff_zero = false;
+  Series conf;  // assigned in the first iteration
+  Series work;
+  for (int iter = 0; iter < 3; ++iter) {
+    work = target - (eff.size() > 0 ? eff : fit.pred);
+    eff = Series();
+    conf = confounder(work);
+    work = target - conf;
+    auto refit = spec.fit(cx, work);
+    if (!refit) {
+      eff_zero = true;
+      break;
+    }
+    eff = std::move(refit->pred);
+  }
+  work = Series();
+  if (eff_zero) eff = Series::Zero(cx.n, cx.nc);
+  const Sums s_joint = ScoreSum(cx, target, conf, eff);
+  const Series alone = confounder(target);
+  // Score(cx, target, &(joint − alone)).hold_pp without an n × N difference matrix.
+  double spread = 0.0;
+  for (int c = 0; c < cx.nc; ++c) {
+    double pp = 0.0;
+    for (int i = 0; i < cx.n; ++i) {
+      if (cx.train[static_cast<std::size_t>(i)]) continue;
+      const double p = static_cast<double>(conf(i, c)) + eff(i, c) - alone(i, c);
+      pp += p * p;
+    }
+    spread += pp * cx.weight(c);
+  }
+  *delta = s_alone.hold_sse - s_joint.hold_sse;
+  return *delta / (2.0 * std::sqrt(std::max(spread, 1e-300)));
+}
+
+namespace {
+
+/// Tests whether one confounder, fitted in `n_params` parameters, leaves the effect identified
+/// (CheckConfounders' test); *z_rest gets the effect's z beyond it.
+using BeyondFn =
+    std::function<bool(const std::function<Series(const Series&)>&, int n_params, double* z_rest)>;
+
+/// The drift in time (the kDriftInTime effect) as a confounder of a temperature-driven effect where
+/// the temperature is monotone in time: its sentence, and its name in out->with, when it confounds.
+std::string DriftInTimeConfounds(const Context& cx, const Series& target, const BeyondFn& beyond,
+                                 Confounding* out) {
+  const double rho = SpearmanWithTime(cx.data->temp_c);
+  const EffectSpec* drift = FindEffectWith(kDriftInTime);
+  if (!(std::fabs(rho) > 0.95) || drift == nullptr) return "";
+  const auto in_time = [&](const Series& y) {
+    auto f = drift->fit(cx, y);
+    return f ? std::move(f->pred) : Series(Series::Zero(cx.n, cx.nc));
+  };
+  double z_rest = 0.0;
+  const auto probe = drift->fit(cx, target);
+  if (!probe || beyond(in_time, probe->n_params, &z_rest)) return "";
+  out->with.emplace_back(drift->name);
+  return Fmt(
+      "the temperature is monotone in time (Spearman rho = %.2f), and a drift in time explains it "
+      "as well (beyond it z = %.1f)",
+      rho, z_rest);
+}
+
+}  // namespace
+
+Confounding CheckConfounders(const Context& cx, const Series& target, const EffectFit& fit,
+                             double z_claim) {
+  Confounding out;
+  // A function of the load's history alone (kLoadHistory): where every load is held once (static
+  // poses, no return to a load from the other side) an offset per load or per recording mimics it.
+  const EffectSpec* spec = FindEffect(fit.name);
+  if (spec == nullptr) return out;
+  const bool history = spec->Has(kLoadHistory);
+  if (!spec->Has(kTimeBased) && !history) return out;
+  double delta_alone = 0.0;
+  double z_alone = 0.0;
+  Improvement(cx, target, fit.pred, &delta_alone, &z_alone);
+  // Joint model by backfitting: the confounder fitted to what the effect leaves, the effect
+  // refitted to what the confounder leaves. Identified when the joint model beats the confounder
+  // alone on the held-out rows (z > z_claim and a tenth of the effect's own improvement).
+  const double log_hold = std::log(std::max<double>(2.0, static_cast<double>(cx.n_hold)));
+  const double score_effect = delta_alone - fit.n_params * log_hold;
+  const double base_sse = Score(cx, target, nullptr).hold_sse;
+  // Identified when the joint model beats the confounder alone (below), or when the confounder
+  // alone, penalised for its parameters as the ranking does (Δχ² − p·ln n_hold), scores clearly
+  // below the effect: a simpler explanation is not confounded by a far richer one.
+  // Memory: the confounder alone is scored here and formed again in JointBeyond, not held.
+  const BeyondFn beyond = [&](const std::function<Series(const Series&)>& confounder,
+                              int confounder_params, double* z_rest) {
+    const Sums s_alone = [&] {
+      const Series alone = confounder(target);
+      return Score(cx, target, &alone);
+    }();
+    const double score_conf = base_sse - s_alone.hold_sse - confounder_params * log_hold;
+    *z_rest = 0.0;
+    if (score_conf < score_effect) return true;
+    double delta = 0.0;
+    *z_rest = JointBeyond(cx, target, fit, *spec, confounder, s_alone, &delta);
+    return *z_rest > z_claim && delta > 0.0;
+  };
+  std::vector<std::string> words;
+  for (const char* name : {"segment_offsets", "load_function", "hold_offsets"}) {
+    if (history && std::string(name) == "hold_offsets") continue;  // the effect is one
+    int groups = 0;
+    const std::vector<int> g = ConfounderGroups(cx, name, &groups);
+    if (g.empty()) continue;
+    double z_rest = 0.0;
+    const auto offsets = [&](const Series& y) { return GroupOffsets(cx, y, g, groups); };
+    const bool identified = beyond(offsets, groups * cx.nc, &z_rest);
+    if (DebugOn()) {
+      std::fprintf(stderr, "confounder %s (%d groups) for %s: z_rest %.1f -> %s\n", name, groups,
+                   fit.name.c_str(), z_rest, identified ? "identified" : "confounded");
+    }
+    if (identified) continue;
+    out.with.push_back(name);
+    words.push_back(ConfounderWords(name, groups) + BeyondWords(z_rest, z_alone));
+  }
+  const DiagData& d = *cx.data;
+  // A smooth function of the load, ramps included (where holds are short or absent).
+  double z_poly = 0.0;
+  if (d.has_wrench() && !history && cx.n > 20 * kLoadTerms &&
+      !beyond([&](const Series& y) { return LoadPolynomial(cx, y); }, kLoadTerms * cx.nc,
+              &z_poly)) {
+    out.with.push_back("load_polynomial");
+    words.push_back(ConfounderWords("load_polynomial", kLoadTerms) + BeyondWords(z_poly, z_alone));
+  }
+  if (spec->Has(kNeedsTemperature) && d.has_temp()) {
+    std::string sentence = DriftInTimeConfounds(cx, target, beyond, &out);
+    if (!sentence.empty()) words.push_back(std::move(sentence));
+  }
+  for (std::size_t i = 0; i < words.size(); ++i) {
+    out.words += (i == 0 ? "" : "; ") + words[i];
+  }
+  if (!out.words.empty()) {
+    out.words =
+        "The data cannot separate " + fit.name + " from another explanation: " + out.words + ".";
+  }
+  return out;
+}
+
+}  // namespace ftstack::diag

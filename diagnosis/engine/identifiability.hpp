@@ -1,0 +1,44 @@
+// Identifiability of time-based effects: tests a claimed drift in time against what the data
+// cannot tell it from (per-segment offsets, a function of the load, temperature versus time).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "diagnosis/engine/effect.hpp"
+
+namespace ftstack::diag {
+
+/// What a claimed effect could not be told apart from.
+struct Confounding {
+  std::vector<std::string> with;  ///< "segment_offsets", "load_function", "hold_offsets",
+                                  ///< "load_polynomial", or the name of the drift in time
+  std::string words;              ///< one sentence for a person
+};
+
+/// Tests `fit` (fitted to `target`) against its confounders: the confounder and the effect are
+/// fitted jointly (backfitting, training rows only), and the effect is confounded with it when the
+/// joint model does not beat the confounder alone on the held-out rows significantly (z at most
+/// `z_claim`) although the confounder
+/// alone, penalised for its parameters like the ranking (Δχ² − p·ln n_hold), scores at least as
+/// well as the effect's penalised score. Confounders tried:
+///  - segment_offsets: one offset per channel and joined recording (≥ 2 segments);
+///  - load_function: one offset per channel and distinct static load (the wrench quantised to
+///    0.5 % of each axis's range; only where loads are held, ≤ rows/20 distinct loads);
+///  - hold_offsets: one offset per channel and load hold (a run of ≥ 0.25 s at one load, with the
+///    movement into it): any function of the load's history (a misfit of a history-dependent
+///    effect);
+///  - load_polynomial: a quadratic polynomial of the reference wrench per channel (28 terms): a
+///    smooth function of the load, ramps included (not for a kLoadHistory effect);
+///  - the drift in time (the kDriftInTime effect, reported by its name), for temperature-driven
+///    effects (kNeedsTemperature) when the temperature is monotone in time (|Spearman ρ| >
+///    0.95).
+[[nodiscard]] Confounding CheckConfounders(const Context& cx, const Series& target,
+                                           const EffectFit& fit, double z_claim);
+
+/// Group of every row for a confounder ("segment_offsets", "load_function"); empty when the
+/// confounder does not apply to the data. *groups receives the number of groups.
+[[nodiscard]] std::vector<int> ConfounderGroups(const Context& cx, const std::string& name,
+                                                int* groups);
+
+}  // namespace ftstack::diag

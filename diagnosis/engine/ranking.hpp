@@ -1,0 +1,50 @@
+// Ranking of the candidate effects: each alone, then pairs (internal to diagnosis/).
+#pragma once
+
+#include <Eigen/Dense>
+#include <chrono>
+#include <cstddef>
+
+#include "diagnosis/engine/debug.hpp"
+#include "diagnosis/engine/diagnose.hpp"
+#include "diagnosis/engine/effect.hpp"
+
+namespace ftstack::diag {
+
+/// An effect's fit with its held-out figures.
+struct Scored {
+  EffectFit fit;
+  double hold_sse = 0.0;
+  double delta = 0.0;
+  double z = 0.0;
+  double score = 0.0;
+  bool eligible = false;
+  double hold_rms_after = 0.0;  ///< held-out RMS after removing the prediction
+
+  /// Whether the prediction is held (only the pair starts keep theirs: memory).
+  [[nodiscard]] bool HasPrediction() const { return fit.pred.size() > 0; }
+};
+
+/// Pairs start from at most this many of the best eligible singles (BestPair).
+inline constexpr std::size_t kPairStarts = 3;
+/// Partners tried with each start (the best by their score on what the start leaves).
+inline constexpr std::size_t kPairPartners = 3;
+
+/// Held-out RMS of target − pred (pred nullptr: of target), all channels, mV/V.
+double HoldRms(const Context& cx, const Series& target, const Series* pred);
+/// Reports progress through options.progress when set.
+void Progress(const DiagnoseOptions& o, double f, const char* what);
+
+/// Every effect fitted alone to the residual and scored on the held-out rows, best first; each is
+/// listed among r.candidates. The fits run in parallel (options.threads); the result does not
+/// depend on their number. Only the kPairStarts best eligible fits keep their predictions.
+std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const Sums& base);
+
+/// Pairs: forward selection from each of the three best eligible singles: every other effect is
+/// fitted to what the first leaves, the best partners are kept, each pair is backfitted and scored
+/// on the held-out rows. True with *pa, *pb set when a pair beats every model so far (the best
+/// penalised held-out score among the qualifying pairs; independent of the thread count).
+bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Scored>& singles,
+              const Sums& base, EffectFit* pa, EffectFit* pb);
+
+}  // namespace ftstack::diag

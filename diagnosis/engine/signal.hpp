@@ -1,0 +1,66 @@
+// Numerical building blocks of the diagnosis: spectra, robust noise, least squares, the Dahl
+// operator, interpolation, correlation (the filters are in diagnosis/filters/).
+#pragma once
+
+#include <Eigen/Dense>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "measurement/numerics.hpp"
+
+namespace ftstack::diag {
+
+// Spectra, the play operator and the 1-D search are the shared numerics (measurement/numerics).
+using numerics::MinimizeOnGrid;
+using numerics::PlayOperator;
+using numerics::Spectrum;
+using numerics::Welch;
+using numerics::WelchSegment;
+
+/// White-noise σ of x from the median Welch level over 5 %…95 % of the Nyquist band (robust to
+/// slow effects and to narrow lines), corrected for the median of the χ² averaging distribution.
+[[nodiscard]] double RobustNoise(const double* x, std::size_t n, double rate_hz);
+
+/// Weighted linear least squares by normal equations, accumulated row by row.
+class NormalEq {
+ public:
+  explicit NormalEq(int p);
+  void Add(const double* x, double y, double w = 1.0);
+  /// Row with only `nnz` non-zero features at indices idx.
+  void AddSparse(const int* idx, const double* val, int nnz, double y, double w = 1.0);
+  struct Result {
+    Eigen::VectorXd beta;
+    Eigen::MatrixXd cov_unit;  ///< (XᵀWX)⁻¹; times the residual variance gives the covariance
+    double sse = 0.0;          ///< weighted residual sum of squares
+    double rows = 0.0;
+  };
+  [[nodiscard]] Result Solve() const;
+  [[nodiscard]] int p() const { return p_; }
+
+ private:
+  int p_;
+  Eigen::MatrixXd xtx_;
+  Eigen::VectorXd xty_;
+  double yty_ = 0.0;
+  double rows_ = 0.0;
+};
+
+/// Rate-independent first-order hysteresis operator (Dahl type) of x with characteristic travel
+/// width: z moves toward sign(dx) by 1 − exp(−|dx|/width) per step; starts at 0. Output in [−1, 1].
+void DahlOperator(const double* x, std::size_t n, double width, double* z);
+
+/// Value of a sampled signal at time tq (cubic Catmull-Rom on uniform grids, else linear; clamped
+/// at the ends). t must be increasing.
+[[nodiscard]] double InterpolateAt(const double* t, const double* x, std::size_t n, double tq,
+                                   bool uniform);
+/// The same, with a guess of the row at or just below tq (guess ≥ n: none): on a non-uniform
+/// clock the interval is walked to from the guess instead of searched, for queries near a row.
+[[nodiscard]] double InterpolateNear(const double* t, const double* x, std::size_t n, double tq,
+                                     bool uniform, std::size_t guess);
+
+/// Pearson correlation of two equally long series.
+[[nodiscard]] double Correlation(const double* a, const double* b, std::size_t n);
+
+}  // namespace ftstack::diag
