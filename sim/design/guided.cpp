@@ -91,6 +91,46 @@ FrameModel GuidedFrame(const GuidedParams& p) {
   return f;
 }
 
+namespace {
+
+// The strain sketch of every leaf (nine stations, four faces) and the leaves as solid members
+// (the FE check's geometry).
+void AddLeafSketchAndMembers(const GuidedParams& p, const FrameSolution& sol,
+                             const std::array<Stage, 3>& stages, DesignModel* model) {
+  DesignModel& m = *model;
+  for (int leaf = 0; leaf < 12; ++leaf) {
+    const double t = stages[static_cast<std::size_t>(leaf / 4)].thickness_m;
+    SketchSegment seg{sol.EndPoint(leaf * p.elements_per_leaf, false),
+                      sol.EndPoint(leaf * p.elements_per_leaf + p.elements_per_leaf - 1, true),
+                      {}};
+    for (int i = 0; i <= 8; ++i) {
+      const auto [e, s] = LeafPoint(p, leaf, p.leaf_length_m * i / 8.0);
+      seg.stations.push_back({sol.AxialStrain(e, s, 0, 0.5 * t), sol.AxialStrain(e, s, 0, -0.5 * t),
+                              sol.AxialStrain(e, s, 0.5 * p.leaf_width_m, 0),
+                              sol.AxialStrain(e, s, -0.5 * p.leaf_width_m, 0)});
+    }
+    m.sketch.push_back(seg);
+  }
+  m.body_count = sol.model().body_count;
+  for (int leaf = 0; leaf < 12; ++leaf) {
+    const FrameElement& first =
+        sol.model().elements[static_cast<std::size_t>(leaf * p.elements_per_leaf)];
+    const FrameElement& last = sol.model().elements[static_cast<std::size_t>(
+        leaf * p.elements_per_leaf + p.elements_per_leaf - 1)];
+    SolidMember mb;
+    mb.a_m = sol.EndPoint(leaf * p.elements_per_leaf, false);
+    mb.b_m = sol.EndPoint(leaf * p.elements_per_leaf + p.elements_per_leaf - 1, true);
+    mb.body_a = first.a.body;
+    mb.body_b = last.b.body;
+    mb.z_axis = first.z_hint;
+    mb.width_m = first.width_m;
+    mb.height_m = first.height_m;
+    m.members.push_back(mb);
+  }
+}
+
+}  // namespace
+
 DesignModel Guided(const GuidedParams& p, const Readout& r) {
   const FrameSolution sol(GuidedFrame(p));
   DesignModel m;
@@ -180,35 +220,7 @@ DesignModel Guided(const GuidedParams& p, const Readout& r) {
     m.buckling.push_back({sol.SectionAt(e, 0).row(0),
                           kPi * kPi * sc.e_pa * i_min / std::pow(fe.buckling_length_m, 2)});
   }
-  for (int leaf = 0; leaf < 12; ++leaf) {
-    const double t = stages[static_cast<std::size_t>(leaf / 4)].thickness_m;
-    SketchSegment seg{sol.EndPoint(leaf * p.elements_per_leaf, false),
-                      sol.EndPoint(leaf * p.elements_per_leaf + p.elements_per_leaf - 1, true),
-                      {}};
-    for (int i = 0; i <= 8; ++i) {
-      const auto [e, s] = LeafPoint(p, leaf, p.leaf_length_m * i / 8.0);
-      seg.stations.push_back({sol.AxialStrain(e, s, 0, 0.5 * t), sol.AxialStrain(e, s, 0, -0.5 * t),
-                              sol.AxialStrain(e, s, 0.5 * p.leaf_width_m, 0),
-                              sol.AxialStrain(e, s, -0.5 * p.leaf_width_m, 0)});
-    }
-    m.sketch.push_back(seg);
-  }
-  m.body_count = sol.model().body_count;
-  for (int leaf = 0; leaf < 12; ++leaf) {
-    const FrameElement& first =
-        sol.model().elements[static_cast<std::size_t>(leaf * p.elements_per_leaf)];
-    const FrameElement& last = sol.model().elements[static_cast<std::size_t>(
-        leaf * p.elements_per_leaf + p.elements_per_leaf - 1)];
-    SolidMember mb;
-    mb.a_m = sol.EndPoint(leaf * p.elements_per_leaf, false);
-    mb.b_m = sol.EndPoint(leaf * p.elements_per_leaf + p.elements_per_leaf - 1, true);
-    mb.body_a = first.a.body;
-    mb.body_b = last.b.body;
-    mb.z_axis = first.z_hint;
-    mb.width_m = first.width_m;
-    mb.height_m = first.height_m;
-    m.members.push_back(mb);
-  }
+  AddLeafSketchAndMembers(p, sol, stages, &m);
   for (const Stage& st : stages) {
     const std::string v = SlenderBeamViolation(p.leaf_length_m, p.leaf_width_m, st.thickness_m);
     if (!v.empty() && m.beam_validity.empty()) m.beam_validity = st.name + (" stage leaves: " + v);
