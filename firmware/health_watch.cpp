@@ -1,5 +1,7 @@
 #include "firmware/health_watch.hpp"
 
+#include <algorithm>
+
 #include "firmware/overload.hpp"
 #include "firmware/status_bits.hpp"
 
@@ -327,8 +329,9 @@ void HealthWatch::FinishBlock() {
   if (!use) return;
   ++blocks_seen_;
   if (commission_blocks_ > 0 && --commission_blocks_ == 0) {
-    for (std::size_t r = 0; r < kAxes; ++r)
+    for (std::size_t r = 0; r < kAxes; ++r) {
       sigma_ref_q8_[r] = sigma_ref_sum_q8_[r] / kCommissionBlocks;
+    }
   }
   if (blocks_seen_ < 8) return;  // the averages need 8 blocks
   bool mains50 = false, mains60 = false, noisy = false;
@@ -344,12 +347,9 @@ void HealthWatch::FinishBlock() {
     e50[r] = Sat32((a50_q8_[r] + 128) >> 8);
     e60[r] = Sat32((a60_q8_[r] + 128) >> 8);
     en[r] = Sat32((sigma_q8_[r] + 128) >> 8);
-    worst50 = a50_q8_[r] * 10000 / (256 * rated_[r]) > worst50
-                  ? a50_q8_[r] * 10000 / (256 * rated_[r])
-                  : worst50;
-    worst60 = a60_q8_[r] * 10000 / (256 * rated_[r]) > worst60
-                  ? a60_q8_[r] * 10000 / (256 * rated_[r])
-                  : worst60;
+    const std::int64_t rated_q8 = std::int64_t{256} * rated_[r];
+    worst50 = std::max(worst50, a50_q8_[r] * 10000 / rated_q8);
+    worst60 = std::max(worst60, a60_q8_[r] * 10000 / rated_q8);
     if (commission_blocks_ == 0 && sigma_ref_q8_[r] > 0) {
       const std::int64_t ratio = sigma_q8_[r] * 100 / sigma_ref_q8_[r];
       if (ratio > worst_ratio) worst_ratio = ratio;
@@ -487,7 +487,8 @@ void HealthWatch::FinishCreep() {
   report_.creep_bp = Sat32(std::int64_t{creep[dom]} * 10000 / step[dom]);
   // The segment means carry noise σ/√n each: a creep must also stand 6 such σ above it.
   // (n = 20 blocks: 1/√n ≈ 1/(4·√block)).
-  const std::int64_t guard = ((6 * sigma_q8_[dom] * inv_sqrt_block_q16_) >> 16) / (4 * 256) + 1;
+  const std::int64_t guard =
+      ((6 * sigma_q8_[dom] * inv_sqrt_block_q16_) >> 16) / (std::int64_t{4} * 256) + 1;
   const bool creeps =
       Abs(creep[dom]) * 10000 > Abs(step[dom]) * th_.creep_limit_bp && Abs(creep[dom]) > guard;
   SetFinding(HealthCause::kCreep, creeps, creep);
