@@ -1,12 +1,10 @@
 // `ftsim design` end to end: requirement verdict, the HTML report rendered in Chromium, the
 // catalogue trend against an independent fit of the vendored CSV, and bad input.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <Eigen/Dense>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
@@ -15,27 +13,16 @@
 
 #include "sim/design/explore.hpp"
 #include "tests/support/chromium.hpp"
+#include "tests/support/run_command.hpp"
 #include "tests/support/temp_dir.hpp"
 
 namespace ftstack::sim::design {
 namespace {
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out;
-};
+using CliRun = test::CommandResult;
 
 CliRun Ftsim(const std::string& args) {
-  const std::string cmd = std::string(FTSTACK_BIN_DIR) + "/ftsim design " + args + " 2>&1";
-  CliRun r;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  std::array<char, 4096> buf{};
-  size_t n = 0;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  const int status = pclose(p);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return test::RunCommand(std::string(FTSTACK_BIN_DIR) + "/ftsim design " + args);
 }
 
 std::string Slurp(const std::string& path) {
