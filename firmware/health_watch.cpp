@@ -341,7 +341,7 @@ void HealthWatch::FinishBlock() {
     // A tone counts above the absolute limit and above twice the RMS a tone bin reads on noise
     // alone (2σ/√N per block, averaged).
     const std::int64_t floor_q8 = (4 * sigma_q8_[r] * inv_sqrt_block_q16_) >> 16;
-    const std::int64_t lim_q8 = rated_[r] * th_.mains_limit_bp * 256 / 10000;
+    const std::int64_t lim_q8 = std::int64_t{rated_[r]} * th_.mains_limit_bp * 256 / 10000;
     mains50 = mains50 || (a50_q8_[r] > lim_q8 && a50_q8_[r] > floor_q8);
     mains60 = mains60 || (a60_q8_[r] > lim_q8 && a60_q8_[r] > floor_q8);
     e50[r] = Sat32((a50_q8_[r] + 128) >> 8);
