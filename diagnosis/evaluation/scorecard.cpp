@@ -98,15 +98,13 @@ double RelErr(double got, double want) {
   return std::fabs(got - want) / std::max(std::fabs(want), 1e-300);
 }
 
-/// Judges one claimed effect against its truth: location and key parameter.
-void Judge(const sim::RecordResult& rec, const Report& r, const sim::Effect& t,
-           const ClaimedEffect* c, ScoreResult* out) {
-  const std::string& n = t.name;
-  const auto& p = c != nullptr ? c->fit.params : nlohmann::json::object();
-  // Footprint: the truth's strongest channel must be among the located mismatch channels.
+/// The truth's strongest channel (largest footprint peak) for the effect `name`, or -1; raises
+/// `size_sigma` to the truth's footprint size.
+int StrongestTruthChannel(const sim::RecordResult& rec, const std::string& name,
+                          double* size_sigma) {
   int strongest = -1;
   for (const auto& te : rec.truth["effects"]) {
-    if (te["name"] != n) continue;
+    if (te["name"] != name) continue;
     const auto& peaks = te["footprint"]["peak_mvv"];
     double best = -1;
     for (std::size_t k = 0; k < peaks.size(); ++k) {
@@ -115,97 +113,113 @@ void Judge(const sim::RecordResult& rec, const Report& r, const sim::Effect& t,
         strongest = static_cast<int>(k);
       }
     }
-    out->size_sigma = std::max(out->size_sigma, te["footprint"]["size_sigma"].get<double>());
+    *size_sigma = std::max(*size_sigma, te["footprint"]["size_sigma"].get<double>());
   }
+  return strongest;
+}
+
+/// How a family's key parameter is compared with its truth.
+enum class Compare {
+  kRelative,        // relative error of a scalar
+  kLargestChannel,  // relative error on the channel with the largest true value
+  kGainMinusOne,    // relative error of (gain - 1) on the first channel
+  kAbsolute,        // absolute error, in the parameter's unit
+  kNone,            // no parameter: only the location rules below
+};
+
+struct ParamCheck {
+  EffectKind kind;
+  const char* key;    // the vocabulary's parameter name
+  const char* label;  // how the scorecard prints it
+  Compare compare;
+  double tolerance;
+  bool gates_location;  // a wrong parameter also means the effect was not located
+};
+
+constexpr ParamCheck kParamChecks[] = {
+    {EffectKind::kCreep, "tau_s", "tau_s", Compare::kRelative, 0.25, false},
+    {EffectKind::kThermalZeroDrift, "coef_per_K", "coef_per_K", Compare::kLargestChannel, 0.2,
+     false},
+    {EffectKind::kThermalSpanDrift, "coef_per_K", "coef_per_K", Compare::kRelative, 0.2, false},
+    {EffectKind::kZeroOffset, "offset", "offset", Compare::kLargestChannel, 0.1, false},
+    {EffectKind::kGainError, "gain", "gain-1", Compare::kGainMinusOne, 0.2, false},
+    {EffectKind::kBridgeNonlinearity, "channels", "", Compare::kNone, 0.0, false},
+    {EffectKind::kMisalignment, "angle_deg", "angle_deg", Compare::kRelative, 0.2, false},
+    {EffectKind::kTimeSkew, "delay_s", "delay_s", Compare::kRelative, 0.25, true},
+    {EffectKind::kSaturation, "limit", "limit", Compare::kRelative, 0.02, false},
+    {EffectKind::kOverloadShift, "onset_s", "onset_s (s)", Compare::kAbsolute, 1.0, true},
+    {EffectKind::kMainsInterference, "freq_hz", "freq_hz", Compare::kRelative, 0.002, true},
+    {EffectKind::kResonance, "freq_hz", "freq_hz", Compare::kRelative, 0.03, true},
+};
+
+/// The error of the fitted value `v` against the truth `t`, as `check` compares them.
+double ParamError(const ParamCheck& check, const nlohmann::json& v, const sim::Effect& t) {
+  switch (check.compare) {
+    case Compare::kRelative:
+      return RelErr(v.get<double>(), t.num.at(check.key));
+    case Compare::kLargestChannel: {
+      std::size_t k = 0;
+      for (std::size_t i = 0; i < t.per_channel.size(); ++i) {
+        if (std::fabs(t.per_channel[i]) > std::fabs(t.per_channel[k])) k = i;
+      }
+      return RelErr(v[k].get<double>(), t.per_channel[k]);
+    }
+    case Compare::kGainMinusOne:
+      return RelErr(v[0].get<double>() - 1.0, t.num.at(check.key) - 1.0);
+    case Compare::kAbsolute:
+      return std::fabs(v.get<double>() - t.num.at(check.key));
+    case Compare::kNone:
+      break;
+  }
+  return 0.0;
+}
+
+/// Whether the claim names the truth's channels or axis, for the families that name them.
+bool NamesTheTruthsChannels(const sim::Effect& t, const ClaimedEffect& c,
+                            const nlohmann::json* fitted_channels, const nlohmann::json* axis) {
+  switch (t.kind) {
+    case EffectKind::kGainError:
+      return c.fit.channels == t.channels;
+    case EffectKind::kBridgeNonlinearity:
+      return fitted_channels->get<std::vector<int>>() == t.channels;
+    case EffectKind::kMisalignment: {
+      const char want[2] = {static_cast<char>('x' + t.axis), 0};
+      return axis != nullptr && *axis == want;
+    }
+    default:
+      return true;
+  }
+}
+
+/// Judges one claimed effect against its truth: location and key parameter.
+void Judge(const sim::RecordResult& rec, const Report& r, const sim::Effect& t,
+           const ClaimedEffect* c, ScoreResult* out) {
+  // Footprint: the truth's strongest channel must be among the located mismatch channels.
+  const int strongest = StrongestTruthChannel(rec, t.name, &out->size_sigma);
   const auto& mc = r.mismatch_channels;
   out->located = strongest < 0 || std::find(mc.begin(), mc.end(), strongest) != mc.end();
   if (c == nullptr) {
     out->located = false;
     return;
   }
-  auto set = [&](const char* name, double err, double tol) {
-    out->param = name;
-    out->param_error = err;
-    out->param_ok = err <= tol;
-  };
+  const auto& p = c->fit.params;
   // The fitted parameter named `key` in the report, the key checked against the vocabulary.
   auto fitted = [&](std::string_view key) -> const nlohmann::json* {
     const std::string k(ParamKey(t.kind, key, kReported));
     return p.contains(k) ? &p[k] : nullptr;
   };
-  // Index of the channel with the largest true per-channel value.
-  auto largest = [&] {
-    std::size_t k = 0;
-    for (std::size_t i = 0; i < t.per_channel.size(); ++i) {
-      if (std::fabs(t.per_channel[i]) > std::fabs(t.per_channel[k])) k = i;
-    }
-    return k;
-  };
-  const nlohmann::json* v = nullptr;
-  switch (t.kind) {
-    case EffectKind::kCreep:
-      if ((v = fitted("tau_s"))) set("tau_s", RelErr(v->get<double>(), t.num.at("tau_s")), 0.25);
-      break;
-    case EffectKind::kThermalZeroDrift:
-      if ((v = fitted("coef_per_K"))) {
-        const std::size_t k = largest();
-        set("coef_per_K", RelErr((*v)[k].get<double>(), t.per_channel[k]), 0.2);
-      }
-      break;
-    case EffectKind::kThermalSpanDrift:
-      if ((v = fitted("coef_per_K")))
-        set("coef_per_K", RelErr(v->get<double>(), t.num.at("coef_per_K")), 0.2);
-      break;
-    case EffectKind::kZeroOffset:
-      if ((v = fitted("offset"))) {
-        const std::size_t k = largest();
-        set("offset", RelErr((*v)[k].get<double>(), t.per_channel[k]), 0.1);
-      }
-      break;
-    case EffectKind::kGainError:
-      if ((v = fitted("gain"))) {
-        out->located = out->located && c->fit.channels == t.channels;
-        set("gain-1", RelErr((*v)[0].get<double>() - 1.0, t.num.at("gain") - 1.0), 0.2);
-      }
-      break;
-    case EffectKind::kBridgeNonlinearity:
-      if ((v = fitted("channels")))
-        out->located = out->located && v->get<std::vector<int>>() == t.channels;
-      break;
-    case EffectKind::kMisalignment:
-      if ((v = fitted("angle_deg"))) {
-        const char axis[2] = {static_cast<char>('x' + t.axis), 0};
-        const nlohmann::json* a = fitted("axis");
-        out->located = out->located && a != nullptr && *a == axis;
-        set("angle_deg", RelErr(v->get<double>(), t.num.at("angle_deg")), 0.2);
-      }
-      break;
-    case EffectKind::kTimeSkew:
-      if ((v = fitted("delay_s"))) {
-        set("delay_s", RelErr(v->get<double>(), t.num.at("delay_s")), 0.25);
-        out->located = out->located && out->param_ok;
-      }
-      break;
-    case EffectKind::kSaturation:
-      if ((v = fitted("limit"))) set("limit", RelErr(v->get<double>(), t.num.at("limit")), 0.02);
-      break;
-    case EffectKind::kOverloadShift:
-      if ((v = fitted("onset_s"))) {
-        set("onset_s (s)", std::fabs(v->get<double>() - t.num.at("onset_s")), 1.0);
-        out->located = out->located && out->param_ok;
-      }
-      break;
-    case EffectKind::kMainsInterference:
-    case EffectKind::kResonance:
-      if ((v = fitted("freq_hz"))) {
-        set("freq_hz", RelErr(v->get<double>(), t.num.at("freq_hz")),
-            t.kind == EffectKind::kResonance ? 0.03 : 0.002);
-        out->located = out->located && out->param_ok;
-      }
-      break;
-    default:
-      break;
-  }
+  const auto* check = std::find_if(std::begin(kParamChecks), std::end(kParamChecks),
+                                   [&](const ParamCheck& pc) { return pc.kind == t.kind; });
+  if (check == std::end(kParamChecks)) return;
+  const nlohmann::json* v = fitted(check->key);
+  if (v == nullptr) return;
+  const nlohmann::json* axis = t.kind == EffectKind::kMisalignment ? fitted("axis") : nullptr;
+  out->located = out->located && NamesTheTruthsChannels(t, *c, v, axis);
+  if (check->compare == Compare::kNone) return;
+  out->param = check->label;
+  out->param_error = ParamError(*check, *v, t);
+  out->param_ok = out->param_error <= check->tolerance;
+  if (check->gates_location) out->located = out->located && out->param_ok;
 }
 
 }  // namespace
