@@ -213,6 +213,95 @@ AxisOperators AxisRelays(const DiagData& d, const std::vector<int>& axes) {
   return o;
 }
 
+/// The operator family chosen for the loop, with what the report says of it.
+struct OperatorChoice {
+  AxisOperators ops;
+  double travel_fraction = 0.0;  // the single-operator width; unused for weighted families
+  bool weights_only = false;     // Prandtl–Ishlinskii or Preisach: no width parameter
+  std::string variant;
+};
+
+/// One Dahl or play operator per axis (width searched), then weighted plays, then relays: the
+/// family with the lowest penalised cost wins.
+OperatorChoice ChooseOperators(const Context& cx, const Runs& runs, const std::vector<int>& axes,
+                               const Eigen::VectorXd& range, double pen) {
+  std::vector<double> grid;
+  for (int j = 0; j <= 10; ++j) grid.push_back(std::log(0.002) + std::log(1000.0) * j / 10.0);
+  OperatorChoice best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (bool play : {false, true}) {
+    const auto f = [&](double v) {
+      return Solve(cx, runs, OneOperator(axes, range, std::exp(v), play)).sse_w;
+    };
+    const double lw = MinimizeOnGrid(f, grid, 10, nullptr);
+    AxisOperators o = OneOperator(axes, range, std::exp(lw), play);
+    const double cost = Solve(cx, runs, o).sse_w + (o.p() + 1) * pen;
+    if (cost < best_cost) {
+      best_cost = cost;
+      best = {o, std::exp(lw), false,
+              play ? "play (backlash) operator on each wrench axis, through the sensitivity"
+                   : "Dahl operator on each wrench axis, through the sensitivity"};
+    }
+  }
+  // Prandtl–Ishlinskii: plays of fixed widths per axis, weights free (general loop shape).
+  AxisOperators pi;
+  pi.axes = axes;
+  pi.per_axis = static_cast<int>(kPiWidths.size());
+  for (int a : axes) {
+    for (double wf : kPiWidths) {
+      pi.widths.push_back(wf * range(a));
+      pi.dahl.push_back(wf * range(a));
+    }
+  }
+  const double pi_cost = Solve(cx, runs, pi).sse_w + pi.p() * pen;
+  if (pi_cost < best_cost) {
+    best_cost = pi_cost;
+    best = {pi, 0.0, true,
+            "Prandtl–Ishlinskii: weighted plays of 5 widths on each wrench axis, through the "
+            "sensitivity"};
+  }
+  // Preisach: relays on a grid of each axis's load levels (contains loops of any shape there).
+  const AxisOperators relays = AxisRelays(*cx.data, axes);
+  if (cx.n > 20 * relays.p() && Solve(cx, runs, relays).sse_w + relays.p() * pen < best_cost) {
+    best = {relays, 0.0, true,
+            "Preisach: weighted sum of 28 relays (thresholds on 8 quantiles of the axis's load) on "
+            "each wrench axis, through the sensitivity"};
+  }
+  return best;
+}
+
+/// Loop half-height per axis (N or N·m: the sum of the axis's operator weights) and its σ; the
+/// axis with the largest loop relative to its range.
+int LoopHalfHeights(const AxisOperators& ops, const AxisFit& fit, const Eigen::VectorXd& range,
+                    EffectFit* e) {
+  const double var = fit.rows > ops.p() ? fit.sse_w / (fit.rows - ops.p()) : 0.0;
+  double top = 0.0;
+  int top_axis = ops.axes.front();
+  nlohmann::json half = nlohmann::json::object();
+  nlohmann::json half_sigma = nlohmann::json::object();
+  for (std::size_t a = 0; a < ops.axes.size(); ++a) {
+    double h = 0.0;
+    double s2 = 0.0;
+    for (int j = 0; j < ops.per_axis; ++j) {
+      const int f = static_cast<int>(a) * ops.per_axis + j;
+      h += fit.beta(f);
+      for (int j2 = 0; j2 < ops.per_axis; ++j2) {
+        s2 += fit.cov_unit(f, static_cast<int>(a) * ops.per_axis + j2) * var;
+      }
+    }
+    half[kAxis[ops.axes[a]]] = h;
+    half_sigma[kAxis[ops.axes[a]]] = std::sqrt(std::max(0.0, s2));
+    const double rel = std::fabs(h) / range(ops.axes[a]);
+    if (rel > top) {
+      top = rel;
+      top_axis = ops.axes[a];
+    }
+  }
+  e->params["loop_half_height"] = half;  // N for forces, N·m for moments
+  e->sigma["loop_half_height"] = half_sigma;
+  return top_axis;
+}
+
 }  // namespace
 
 std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Series& target) {
@@ -227,92 +316,18 @@ std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Series& targ
   if (axes.empty()) return std::nullopt;
   const Runs runs = MakeRuns(cx, target, cx.search_stride);
   const double pen = std::log(std::max(2.0, static_cast<double>(cx.n_train) * cx.nc));
-  // One operator per axis, width (fraction of each axis's range) searched; Dahl or play.
-  std::vector<double> grid;
-  for (int j = 0; j <= 10; ++j) grid.push_back(std::log(0.002) + std::log(1000.0) * j / 10.0);
-  AxisOperators best;
-  double best_cost = std::numeric_limits<double>::infinity();
-  double best_frac = 0.0;
-  std::string variant;
-  for (bool play : {false, true}) {
-    const auto f = [&](double v) {
-      return Solve(cx, runs, OneOperator(axes, range, std::exp(v), play)).sse_w;
-    };
-    const double lw = MinimizeOnGrid(f, grid, 10, nullptr);
-    AxisOperators o = OneOperator(axes, range, std::exp(lw), play);
-    const double cost = Solve(cx, runs, o).sse_w + (o.p() + 1) * pen;
-    if (cost < best_cost) {
-      best_cost = cost;
-      best = o;
-      best_frac = std::exp(lw);
-      variant = play ? "play (backlash) operator on each wrench axis, through the sensitivity"
-                     : "Dahl operator on each wrench axis, through the sensitivity";
-    }
-  }
-  // Prandtl–Ishlinskii: plays of fixed widths per axis, weights free (general loop shape).
-  AxisOperators pi;
-  pi.axes = axes;
-  pi.per_axis = static_cast<int>(kPiWidths.size());
-  for (int a : axes) {
-    for (double wf : kPiWidths) {
-      pi.widths.push_back(wf * range(a));
-      pi.dahl.push_back(wf * range(a));
-    }
-  }
-  const double pi_cost = Solve(cx, runs, pi).sse_w + pi.p() * pen;
-  bool use_pi = pi_cost < best_cost;
-  if (use_pi) {
-    best = pi;
-    best_cost = pi_cost;
-    variant =
-        "Prandtl–Ishlinskii: weighted plays of 5 widths on each wrench axis, through the "
-        "sensitivity";
-  }
-  // Preisach: relays on a grid of each axis's load levels (contains loops of any shape there).
-  const AxisOperators relays = AxisRelays(d, axes);
-  if (cx.n > 20 * relays.p() && Solve(cx, runs, relays).sse_w + relays.p() * pen < best_cost) {
-    best = relays;
-    use_pi = true;
-    variant =
-        "Preisach: weighted sum of 28 relays (thresholds on 8 quantiles of the axis's load) on "
-        "each wrench axis, through the sensitivity";
-  }
+  const OperatorChoice best = ChooseOperators(cx, runs, axes, range, pen);
   // Final weights from every row_step-th training row too (the operators' states change only at
   // load reversals and threshold crossings, so little is lost on long records); predictions on all.
-  const AxisFit fit = Solve(cx, runs, best);
+  const AxisFit fit = Solve(cx, runs, best.ops);
   EffectFit e;
   e.name = "hysteresis";
-  e.variant = variant;
-  e.n_params = best.p() + (use_pi ? 0 : 1);
-  e.pred = Predict(cx, runs, best, fit.beta);
+  e.variant = best.variant;
+  e.n_params = best.ops.p() + (best.weights_only ? 0 : 1);
+  e.pred = Predict(cx, runs, best.ops, fit.beta);
   e.train_sse_w = fit.sse_w;
-  const double var = fit.rows > best.p() ? fit.sse_w / (fit.rows - best.p()) : 0.0;
-  // Loop half-height per axis (N or N·m): the largest reading difference at one load.
-  double top = 0.0;
-  int top_axis = axes.front();
-  nlohmann::json half = nlohmann::json::object();
-  nlohmann::json half_sigma = nlohmann::json::object();
-  for (std::size_t a = 0; a < axes.size(); ++a) {
-    double h = 0.0;
-    double s2 = 0.0;
-    for (int j = 0; j < best.per_axis; ++j) {
-      const int f = static_cast<int>(a) * best.per_axis + j;
-      h += fit.beta(f);
-      for (int j2 = 0; j2 < best.per_axis; ++j2) {
-        s2 += fit.cov_unit(f, static_cast<int>(a) * best.per_axis + j2) * var;
-      }
-    }
-    half[kAxis[axes[a]]] = h;
-    half_sigma[kAxis[axes[a]]] = std::sqrt(std::max(0.0, s2));
-    const double rel = std::fabs(h) / range(axes[a]);
-    if (rel > top) {
-      top = rel;
-      top_axis = axes[a];
-    }
-  }
-  e.params["loop_half_height"] = half;  // N for forces, N·m for moments
-  e.sigma["loop_half_height"] = half_sigma;
-  if (!use_pi) e.params["travel_fraction"] = best_frac;
+  const int top_axis = LoopHalfHeights(best.ops, fit, range, &e);
+  if (!best.weights_only) e.params["travel_fraction"] = best.travel_fraction;
   const int bc = fx::DominantChannel(cx, e.pred);
   for (int c = 0; c < cx.nc; ++c) {
     if (e.pred.col(c).cast<double>().squaredNorm() * cx.weight(c) > 0.01 * cx.n) {
@@ -327,8 +342,8 @@ std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Series& targ
                 "past reversals (%.1f σ), constant during holds: a loop of %.3g %s on %s",
                 bc, col.maxCoeff() - col.minCoeff(),
                 (col.maxCoeff() - col.minCoeff()) / cx.sigma(bc),
-                2.0 * std::fabs(half[kAxis[top_axis]].get<double>()), top_axis < 3 ? "N" : "N·m",
-                kAxis[top_axis]);
+                2.0 * std::fabs(e.params["loop_half_height"][kAxis[top_axis]].get<double>()),
+                top_axis < 3 ? "N" : "N·m", kAxis[top_axis]);
   e.evidence = buf;
   return e;
 }
