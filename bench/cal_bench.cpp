@@ -4,7 +4,7 @@
 
 #include <cstdio>
 
-#include "calibration/fit.hpp"
+#include "calibration/fit/fit.hpp"
 #include "sim/rig.hpp"
 #include "sim/sensor_description.hpp"
 

@@ -1,6 +1,6 @@
 # Fails when embedded code (hal/, firmware/) includes host-only code (measurement/, sim/,
-# calibration/, diagnosis/, numerics/, tools/), when calibration/ includes the simulator, when any
-# library includes tests/ or tools/, or when a folder of
+# calibration/, diagnosis/, numerics/, tools/), when calibration/ includes the simulator or its
+# file/ folder the fitting, when any library includes tests/ or tools/, or when a folder of
 # diagnosis/ includes one above it. Run as: cmake -DROOT=<repo> -P CheckIncludes.cmake
 file(GLOB_RECURSE embedded "${ROOT}/hal/*.hpp" "${ROOT}/hal/*.cpp" "${ROOT}/firmware/*.hpp" "${ROOT}/firmware/*.cpp")
 file(GLOB_RECURSE host "${ROOT}/sim/*.hpp" "${ROOT}/sim/*.cpp" "${ROOT}/calibration/*.hpp"
@@ -26,6 +26,9 @@ forbid("${host}" "[<\"](tools|tests)/" "a library includes a tool or a test")
 # Calibration (fitting and files) stands below the simulator: it never includes it.
 file(GLOB_RECURSE calibration "${ROOT}/calibration/*.hpp" "${ROOT}/calibration/*.cpp")
 forbid("${calibration}" "[<\"](sim|diagnosis)/" "calibration includes the simulator")
+# What a board loads (calibration/file) stands below the fitting (calibration/fit).
+file(GLOB_RECURSE calibration_file "${ROOT}/calibration/file/*.hpp" "${ROOT}/calibration/file/*.cpp")
+forbid("${calibration_file}" "[<\"]calibration/fit/" "the calibration file includes the fitting")
 # The diagnosis (filters, engine, effect plug-ins, reports) knows recordings and numbers, not the
 # simulator or a CLI; only evaluation/ uses the simulator.
 file(GLOB_RECURSE diagnosis "${ROOT}/diagnosis/filters/*.[ch]pp" "${ROOT}/diagnosis/engine/*.[ch]pp"

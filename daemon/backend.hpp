@@ -5,7 +5,7 @@
 #include <memory>
 #include <optional>
 
-#include "calibration/cal_file.hpp"
+#include "calibration/file/cal_file.hpp"
 #include "hal/adc.hpp"
 
 namespace ftstack::daemon {

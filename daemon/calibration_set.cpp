@@ -5,9 +5,9 @@
 #include <filesystem>
 #include <fstream>
 
-#include "calibration/cal_file.hpp"
-#include "calibration/payload_file.hpp"
-#include "calibration/slots.hpp"
+#include "calibration/file/cal_file.hpp"
+#include "calibration/file/payload_file.hpp"
+#include "calibration/file/slots.hpp"
 
 namespace ftstack::daemon {
 namespace {

@@ -14,7 +14,7 @@
 #include <mutex>
 #include <thread>
 
-#include "calibration/cal_file.hpp"
+#include "calibration/file/cal_file.hpp"
 
 namespace ftstack::daemon {
 

@@ -1,7 +1,7 @@
 // The ideal calibration of a simulated sensor: the pseudo-inverse of its small-signal sensitivity.
 #pragma once
 
-#include "calibration/cal_file.hpp"
+#include "calibration/file/cal_file.hpp"
 #include "sim/sensor_model.hpp"
 
 namespace ftstack::sim {

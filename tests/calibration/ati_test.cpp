@@ -11,8 +11,8 @@
 #include <regex>
 #include <sstream>
 
-#include "calibration/apply.hpp"
-#include "calibration/ati.hpp"
+#include "calibration/fit/apply.hpp"
+#include "calibration/fit/ati.hpp"
 #include "tests/support/temp_dir.hpp"
 
 namespace ftstack::cal {

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "calibration/cal_file.hpp"
-#include "calibration/slots.hpp"
+#include "calibration/file/cal_file.hpp"
+#include "calibration/file/slots.hpp"
 #include "sim/default_sensor.hpp"
 #include "sim/ideal_calibration.hpp"
 

@@ -13,9 +13,9 @@
 #include <random>
 #include <string>
 
-#include "calibration/cal_file.hpp"
-#include "calibration/check.hpp"
-#include "calibration/input_units.hpp"
+#include "calibration/file/cal_file.hpp"
+#include "calibration/fit/check.hpp"
+#include "calibration/fit/input_units.hpp"
 #include "measurement/recording.hpp"
 #include "tests/calibration/run_ftcal.hpp"
 

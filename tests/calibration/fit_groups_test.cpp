@@ -8,7 +8,7 @@
 #include <cmath>
 #include <random>
 
-#include "calibration/fit.hpp"
+#include "calibration/fit/fit.hpp"
 
 namespace {
 

@@ -3,9 +3,9 @@
 
 #include <cmath>
 
-#include "calibration/apply.hpp"
-#include "calibration/fit.hpp"
-#include "calibration/fit_report.hpp"
+#include "calibration/fit/apply.hpp"
+#include "calibration/fit/fit.hpp"
+#include "calibration/fit/fit_report.hpp"
 #include "sim/rig.hpp"
 #include "tests/calibration/test_models.hpp"
 

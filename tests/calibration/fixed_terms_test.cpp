@@ -7,8 +7,8 @@
 #include <random>
 #include <vector>
 
-#include "calibration/cal_file.hpp"
-#include "calibration/model.hpp"
+#include "calibration/file/cal_file.hpp"
+#include "calibration/fit/model.hpp"
 #include "firmware/core.hpp"
 #include "firmware/fixed_calibration.hpp"
 

@@ -12,7 +12,7 @@
 #include <sstream>
 #include <string>
 
-#include "calibration/cal_file.hpp"
+#include "calibration/file/cal_file.hpp"
 #include "measurement/recording.hpp"
 #include "sim/sensor_description.hpp"
 #include "tests/calibration/test_models.hpp"

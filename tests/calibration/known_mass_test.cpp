@@ -9,9 +9,9 @@
 #include <cstdio>
 #include <random>
 
-#include "calibration/cal_file.hpp"
-#include "calibration/fit.hpp"
-#include "calibration/known_mass.hpp"
+#include "calibration/file/cal_file.hpp"
+#include "calibration/fit/fit.hpp"
+#include "calibration/fit/known_mass.hpp"
 #include "sim/sensor_description.hpp"
 #include "sim/sensor_model.hpp"
 #include "tests/calibration/run_ftcal.hpp"

@@ -10,7 +10,7 @@
 #include <fstream>
 #include <random>
 
-#include "calibration/payload.hpp"
+#include "calibration/fit/payload.hpp"
 #include "sim/default_sensor.hpp"
 #include "tests/calibration/run_ftcal.hpp"
 #include "tests/support/temp_dir.hpp"

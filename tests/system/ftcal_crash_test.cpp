@@ -12,8 +12,8 @@
 #include <sstream>
 #include <thread>
 
-#include "calibration/cal_file.hpp"
-#include "calibration/slots.hpp"
+#include "calibration/file/cal_file.hpp"
+#include "calibration/file/slots.hpp"
 #include "firmware/register_map.hpp"
 #include "sim/ideal_calibration.hpp"
 #include "sim/sensor_description.hpp"

@@ -8,7 +8,7 @@
 #include <map>
 #include <random>
 
-#include "calibration/cal_file.hpp"
+#include "calibration/file/cal_file.hpp"
 #include "firmware/register_map.hpp"
 #include "sim/default_sensor.hpp"
 #include "sim/ideal_calibration.hpp"

@@ -12,7 +12,7 @@
 #include <string>
 #include <thread>
 
-#include "calibration/cal_file.hpp"
+#include "calibration/file/cal_file.hpp"
 #include "firmware/health_types.hpp"
 #include "sim/default_sensor.hpp"
 #include "sim/ideal_calibration.hpp"

@@ -11,7 +11,7 @@
 #include <string>
 #include <thread>
 
-#include "calibration/cal_file.hpp"
+#include "calibration/file/cal_file.hpp"
 #include "firmware/register_map.hpp"
 #include "firmware/status_bits.hpp"
 #include "sim/ideal_calibration.hpp"

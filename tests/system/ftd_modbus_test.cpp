@@ -17,7 +17,7 @@
 #include <system_error>
 #include <thread>
 
-#include "calibration/cal_file.hpp"
+#include "calibration/file/cal_file.hpp"
 #include "firmware/modbus_server.hpp"
 #include "firmware/register_map.hpp"
 #include "measurement/recording.hpp"

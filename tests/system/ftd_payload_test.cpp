@@ -11,7 +11,7 @@
 #include <fstream>
 #include <thread>
 
-#include "calibration/payload_file.hpp"
+#include "calibration/file/payload_file.hpp"
 #include "firmware/register_map.hpp"
 #include "tests/calibration/run_ftcal.hpp"
 #include "tests/support/temp_dir.hpp"

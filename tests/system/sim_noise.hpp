@@ -4,7 +4,7 @@
 #include <array>
 #include <cmath>
 
-#include "calibration/cal_file.hpp"
+#include "calibration/file/cal_file.hpp"
 #include "sim/default_sensor.hpp"
 #include "sim/ideal_calibration.hpp"
 #include "tests/system/builtin_adc.hpp"

@@ -2,8 +2,8 @@
 
 #include <cstdio>
 
-#include "calibration/commands.hpp"
-#include "calibration/slots.hpp"
+#include "calibration/fit/commands.hpp"
+#include "calibration/file/slots.hpp"
 
 namespace ftstack::tools {
 

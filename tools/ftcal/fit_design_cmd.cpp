@@ -3,7 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "calibration/fit_report.hpp"
+#include "calibration/fit/fit_report.hpp"
 #include "sim/rig.hpp"
 #include "sim/sensor_description.hpp"
 #include "tools/common.hpp"

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "calibration/commands.hpp"
+#include "calibration/fit/commands.hpp"
 #include "measurement/units.hpp"
 
 namespace ftstack::tools {
