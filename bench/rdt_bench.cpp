@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "daemon/daemon.hpp"
-#include "daemon/sim_backend.hpp"
+#include "daemon/sim/sim_backend.hpp"
 
 namespace {
 

@@ -29,6 +29,10 @@ forbid("${calibration}" "[<\"](sim|diagnosis)/" "calibration includes the simula
 # What a board loads (calibration/file) stands below the fitting (calibration/fit).
 file(GLOB_RECURSE calibration_file "${ROOT}/calibration/file/*.hpp" "${ROOT}/calibration/file/*.cpp")
 forbid("${calibration_file}" "[<\"]calibration/fit/" "the calibration file includes the fitting")
+# The daemon's board part never includes the simulator; its simulated backend lives in daemon/sim.
+file(GLOB daemon_board "${ROOT}/daemon/*.hpp" "${ROOT}/daemon/*.cpp")
+forbid("${daemon_board}" "[<\"](sim|daemon/sim|calibration/fit|diagnosis)/"
+       "the daemon's board part includes the simulator, the fitting or the diagnosis")
 # The diagnosis (filters, engine, effect plug-ins, reports) knows recordings and numbers, not the
 # simulator or a CLI; only evaluation/ uses the simulator.
 file(GLOB_RECURSE diagnosis "${ROOT}/diagnosis/filters/*.[ch]pp" "${ROOT}/diagnosis/engine/*.[ch]pp"

@@ -30,7 +30,7 @@ class AdcBackend {
 };
 
 /// Makes the simulated backend (`--adc sim`). Host builds of ftd pass MakeSimulatedBackend
-/// (tools/ftd/sim_backend.hpp); a board build passes nullptr and refuses `--adc sim`.
+/// (daemon/sim/sim_backend.hpp); a board build passes nullptr and refuses `--adc sim`.
 using SimulatorFactory = std::unique_ptr<AdcBackend> (*)(const FtdOptions& options);
 
 }  // namespace ftstack::daemon

@@ -12,7 +12,7 @@
 #include "tools/common.hpp"
 #include "tools/ftd/mqtt_options.hpp"
 #if FTSTACK_FTD_SIMULATOR
-#include "daemon/sim_backend.hpp"
+#include "daemon/sim/sim_backend.hpp"
 #endif
 
 namespace {

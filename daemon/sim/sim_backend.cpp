@@ -1,4 +1,4 @@
-#include "daemon/sim_backend.hpp"
+#include "daemon/sim/sim_backend.hpp"
 
 #include <cmath>
 #include <stdexcept>
