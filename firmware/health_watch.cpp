@@ -366,9 +366,14 @@ void HealthWatch::FinishBlock() {
 
 void HealthWatch::UpdateRinging(const HealthInput& in) {
   if (refractory_ > 0) --refractory_;
-  if (analysing_ < kAxes) {  // one axis of the finished capture per sample (bounded cost)
-    AnalyseAxis(analysing_++);
-    if (analysing_ == kAxes) FinishRinging();
+  if (analysing_ < kAxes) {  // a slice of one axis of the finished capture per sample
+    if (!ring_scan_.Advance(kRingSlice)) return;
+    FinishAxis(analysing_);
+    if (++analysing_ < kAxes) {
+      StartAxis(analysing_);
+    } else {
+      FinishRinging();
+    }
     return;
   }
   if (!capturing_) {
@@ -387,16 +392,21 @@ void HealthWatch::UpdateRinging(const HealthInput& in) {
   if (++capture_pos_ < kRingCapture) return;
   capturing_ = false;
   refractory_ = static_cast<std::uint32_t>(kRingCapture) * capture_stride_;
-  analysing_ = 0;  // the next six samples analyse it, one axis each
+  analysing_ = 0;  // the next samples analyse it, axis by axis, a slice per sample
+  StartAxis(0);
 }
 
-void HealthWatch::AnalyseAxis(std::size_t r) {
+void HealthWatch::StartAxis(std::size_t r) {
   // Hysteresis: 4σ of the noise (the commissioning's, or the current one before it is known).
   const std::int64_t sigma = sigma_ref_q8_[r] > 0 ? sigma_ref_q8_[r] : sigma_q8_[r];
-  const std::int32_t h = Sat32(((4 * sigma) >> 8) + 1);
-  ring_axis_[r] = MeasureRinging(capture_[r].data(), kRingCapture, rate_ / capture_stride_, h);
+  ring_h_ = Sat32(((4 * sigma) >> 8) + 1);
+  ring_scan_.Start(capture_[r].data(), kRingCapture, rate_ / capture_stride_, ring_h_);
+}
+
+void HealthWatch::FinishAxis(std::size_t r) {
+  ring_axis_[r] = ring_scan_.result();
   // A ringing well clear of the noise only (8 hysteresis bands): the count is then clean.
-  if (ring_axis_[r].amplitude < 8 * h) ring_axis_[r].freq_mhz = 0;
+  if (ring_axis_[r].amplitude < 8 * ring_h_) ring_axis_[r].freq_mhz = 0;
 }
 
 void HealthWatch::FinishRinging() {
