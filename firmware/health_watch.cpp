@@ -121,6 +121,8 @@ void HealthWatch::ResetReference(std::int32_t temperature_mdegc, bool has_temper
   spell_checked_ = false;
   SetFinding(HealthCause::kZeroDrift, false, {});
   SetFinding(HealthCause::kThermalZeroDrift, false, {});
+  SetFinding(HealthCause::kOverloadShift, false, {});
+  overload_seen_ = false;
   // The output jumps at a tare: no load change, transient or hold is judged across it.
   ResetFilters();
   capturing_ = false;
@@ -144,6 +146,8 @@ void HealthWatch::SetFinding(HealthCause cause, bool on, const WrenchLsb& error)
 void HealthWatch::Step(const HealthInput& in) {
   if (!configured_) return;
   ++samples_;
+  // Also while the wrench is not valid (a bridge at a rail): an overload is what matters here.
+  if ((in.status & kStatusOverload) != 0) overload_seen_ = true;
   if (in.untared_valid) {
     for (std::size_t r = 0; r < kAxes; ++r) rainflow_[r].Add(in.untared[r]);
   }
@@ -225,6 +229,15 @@ void HealthWatch::AddZeroPoint(const HealthInput& in) {
   if (!spell_checked_) {
     spell_checked_ = true;
     spell_rejected_ = jumped;
+    // Unless an overload came between: a zero that jumps across one has shifted (the gauges or
+    // the body yielded); the jump is the error. A part held still right after an overload reads
+    // the same way and is flagged too: after an overload a check is due anyway.
+    if (jumped && overload_seen_) {
+      WrenchLsb shift{};
+      for (std::size_t r = 0; r < kAxes; ++r) shift[r] = Sat32(z[r] - zero_last_[r]);
+      SetFinding(HealthCause::kOverloadShift, true, shift);
+    }
+    overload_seen_ = false;
   }
   if (spell_rejected_) return;
   const std::int64_t dt_s = static_cast<std::int64_t>((samples_ - ref_sample_) / rate_);
@@ -521,9 +534,11 @@ void HealthWatch::Publish(const HealthInput& in) {
   const bool thermal =
       (active_ & (1u << (static_cast<int>(HealthCause::kThermalZeroDrift) - 1))) != 0;
   const bool zero = (active_ & (1u << (static_cast<int>(HealthCause::kZeroDrift) - 1))) != 0;
-  r.retare_suggested = thermal || zero;
-  r.retare_reason = thermal ? HealthCause::kThermalZeroDrift
-                            : (zero ? HealthCause::kZeroDrift : HealthCause::kNone);
+  const bool shift = (active_ & (1u << (static_cast<int>(HealthCause::kOverloadShift) - 1))) != 0;
+  r.retare_suggested = thermal || zero || shift;
+  r.retare_reason = shift     ? HealthCause::kOverloadShift
+                    : thermal ? HealthCause::kThermalZeroDrift
+                              : (zero ? HealthCause::kZeroDrift : HealthCause::kNone);
   if ((in.status & (kStatusBridgeFault | kStatusAdcFault | kStatusCalInvalid)) != 0) {
     r.state = Ne107State::kFailure;
   } else if (in.tare_pending) {

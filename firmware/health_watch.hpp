@@ -91,6 +91,7 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   std::array<std::int64_t, kAxes> zero_last_{};  ///< the last zero point accepted
   bool spell_checked_ = false;   ///< this spell's first zero point was compared with zero_last_
   bool spell_rejected_ = false;  ///< … and was too far from it: a held load, not the zero
+  bool overload_seen_ = false;   ///< an overload since the last spell was judged
   std::uint64_t ref_sample_ = 0;
   std::int32_t ref_temp_mdegc_ = 0;
   bool ref_has_temp_ = false;
