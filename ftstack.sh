@@ -21,7 +21,7 @@ PACKAGES=(build-essential cmake ninja-build pkg-config ccache
   mbpoll socat gnuplot-nox chromium
   mosquitto mosquitto-clients libmosquitto-dev libprotobuf-c-dev protobuf-c-compiler
   protobuf-compiler python3-paho-mqtt python3-protobuf python3-numpy openssl
-  calculix-ccx gmsh python3-gmsh)
+  calculix-ccx gmsh python3-gmsh valgrind)
 
 log() { printf '[ftstack] %s\n' "$*" >&2; }
 

@@ -48,14 +48,22 @@ health_table() {
         for (r = 1000; r <= 8000; r *= 8) if (t["BM_HealthWatchStep/" r] > 0)
           printf "  watch per sample at %d Hz: %.1f ns (%.3f %% of the %d us sample budget)\n", r,
             t["BM_HealthWatchStep/" r], t["BM_HealthWatchStep/" r] / (1e7 / r), 1e6 / r
+        if (t["BM_RingingWorstSlice"] > 0)
+          printf "  worst sample (a ringing analysis slice, upper bound): +%.0f ns (%.2f %% of 125 us)\n",
+            t["BM_RingingWorstSlice"], t["BM_RingingWorstSlice"] / 1250
         if (t["BM_RingingAnalysis"] > 0)
-          printf "  worst sample (one ringing analysis after a transient capture): +%.0f ns (%.2f %% of 125 us)\n",
-            t["BM_RingingAnalysis"], t["BM_RingingAnalysis"] / 1250
+          printf "  one whole ringing analysis of an axis (spread over 4 samples): %.0f ns\n", t["BM_RingingAnalysis"]
       }'
 }
 if [ -x "$B/bench_health" ]; then
   section "health watch (CPU ns per sample, goal <= 1000 ns on the host)"
   "$B/bench_health" --benchmark_min_time="$MIN_TIME" --benchmark_format=csv 2>/dev/null | health_table
+fi
+# Its instructions per sample on aarch64 (qemu trace) and the board-core estimate: see
+# bench/health_cycles.sh (needs a cross build of count_health; about a minute).
+if [ -x "${FTSTACK_AARCH64_BUILD:-build-aarch64}/bench/count_health" ]; then
+  section "health watch on aarch64: instructions per sample and the board-core estimate"
+  "$(dirname "$0")/health_cycles.sh" "$BUILD" "${FTSTACK_AARCH64_BUILD:-build-aarch64}"
 fi
 
 # --- the same on aarch64 under qemu-user (issue 15), when a cross build of bench_core exists ------

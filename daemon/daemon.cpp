@@ -69,6 +69,7 @@ void Ftd::Start() {
   }
   LoadCalibrationSet(opt_, dir_slot, *backend_, adc.Info(), &cfg);
   if (!opt_.payload.empty()) LoadPayload(opt_.payload, &cfg);
+  cfg.health_watch = opt_.health_watch;
 
   core_ = std::make_unique<fw::WrenchCore>();
   device_ = std::make_unique<fw::Device>(adc, *core_);

@@ -51,6 +51,8 @@ struct FtdOptions {
   std::string spidev;
   std::uint64_t seed = 1;
   bool paced = true;  ///< simulated ADC follows the wall clock (false: as fast as possible)
+  bool health_watch =
+      true;  ///< run the health watch (false: --no-health-watch, inputs 100–199 read 0)
   /// Simulated ADC: hold the sampling thread sim_stall_ms on every sim_stall_every-th sample
   /// (0: never) — a deterministic stand-in for a preempted sampler (--sim-stall EVERY:MS).
   unsigned sim_stall_every = 0;

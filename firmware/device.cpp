@@ -35,7 +35,7 @@ DeviceStatus Device::Start(const DeviceConfig& config) {
   active_.cal_slot = config.initial_slot;
   active_.filter_length = core_.filter_length();
   // The watch judges every threshold against the rated range: without one it stays off.
-  (void)health_.Configure(rate, config.rated_lsb);
+  if (config.health_watch) (void)health_.Configure(rate, config.rated_lsb);
   active_.health = health_.thresholds();
   initial_settings_ = active_;
   settings_.Write(active_);

@@ -76,6 +76,7 @@ struct DeviceConfig {
   /// with kStatusCalInvalid and an invalid wrench (a field device comes up and says why).
   bool allow_uncalibrated = false;
   FixedPayload payload{};         ///< gravity compensation's payload (present: loaded)
+  bool health_watch = true;       ///< run the health watch (it also needs rated_lsb)
   std::uint32_t payload_crc = 0;  ///< CRC-32 of the payload file
 };
 

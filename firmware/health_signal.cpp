@@ -46,48 +46,79 @@ void ToneDetector::Finish(std::int64_t* amplitude_q8, std::int64_t* diff_power_q
 
 RingingResult MeasureRinging(const std::int32_t* x, std::size_t n, std::uint32_t rate_hz,
                              std::int32_t hysteresis) {
-  RingingResult r{};
-  if (n < 16 || rate_hz == 0 || hysteresis < 1) return r;
-  std::int64_t sum = 0;
-  const std::size_t tail = n / 4;
-  for (std::size_t i = n - tail; i < n; ++i) sum += x[i];
-  const std::int64_t level = sum / static_cast<std::int64_t>(tail);
-  int side = 0;  // +1 above level + h, −1 below level − h, 0 not yet known
-  std::int64_t first_q8 = 0;
-  std::int64_t last_q8 = 0;
-  std::int64_t peak = 0;
-  std::int64_t zero_q8 = 0;  // the latest sign change of x − level, Q8 samples (interpolated)
-  std::int64_t prev = x[0] - level;
-  std::int64_t lobe = 0;  // the largest |x − level| since the last crossing
-  for (std::size_t i = 0; i < n - tail; ++i) {
-    const std::int64_t v = x[i] - level;
-    if (i > 0 && (v >= 0) != (prev >= 0)) {
-      zero_q8 = static_cast<std::int64_t>(i - 1) * 256 + (-prev * 256) / (v - prev);
+  RingingScan scan;
+  scan.Start(x, n, rate_hz, hysteresis);
+  while (!scan.Advance(n)) {
+  }
+  return scan.result();
+}
+
+void RingingScan::Start(const std::int32_t* x, std::size_t n, std::uint32_t rate_hz,
+                        std::int32_t hysteresis) {
+  *this = RingingScan{};
+  if (x == nullptr || n < 16 || rate_hz == 0 || hysteresis < 1) return;  // kDone, no ringing
+  x_ = x;
+  n_ = n;
+  tail_ = n / 4;
+  i_ = n - tail_;
+  rate_hz_ = rate_hz;
+  hysteresis_ = hysteresis;
+  phase_ = Phase::kLevel;
+}
+
+bool RingingScan::Advance(std::size_t budget) {
+  if (phase_ == Phase::kLevel) {
+    const std::size_t end = n_ - i_ > budget ? i_ + budget : n_;
+    for (; i_ < end; ++i_) sum_ += x_[i_];
+    if (i_ < n_) return false;
+    level_ = sum_ / static_cast<std::int64_t>(tail_);
+    prev_ = x_[0] - level_;
+    i_ = 0;
+    phase_ = Phase::kScan;
+    return false;
+  }
+  if (phase_ != Phase::kScan) return true;
+  const std::size_t stop = n_ - tail_;
+  const std::size_t end = stop - i_ > budget ? i_ + budget : stop;
+  const std::int64_t h = hysteresis_;
+  for (; i_ < end; ++i_) {
+    const std::int64_t v = x_[i_] - level_;
+    if (i_ > 0 && (v >= 0) != (prev_ >= 0)) {
+      zero_q8_ = static_cast<std::int64_t>(i_ - 1) * 256 + (-prev_ * 256) / (v - prev_);
     }
-    prev = v;
+    prev_ = v;
     const std::int64_t mag = v < 0 ? -v : v;
-    const int now = v > hysteresis ? 1 : (v < -hysteresis ? -1 : 0);
+    const int now = v > h ? 1 : (v < -h ? -1 : 0);
     // A crossing confirmed by the hysteresis is dated at its sign change (no amplitude bias).
     // Counting ends at the first lobe under 3 hysteresis bands: past it a lobe lost in the noise
     // would drop a whole period from the count.
-    if (now != 0 && side != 0 && now != side) {
-      if (r.crossings > 0 && lobe < 3 * std::int64_t{hysteresis}) break;
-      if (r.crossings == 0) first_q8 = zero_q8;
-      last_q8 = zero_q8;
-      ++r.crossings;
-      lobe = 0;
+    if (now != 0 && side_ != 0 && now != side_) {
+      if (r_.crossings > 0 && lobe_ < 3 * h) {
+        Finish();
+        return true;
+      }
+      if (r_.crossings == 0) first_q8_ = zero_q8_;
+      last_q8_ = zero_q8_;
+      ++r_.crossings;
+      lobe_ = 0;
     }
-    if (mag > lobe) lobe = mag;
-    if (now != 0) side = now;
-    if (r.crossings > 0 && (v < 0 ? -v : v) > peak) peak = v < 0 ? -v : v;
+    if (mag > lobe_) lobe_ = mag;
+    if (now != 0) side_ = now;
+    if (r_.crossings > 0 && mag > peak_) peak_ = mag;
   }
-  r.amplitude = static_cast<std::int32_t>(peak);
-  if (r.crossings < 4 || last_q8 <= first_q8) return r;
+  if (i_ < stop) return false;
+  Finish();
+  return true;
+}
+
+void RingingScan::Finish() {
+  phase_ = Phase::kDone;
+  r_.amplitude = static_cast<std::int32_t>(peak_);
+  if (r_.crossings < 4 || last_q8_ <= first_q8_) return;
   // (crossings − 1) half periods between the first and the last crossing.
-  const std::uint64_t num = static_cast<std::uint64_t>(r.crossings - 1) * rate_hz * 256000u;
-  const std::uint64_t span = static_cast<std::uint64_t>(last_q8 - first_q8);
-  r.freq_mhz = static_cast<std::int32_t>((num + span) / (2u * span));
-  return r;
+  const std::uint64_t num = static_cast<std::uint64_t>(r_.crossings - 1) * rate_hz_ * 256000u;
+  const std::uint64_t span = static_cast<std::uint64_t>(last_q8_ - first_q8_);
+  r_.freq_mhz = static_cast<std::int32_t>((num + span) / (2u * span));
 }
 
 std::int64_t CreepRemaining(std::int64_t m1, std::int64_t m2, std::int64_t m3) {

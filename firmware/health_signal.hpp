@@ -45,6 +45,40 @@ struct RingingResult {
 [[nodiscard]] RingingResult MeasureRinging(const std::int32_t* x, std::size_t n,
                                            std::uint32_t rate_hz, std::int32_t hysteresis);
 
+/// MeasureRinging in slices, so that no single sample pays for a whole capture: Start, then
+/// Advance until it returns true; result() is then MeasureRinging's. `x` must stay unchanged
+/// until then.
+class RingingScan {
+ public:
+  void Start(const std::int32_t* x, std::size_t n, std::uint32_t rate_hz, std::int32_t hysteresis);
+  /// Works on at most `budget` (≥ 1) more samples: the level's quarter first, then the crossings.
+  /// True once the result is final (also when nothing was started).
+  [[nodiscard]] bool Advance(std::size_t budget);
+  [[nodiscard]] const RingingResult& result() const { return r_; }
+
+ private:
+  enum class Phase : std::uint8_t { kDone, kLevel, kScan };
+  void Finish();
+
+  const std::int32_t* x_ = nullptr;
+  std::size_t n_ = 0;
+  std::size_t tail_ = 0;
+  std::size_t i_ = 0;
+  std::int64_t sum_ = 0;
+  std::int64_t level_ = 0;
+  std::int64_t first_q8_ = 0;
+  std::int64_t last_q8_ = 0;
+  std::int64_t peak_ = 0;
+  std::int64_t zero_q8_ = 0;  // the latest sign change of x − level, Q8 samples (interpolated)
+  std::int64_t prev_ = 0;
+  std::int64_t lobe_ = 0;  // the largest |x − level| since the last crossing
+  std::uint32_t rate_hz_ = 0;
+  std::int32_t hysteresis_ = 0;
+  int side_ = 0;  // +1 above level + h, −1 below level − h, 0 not yet known
+  Phase phase_ = Phase::kDone;
+  RingingResult r_{};
+};
+
 /// Creep estimate from the means of three equal, consecutive segments of a hold: with d1 = m2 − m1
 /// and d2 = m3 − m2 of an exponential approach, the creep still to come after m1's middle is
 /// d1² / (d1 − d2); d1 + d2 (what was seen) when the increments do not decay.

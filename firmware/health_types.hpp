@@ -27,8 +27,9 @@ enum class HealthCause : std::uint16_t {
   kNoiseFloor = 5,        ///< broadband noise above the commissioning's
   kResonanceShift = 6,    ///< first ringing frequency moved from the commissioning's
   kCreep = 7,             ///< the output keeps moving during holds after load changes
+  kOverloadShift = 8,     ///< the zero jumped across an overload (plastic yield, a slipped bond)
 };
-inline constexpr std::size_t kHealthCauses = 7;  ///< causes 1 … 7
+inline constexpr std::size_t kHealthCauses = 8;  ///< causes 1 … 8
 /// Finding slots in the register map (the first kHealthSlots active causes, in code order).
 inline constexpr std::size_t kHealthSlots = 4;
 

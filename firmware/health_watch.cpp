@@ -121,6 +121,8 @@ void HealthWatch::ResetReference(std::int32_t temperature_mdegc, bool has_temper
   spell_checked_ = false;
   SetFinding(HealthCause::kZeroDrift, false, {});
   SetFinding(HealthCause::kThermalZeroDrift, false, {});
+  SetFinding(HealthCause::kOverloadShift, false, {});
+  overload_seen_ = false;
   // The output jumps at a tare: no load change, transient or hold is judged across it.
   ResetFilters();
   capturing_ = false;
@@ -144,6 +146,8 @@ void HealthWatch::SetFinding(HealthCause cause, bool on, const WrenchLsb& error)
 void HealthWatch::Step(const HealthInput& in) {
   if (!configured_) return;
   ++samples_;
+  // Also while the wrench is not valid (a bridge at a rail): an overload is what matters here.
+  if ((in.status & kStatusOverload) != 0) overload_seen_ = true;
   if (in.untared_valid) {
     for (std::size_t r = 0; r < kAxes; ++r) rainflow_[r].Add(in.untared[r]);
   }
@@ -225,6 +229,15 @@ void HealthWatch::AddZeroPoint(const HealthInput& in) {
   if (!spell_checked_) {
     spell_checked_ = true;
     spell_rejected_ = jumped;
+    // Unless an overload came between: a zero that jumps across one has shifted (the gauges or
+    // the body yielded); the jump is the error. A part held still right after an overload reads
+    // the same way and is flagged too: after an overload a check is due anyway.
+    if (jumped && overload_seen_) {
+      WrenchLsb shift{};
+      for (std::size_t r = 0; r < kAxes; ++r) shift[r] = Sat32(z[r] - zero_last_[r]);
+      SetFinding(HealthCause::kOverloadShift, true, shift);
+    }
+    overload_seen_ = false;
   }
   if (spell_rejected_) return;
   const std::int64_t dt_s = static_cast<std::int64_t>((samples_ - ref_sample_) / rate_);
@@ -366,9 +379,14 @@ void HealthWatch::FinishBlock() {
 
 void HealthWatch::UpdateRinging(const HealthInput& in) {
   if (refractory_ > 0) --refractory_;
-  if (analysing_ < kAxes) {  // one axis of the finished capture per sample (bounded cost)
-    AnalyseAxis(analysing_++);
-    if (analysing_ == kAxes) FinishRinging();
+  if (analysing_ < kAxes) {  // a slice of one axis of the finished capture per sample
+    if (!ring_scan_.Advance(kRingSlice)) return;
+    FinishAxis(analysing_);
+    if (++analysing_ < kAxes) {
+      StartAxis(analysing_);
+    } else {
+      FinishRinging();
+    }
     return;
   }
   if (!capturing_) {
@@ -387,16 +405,21 @@ void HealthWatch::UpdateRinging(const HealthInput& in) {
   if (++capture_pos_ < kRingCapture) return;
   capturing_ = false;
   refractory_ = static_cast<std::uint32_t>(kRingCapture) * capture_stride_;
-  analysing_ = 0;  // the next six samples analyse it, one axis each
+  analysing_ = 0;  // the next samples analyse it, axis by axis, a slice per sample
+  StartAxis(0);
 }
 
-void HealthWatch::AnalyseAxis(std::size_t r) {
+void HealthWatch::StartAxis(std::size_t r) {
   // Hysteresis: 4σ of the noise (the commissioning's, or the current one before it is known).
   const std::int64_t sigma = sigma_ref_q8_[r] > 0 ? sigma_ref_q8_[r] : sigma_q8_[r];
-  const std::int32_t h = Sat32(((4 * sigma) >> 8) + 1);
-  ring_axis_[r] = MeasureRinging(capture_[r].data(), kRingCapture, rate_ / capture_stride_, h);
+  ring_h_ = Sat32(((4 * sigma) >> 8) + 1);
+  ring_scan_.Start(capture_[r].data(), kRingCapture, rate_ / capture_stride_, ring_h_);
+}
+
+void HealthWatch::FinishAxis(std::size_t r) {
+  ring_axis_[r] = ring_scan_.result();
   // A ringing well clear of the noise only (8 hysteresis bands): the count is then clean.
-  if (ring_axis_[r].amplitude < 8 * h) ring_axis_[r].freq_mhz = 0;
+  if (ring_axis_[r].amplitude < 8 * ring_h_) ring_axis_[r].freq_mhz = 0;
 }
 
 void HealthWatch::FinishRinging() {
@@ -511,9 +534,11 @@ void HealthWatch::Publish(const HealthInput& in) {
   const bool thermal =
       (active_ & (1u << (static_cast<int>(HealthCause::kThermalZeroDrift) - 1))) != 0;
   const bool zero = (active_ & (1u << (static_cast<int>(HealthCause::kZeroDrift) - 1))) != 0;
-  r.retare_suggested = thermal || zero;
-  r.retare_reason = thermal ? HealthCause::kThermalZeroDrift
-                            : (zero ? HealthCause::kZeroDrift : HealthCause::kNone);
+  const bool shift = (active_ & (1u << (static_cast<int>(HealthCause::kOverloadShift) - 1))) != 0;
+  r.retare_suggested = thermal || zero || shift;
+  r.retare_reason = shift     ? HealthCause::kOverloadShift
+                    : thermal ? HealthCause::kThermalZeroDrift
+                              : (zero ? HealthCause::kZeroDrift : HealthCause::kNone);
   if ((in.status & (kStatusBridgeFault | kStatusAdcFault | kStatusCalInvalid)) != 0) {
     r.state = Ne107State::kFailure;
   } else if (in.tare_pending) {

@@ -24,13 +24,14 @@ struct HealthInput {
 };
 
 /// Integer-only; no heap; the cost of one Step is bounded: a few hundred operations, plus at most
-/// one ringing analysis of kRingCapture samples (one axis on each of the six samples after a
-/// transient capture ends).
+/// one slice of kRingSlice samples of a ringing analysis (after a transient capture ends, its six
+/// axes are analysed a slice per sample: 4 samples per axis).
 /// Single-threaded: the sampling thread calls everything.
 /// Members are grouped by watch, not by size: 64 bytes of padding in a 13 KB object.
 class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
  public:
   static constexpr std::size_t kRingCapture = 512;  ///< samples of a transient capture
+  static constexpr std::size_t kRingSlice = 128;    ///< capture samples analysed per Step
 
   /// Rate and rated range per axis (LSB, each > 0). False (the watch stays off) otherwise, or at
   /// a rate below 100 Hz.
@@ -60,7 +61,8 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   void UpdateBlock(const HealthInput& in, const WrenchLsb& d);
   void FinishBlock();
   void UpdateRinging(const HealthInput& in);
-  void AnalyseAxis(std::size_t axis);
+  void StartAxis(std::size_t axis);
+  void FinishAxis(std::size_t axis);
   void FinishRinging();
   void UpdateCreep(const HealthInput& in, bool moving);
   void FinishCreep();
@@ -89,6 +91,7 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   std::array<std::int64_t, kAxes> zero_last_{};  ///< the last zero point accepted
   bool spell_checked_ = false;   ///< this spell's first zero point was compared with zero_last_
   bool spell_rejected_ = false;  ///< … and was too far from it: a held load, not the zero
+  bool overload_seen_ = false;   ///< an overload since the last spell was judged
   std::uint64_t ref_sample_ = 0;
   std::int32_t ref_temp_mdegc_ = 0;
   bool ref_has_temp_ = false;
@@ -116,7 +119,9 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   std::uint32_t capture_stride_ = 1;
   std::uint32_t stride_count_ = 0;
   std::uint32_t refractory_ = 0;
-  std::size_t analysing_ = kAxes;  ///< the capture's axis analysed next (kAxes: none pending)
+  std::size_t analysing_ = kAxes;  ///< the capture's axis under analysis (kAxes: none pending)
+  RingingScan ring_scan_{};        ///< that axis's analysis, a slice per sample
+  std::int32_t ring_h_ = 0;        ///< its hysteresis, LSB
   std::array<RingingResult, kAxes> ring_axis_{};
   std::array<std::int32_t, 3> ring_last_mhz_{};
   std::uint32_t ring_measured_ = 0;

@@ -1,13 +1,15 @@
 #include "firmware/overload.hpp"
 
+#include <bit>
 #include <limits>
 
 namespace ftstack::fw {
 
 std::uint32_t ISqrt64(std::uint64_t n) {
+  if (n == 0) return 0;
   std::uint64_t root = 0;
-  std::uint64_t bit = std::uint64_t{1} << 62;
-  while (bit > n) bit >>= 2;
+  // Start at the highest even power of two not above n (one instruction instead of a loop).
+  std::uint64_t bit = std::uint64_t{1} << ((63 - std::countl_zero(n)) & ~1);
   while (bit != 0) {
     if (n >= root + bit) {
       n -= root + bit;

@@ -8,8 +8,15 @@ bool SimulatedSensor::Sample(double t_s, double* bridge_mvv, double* temperature
   Wrench w;
   double temp = 20.0;
   if (!source_.At(t_s, &w, &temp)) return false;
-  last_wrench_ = w;
-  model_.BridgeOutputsInto(w, temp, bridge_mvv);  // no allocation: runs in the sampling thread
+  const std::size_t n = channel_count();
+  // Exact equality only: any change of load or temperature runs the model.
+  if (!have_last_ || w != last_wrench_ || temp != last_temperature_c_) {
+    model_.BridgeOutputsInto(w, temp, last_mvv_.data());  // no allocation: the sampling thread
+    last_wrench_ = w;
+    last_temperature_c_ = temp;
+    have_last_ = true;
+  }
+  for (std::size_t i = 0; i < n; ++i) bridge_mvv[i] = last_mvv_[i];
   *temperature_c = temp;
   return true;
 }

@@ -1,6 +1,7 @@
 // The simulated sensor and its converter: wrench source → sensor model → hal::sim::SimAdc.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include "hal/sim/sim_adc.hpp"
@@ -27,6 +28,12 @@ class SimulatedSensor final : public hal::sim::BridgeSignalSource {
   const SensorModel& model_;
   const WrenchSource& source_;
   Wrench last_wrench_ = Wrench::Zero();
+  // The model is a pure function of (wrench, temperature): a held load (a constant wrench, a
+  // replay between keyframes at equal values) reuses the last outputs instead of running the
+  // physics again on every conversion.
+  bool have_last_ = false;
+  double last_temperature_c_ = 0.0;
+  std::array<double, hal::kMaxChannels> last_mvv_{};
 };
 
 /// A sensor description read by its simulated converter: the one set-up of description →

@@ -74,6 +74,33 @@ TEST(MeasureRinging, DampedSineAfterAStep) {
   }
 }
 
+TEST(RingingScan, InSlicesMeasuresTheClosedFormAndTheWholeScansResult) {
+  const std::uint32_t rate = 1000;
+  const double zeta = 0.04, wn = 2 * M_PI * 25.0, wd = wn * std::sqrt(1 - zeta * zeta);
+  std::vector<std::int32_t> x(512);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double t = static_cast<double>(i) / rate;
+    x[i] = static_cast<std::int32_t>(
+        std::lround(-20000.0 + 3000.0 * std::exp(-zeta * wn * t) * std::cos(wd * t)));
+  }
+  const RingingResult whole = MeasureRinging(x.data(), x.size(), rate, 20);
+  for (const std::size_t budget : {1u, 7u, 100u, 128u, 384u, 1000u}) {
+    RingingScan scan;
+    scan.Start(x.data(), x.size(), rate, 20);
+    std::size_t calls = 1;
+    while (!scan.Advance(budget)) ++calls;
+    // The level's quarter (128 samples) and the crossings' 384, `budget` at a time, at most.
+    EXPECT_LE(calls, (128 + budget - 1) / budget + (384 + budget - 1) / budget + 1) << budget;
+    EXPECT_NEAR(scan.result().freq_mhz / 1000.0, wd / (2 * M_PI), wd / (2 * M_PI) * 0.01);
+    EXPECT_EQ(scan.result().freq_mhz, whole.freq_mhz) << budget;
+    EXPECT_EQ(scan.result().crossings, whole.crossings) << budget;
+    EXPECT_EQ(scan.result().amplitude, whole.amplitude) << budget;
+  }
+  RingingScan idle;  // nothing started: final at once, no ringing
+  EXPECT_TRUE(idle.Advance(1));
+  EXPECT_EQ(idle.result().freq_mhz, 0);
+}
+
 TEST(MeasureRinging, NoRingingNoFrequency) {
   std::vector<std::int32_t> x(512, 1000);
   for (std::size_t i = 0; i < 40; ++i) x[i] = static_cast<std::int32_t>(i * 25);  // a ramp

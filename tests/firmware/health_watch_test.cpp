@@ -39,6 +39,7 @@ struct Scene {
   std::uint32_t rate = 1000;
   double noise_fraction = 5e-5;  ///< noise σ as a fraction of rated
   std::function<void(double t, std::array<double, 6>& y, double& temp_c)> load;
+  std::function<std::uint16_t(double t)> status;  ///< the device's status bits (none: 0)
 };
 
 class Runner {
@@ -65,6 +66,7 @@ class Runner {
       }
       in.untared = in.tared;  // no tare in the scenes: the load is the output
       in.untared_valid = true;
+      if (scene_.status) in.status = scene_.status(t);
       watch_.Step(in);
       if (each_second && n_ % scene_.rate == 0) each_second(t);
     }
@@ -132,6 +134,63 @@ TEST(HealthWatch, ZeroDriftFlaggedWithItsSizePerAxis) {
   run.Run(210);
   EXPECT_EQ(run.report().findings, 0);
   EXPECT_EQ(run.report().tare_count, 1);
+}
+
+/// Unloaded until 40 s, a press to 150 % of rated Fz from 40 to 42 s (flagged as an overload by
+/// the device when `overload`), then unloaded again with the zero moved by `shift` of rated on
+/// Fz and Mx.
+void OverloadScene(bool overload, double shift, Scene* s) {
+  s->load = [shift](double t, std::array<double, 6>& y, double&) {
+    if (t >= 40 && t < 42) y[2] = 1.5 * kRated[2];
+    if (t >= 42) {
+      y[2] = shift * kRated[2];
+      y[3] = -shift * kRated[3];
+    }
+  };
+  s->status = [overload](double t) -> std::uint16_t {
+    return overload && t >= 40 && t < 42 ? kStatusOverload : 0;
+  };
+}
+
+TEST(HealthWatch, ZeroShiftAcrossAnOverloadIsFlaggedWithItsSize) {
+  Scene s;
+  OverloadScene(true, 0.01, &s);  // 1 % of rated: twice the zero limit
+  Runner run(s);
+  double flagged_at = -1;
+  run.Run(60, [&](double t) {
+    if (flagged_at < 0 && Has(run.report(), HealthCause::kOverloadShift)) flagged_at = t;
+  });
+  // Stable again once the slow filter (τ ≈ 1 s) has come within 0.2 % of rated after a 150 %
+  // step (ln(750) ≈ 6.6 τ, less the fast filter's lag); then 2 s of stability and a 1 s point.
+  EXPECT_GE(flagged_at, 45.0);
+  EXPECT_LE(flagged_at, 52.0);
+  const HealthFinding* f = Slot(run.report(), HealthCause::kOverloadShift);
+  ASSERT_NE(f, nullptr);
+  EXPECT_NEAR(f->error_lsb[2], 0.01 * kRated[2], 0.02 * 0.01 * kRated[2]);
+  EXPECT_NEAR(f->error_lsb[3], -0.01 * kRated[3], 0.02 * 0.01 * kRated[3]);
+  EXPECT_NEAR(f->error_lsb[0], 0, 1e-3 * kRated[0]);
+  EXPECT_TRUE(run.report().retare_suggested);
+  EXPECT_EQ(run.report().retare_reason, HealthCause::kOverloadShift);
+  EXPECT_FALSE(Has(run.report(), HealthCause::kZeroDrift));  // not a slow drift
+  // A tare takes the shifted zero: the finding goes.
+  run.watch().OnTare(20000, true, false);
+  run.Run(61);
+  EXPECT_FALSE(Has(run.report(), HealthCause::kOverloadShift));
+}
+
+TEST(HealthWatch, TheSameOffsetWithoutAnOverloadIsAHeldLoad) {
+  Scene s;
+  OverloadScene(false, 0.01, &s);  // a part put down in the gripper: the spell is left out
+  Runner run(s);
+  run.Run(60);
+  EXPECT_EQ(run.report().findings, 0);
+  // And an overload after which the zero comes back where it was is no shift either.
+  Scene back;
+  OverloadScene(true, 0.0, &back);
+  Runner run2(back);
+  run2.Run(60);
+  EXPECT_EQ(run2.report().findings, 0);
+  EXPECT_GT(run2.report().zero_points, 45u);
 }
 
 TEST(HealthWatch, ThermalZeroDriftFlaggedWithItsCoefficient) {

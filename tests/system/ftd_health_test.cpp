@@ -11,6 +11,7 @@
 #include <fstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "calibration/file/cal_file.hpp"
 #include "firmware/health_types.hpp"
@@ -307,6 +308,28 @@ TEST(FtdHealth, PoweredUpUnderLoadIsOverloadNotBridgeFault) {
           "mbpoll -m tcp -p " + port + " -a 1 -t 3:int -B -0 -r 58 -c 1 -1 " + "127.0.0.1", &out),
       0);
   EXPECT_EQ(test::ParseMbpoll(out).at(58), 1);  // one overload event, from the start
+}
+
+TEST(FtdHealth, NoHealthWatchTurnsTheWatchOff) {
+  // Input 104 (watch on) read with mbpoll from an ftd with and without --no-health-watch; with the
+  // watch off the health block keeps its zeros (state 0, no findings).
+  for (const bool off : {false, true}) {
+    std::vector<std::string> args = {"--modbus-tcp", "127.0.0.1:0", "--print-hz", "0"};
+    if (off) args.emplace_back("--no-health-watch");
+    test::FtdProcess ftd(args);
+    ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    std::string out;
+    ASSERT_EQ(test::RunShell("mbpoll -m tcp -p " + std::to_string(ftd.port()) +
+                                 " -a 1 -t 3 -0 -r 100 -c 5 -1 127.0.0.1",
+                             &out),
+              0)
+        << out;
+    const auto regs = test::ParseMbpoll(out);
+    EXPECT_EQ(regs.at(104), off ? 0 : 1) << off;
+    EXPECT_EQ(regs.at(100), 0) << off;  // NE 107 normal (on) / nothing (off)
+    EXPECT_EQ(regs.at(101), 0) << off;  // no findings
+  }
 }
 
 }  // namespace

@@ -54,6 +54,7 @@ struct Args {
   double duration_s = 0;
   double print_hz = -1;
   bool unpaced = false;
+  bool no_health_watch = false;
 };
 
 void AddOptions(CLI::App& app, Args& a) {
@@ -98,6 +99,8 @@ void AddOptions(CLI::App& app, Args& a) {
                  "simulated ADC: hold the sampling thread MS ms on every EVERY-th sample, "
                  "EVERY:MS (tests the late-sample counter)");
   app.add_flag("--unpaced", a.unpaced, "run the simulated ADC as fast as possible (benchmarks)");
+  app.add_flag("--no-health-watch", a.no_health_watch,
+               "run without the health watch (input 104 reads 0; measures what it costs)");
   app.add_option("--sim-effect", opt.sim_effects,
                  "inject NAME[:k=v,...] into the simulated sensor (ftsim record --effect; repeat)");
   app.add_option("--sim-profile", opt.sim_profile,
@@ -114,6 +117,7 @@ void AddOptions(CLI::App& app, Args& a) {
 void ResolveArgs(Args& a) {
   a.opt.parity = a.parity[0];
   a.opt.paced = !a.unpaced;
+  a.opt.health_watch = !a.no_health_watch;
   try {
     if (!a.sim_wrench.empty()) a.opt.sim_wrench = ftstack::tools::ParseWrench(a.sim_wrench);
   } catch (const std::exception& e) {
