@@ -6,8 +6,6 @@
 #include <numbers>
 #include <stdexcept>
 
-#include <fmt/format.h>
-
 #include "sim/physical_sensor.hpp"
 
 namespace ftstack::sim::design {
@@ -27,48 +25,6 @@ std::string ToString(Limit l) {
       return "buckling/SF";
   }
   return "?";
-}
-
-double GaugeEndZoneDepthM(double width_m, double height_m) {
-  const double t = std::min(width_m, height_m);
-  const double b = std::max(width_m, height_m);
-  return b >= 5 * t ? t : b;
-}
-
-double GaugeStationOutsideEndZoneM(double wanted_m, double length_m, double depth_m) {
-  return length_m >= 2 * depth_m ? std::max(wanted_m, depth_m) : wanted_m;
-}
-
-std::string GaugeEndZoneViolation(const std::vector<GaugeGrid>& gauges,
-                                  const std::vector<SolidMember>& members) {
-  for (const GaugeGrid& g : gauges) {
-    // The member under the grid: the one whose axis passes closest to it within its length.
-    const SolidMember* on = nullptr;
-    double best_off = INFINITY;
-    double s_on = 0;
-    for (const SolidMember& mb : members) {
-      const Eigen::Vector3d axis = mb.b_m - mb.a_m;
-      const double length = axis.norm();
-      const double s = (g.point_m - mb.a_m).dot(axis) / length;
-      const double off = (g.point_m - mb.a_m - s * axis / length).norm();
-      const double tol = 1e-9 + 1e-6 * length;
-      if (s < -tol || s > length + tol || off > 0.51 * std::hypot(mb.width_m, mb.height_m) + tol)
-        continue;
-      if (off < best_off) {
-        best_off = off;
-        on = &mb;
-        s_on = s;
-      }
-    }
-    if (on == nullptr) throw std::invalid_argument("gauge '" + g.name + "' sits on no member");
-    const double clearance = std::min(s_on, (on->b_m - on->a_m).norm() - s_on);
-    const double depth = GaugeEndZoneDepthM(on->width_m, on->height_m);
-    if (clearance < depth * (1 - 1e-9)) {
-      return fmt::format("gauge '{}' {:.2f} mm from a joint < section depth {:.2f} mm", g.name,
-                         1e3 * clearance, 1e3 * depth);
-    }
-  }
-  return "";
 }
 
 double EnvelopeLoads::Max(const Row6& c) const {

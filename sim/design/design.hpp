@@ -83,26 +83,7 @@ struct DesignModel {
   /// "" when every member is a slender beam (SlenderBeamViolation), else the first violation:
   /// the beam figures are then not to be trusted alone and the design is not ranked.
   std::string beam_validity;
-  /// "" when every gauge grid sits at least one end-zone depth (GaugeEndZoneDepthM) from both
-  /// ends of its member, else the first gauge inside a joint's end zone: its strain is not the
-  /// beam's (Saint-Venant), so the design is not ranked on beam figures either.
-  std::string gauge_placement;
 };
-
-/// How far a joint disturbs the strain of a member (m): about one section depth — the larger
-/// section side, or the thickness of a leaf (larger side >= 5 x the smaller).
-[[nodiscard]] double GaugeEndZoneDepthM(double width_m, double height_m);
-/// Where a family places a gauge station from a member's root: the wanted distance, moved out to
-/// the end-zone depth when the member is long enough (>= 2 depths) to have room for it.
-[[nodiscard]] double GaugeStationOutsideEndZoneM(double wanted_m, double length_m, double depth_m);
-/// The first gauge whose centre is closer to an end of the member it sits on than that member's
-/// end-zone depth ("" when none). A gauge on no member is an error (std::invalid_argument).
-[[nodiscard]] std::string GaugeEndZoneViolation(const std::vector<GaugeGrid>& gauges,
-                                                const std::vector<SolidMember>& members);
-/// Whether a design's beam figures may rank it: slender members and gauges outside end zones.
-[[nodiscard]] inline bool BeamFiguresTrusted(const DesignModel& m) {
-  return m.beam_validity.empty() && m.gauge_placement.empty();
-}
 
 /// Options of an evaluation; every assumption is a number here.
 struct DesignOptions {

@@ -140,10 +140,10 @@ void MarkPareto(std::vector<Candidate>* cs) {
   };
   for (Candidate& a : *cs) {
     const auto oa = obj(a);
-    a.pareto = BeamFiguresTrusted(a.model);  // outside beam theory: not ranked
+    a.pareto = a.model.beam_validity.empty();  // outside beam theory: not ranked
     if (!a.pareto) continue;
     for (const Candidate& b : *cs) {
-      if (!BeamFiguresTrusted(b.model)) continue;
+      if (!b.model.beam_validity.empty()) continue;
       const auto ob = obj(b);
       bool all_ge = true, one_gt = false;
       for (int k = 0; k < 4; ++k) {
@@ -255,7 +255,7 @@ GuidedParams GuidedFrom(const DesignModel& m) {
 /// utilisation: lowered by geometry that keeps moments off the force gauges). Phase 1: met designs
 /// inside the goal range by resolution, then by force range.
 double RefineScore(const Candidate& c, int phase = 1) {
-  if (!c.check.met() || !BeamFiguresTrusted(c.model)) return INFINITY;
+  if (!c.check.met() || !c.model.beam_validity.empty()) return INFINITY;
   if (phase == 0) return c.figures.force_range_n * c.check.gauge;
   if (c.figures.force_range_n > kGoalForceRangeN) return 1e3 + c.figures.force_range_n;
   return c.figures.force_resolution_n;
@@ -267,7 +267,7 @@ int RefineGuided(std::vector<Candidate>* cs, const Requirement& req, const Sweep
                  int starts) {
   std::vector<const Candidate*> seeds;
   for (const Candidate& c : *cs) {
-    if (c.model.family == "guided" && c.check.met() && BeamFiguresTrusted(c.model)) {
+    if (c.model.family == "guided" && c.check.met() && c.model.beam_validity.empty()) {
       seeds.push_back(&c);
     }
   }
@@ -384,8 +384,8 @@ int PrintRequirementVerdict(std::ostream& out, const std::vector<Candidate>& cs,
   std::vector<const Candidate*> ok;
   int unranked = 0;
   for (const Candidate& c : cs) {
-    if (c.check.met() && BeamFiguresTrusted(c.model)) ok.push_back(&c);
-    if (c.check.met() && !BeamFiguresTrusted(c.model)) ++unranked;
+    if (c.check.met() && c.model.beam_validity.empty()) ok.push_back(&c);
+    if (c.check.met() && !c.model.beam_validity.empty()) ++unranked;
   }
   std::sort(ok.begin(), ok.end(), [](const Candidate* a, const Candidate* b) {
     return a->figures.force_resolution_n < b->figures.force_resolution_n;
@@ -415,7 +415,7 @@ int PrintRequirementVerdict(std::ostream& out, const std::vector<Candidate>& cs,
       if (c.model.family != fam) continue;
       lever = std::max(lever, c.figures.tilt_capacity_nm / c.figures.capacity.head<2>().minCoeff());
       if (closest == nullptr || c.check.worst() < closest->check.worst()) closest = &c;
-      if (!c.check.met() || !BeamFiguresTrusted(c.model)) continue;
+      if (!c.check.met() || !c.model.beam_validity.empty()) continue;
       ++met;
       if (finest == nullptr || c.figures.force_resolution_n < finest->figures.force_resolution_n) {
         finest = &c;
@@ -448,7 +448,7 @@ int PrintRequirementVerdict(std::ostream& out, const std::vector<Candidate>& cs,
 }
 
 bool MeetsGoal(const Candidate& c, const Requirement& req) {
-  return req.safety_factor >= 1.5 && c.check.met() && BeamFiguresTrusted(c.model) &&
+  return req.safety_factor >= 1.5 && c.check.met() && c.model.beam_validity.empty() &&
          c.figures.force_range_n <= kGoalForceRangeN &&
          c.figures.force_resolution_n <= kGoalForceResolutionN;
 }
@@ -477,7 +477,7 @@ void PrintGoal(std::ostream& out, const std::vector<Candidate>& cs, const Requir
     return;
   }
   for (const Candidate& c : cs) {
-    if (c.check.met() && BeamFiguresTrusted(c.model) &&
+    if (c.check.met() && c.model.beam_validity.empty() &&
         (best == nullptr || c.figures.force_range_n < best->figures.force_range_n)) {
       best = &c;
     }

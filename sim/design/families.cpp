@@ -115,7 +115,6 @@ DesignModel FromPhysicalSensor(const PhysicalSensorModel& s, const Material& mat
     m.sketch.push_back(seg);
   }
   m.stress_shear = Stack(shear);
-  m.gauge_placement = GaugeEndZoneViolation(m.gauges, m.members);
   m.bridge_noise_mvv = bridge_noise_mvv;
   m.native_bandwidth_hz = 0.5 * rate_hz;
   return m;
@@ -139,13 +138,7 @@ DesignModel HubSpoke(const HubSpokeParams& p, const Readout& r) {
   spec.max_condition_number = 1e9;
   BridgeCircuit circuit;
   circuit.excitation_v = r.adc.excitation_v;
-  // The bridges at gauge_frac of the beam from the hub, but outside the hub joint's end zone.
-  const double length = p.rim_radius_m - p.hub_radius_m;
-  AddBendingBridges(
-      &spec,
-      GaugeStationOutsideEndZoneM(p.gauge_frac * length, length,
-                                  GaugeEndZoneDepthM(p.beam_width_m, p.beam_height_m)),
-      circuit);
+  AddBendingBridges(&spec, p.gauge_frac * (p.rim_radius_m - p.hub_radius_m), circuit);
   const PhysicalSensorModel model(spec);
   DesignModel m = FromPhysicalSensor(model, p.material, ReadoutNoiseMvv(r), r.adc.rate_hz);
   m.parameters["gauge_frac"] = p.gauge_frac;

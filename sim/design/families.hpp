@@ -23,9 +23,7 @@ struct Readout {
 [[nodiscard]] DesignModel FromPhysicalSensor(const PhysicalSensorModel& s, const Material& mat,
                                              double bridge_noise_mvv, double rate_hz);
 
-/// Family "hub-spoke": 3 or 4 radial beams, classic bending bridges at gauge_frac of the length
-/// from the hub, moved out to one section depth from the hub when the beam has room
-/// (GaugeStationOutsideEndZoneM).
+/// Family "hub-spoke": 3 or 4 radial beams, classic bending bridges at gauge_frac of the length.
 struct HubSpokeParams {
   int beams = 4;
   double hub_radius_m = 0.015, rim_radius_m = 0.05;
@@ -49,9 +47,8 @@ struct GuidedParams {
   double separation_m = 0.04;    ///< between the two leaves of a parallelogram
   double inner_radius_m = 0.02;  ///< innermost leaf roots from the axis
   double gap_m = 0.01;           ///< radial gap between nested stages
-  double gauge_frac =
-      0.1;  ///< force gauges this fraction of L from the outer root (>= t when L >= 2t)
-  int elements_per_leaf = 1;  ///< mesh (exact beam elements: refinement changes nothing)
+  double gauge_frac = 0.1;       ///< force gauges this fraction of L from the outer root
+  int elements_per_leaf = 1;     ///< mesh (exact beam elements: refinement changes nothing)
   Material material = Steel174Ph();
 };
 [[nodiscard]] FrameModel GuidedFrame(const GuidedParams& p);

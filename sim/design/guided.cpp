@@ -1,5 +1,4 @@
 // Family "guided": nested parallelogram stages (see families.hpp).
-#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -162,16 +161,13 @@ DesignModel Guided(const GuidedParams& p, const Readout& r) {
     g.direction = (inner - outer).normalized();
     g.normal = z_sign * stage.c;
     g.point_m = outer + g.direction * s_m + 0.5 * t * g.normal;
-    g.name = std::string(stage.name) + (s_m < 0.5 * p.leaf_length_m ? " force" : " moment") +
+    g.name = std::string(stage.name) + (s_m < 0.25 * p.leaf_length_m ? " force" : " moment") +
              ((leaf % 4) / 2 == 0 ? ", + side" : ", - side") +
              (leaf % 2 == 0 ? " upper leaf" : " lower leaf") + (z_sign > 0 ? ", top" : ", bottom");
     m.gauges.push_back(g);
     return row;
   };
-  // Force gauges at gauge_frac of the leaf from its outer root, outside the root's end zone.
-  const double root = GaugeStationOutsideEndZoneM(
-      p.gauge_frac * p.leaf_length_m, p.leaf_length_m,
-      GaugeEndZoneDepthM(p.leaf_width_m, std::max(p.leaf_thickness_m, p.leaf_thickness_z_m)));
+  const double root = p.gauge_frac * p.leaf_length_m;
   const double mid = 0.5 * p.leaf_length_m;
   // Gauge rows, in this order (one statement per gauge: the order is part of the contract):
   // per stage z, x, y the force bridge — + side upper leaf at the root, top then bottom face, then
@@ -229,7 +225,6 @@ DesignModel Guided(const GuidedParams& p, const Readout& r) {
     const std::string v = SlenderBeamViolation(p.leaf_length_m, p.leaf_width_m, st.thickness_m);
     if (!v.empty() && m.beam_validity.empty()) m.beam_validity = st.name + (" stage leaves: " + v);
   }
-  m.gauge_placement = GaugeEndZoneViolation(m.gauges, m.members);
   m.bridge_noise_mvv = ReadoutNoiseMvv(r);
   m.native_bandwidth_hz = 0.5 * r.adc.rate_hz;
   return m;

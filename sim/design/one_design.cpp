@@ -107,11 +107,6 @@ void PrintDesignDetail(std::ostream& out, const Candidate& c, const DesignOption
               ? std::string("every member is a slender beam (L >= 2 h; leaf width L >= b/2)")
               : "OUTSIDE the slender-beam range (" + c.model.beam_validity +
                     "): figures need a solid FE check")
-      << "\n  gauges: "
-      << (c.model.gauge_placement.empty()
-              ? std::string("every grid at least one section depth from a joint")
-              : "INSIDE a joint's end zone (" + c.model.gauge_placement +
-                    "): the beam model cannot predict its strain; not ranked")
       << "\n  stiffness at the origin (rows/cols Fx Fy Fz Mx My Mz; N/m, N/rad, N·m/rad):\n";
   for (int i = 0; i < 6; ++i) {
     out << "   ";
@@ -160,8 +155,6 @@ nlohmann::json DesignJson(const Candidate& c, const DesignOptions& o) {
   j["parameters"] = c.model.parameters;
   j["slender_beams"] = c.model.beam_validity.empty();
   j["beam_validity"] = c.model.beam_validity;
-  j["gauges_outside_end_zones"] = c.model.gauge_placement.empty();
-  j["gauge_placement"] = c.model.gauge_placement;
   j["wrench_order"] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
   nlohmann::json k = nlohmann::json::array();
   for (int i = 0; i < 6; ++i) {

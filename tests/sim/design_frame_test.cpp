@@ -8,8 +8,6 @@
 #include "sim/design/families.hpp"
 #include "sim/design/frame.hpp"
 #include "sim/flexure_body.hpp"
-#include "sim/physical_sensor.hpp"
-#include "sim/sensor_description.hpp"
 
 namespace ftstack::sim::design {
 namespace {
@@ -188,64 +186,6 @@ TEST(DesignFrame, HubSpokeTimoshenkoAndSlenderFlag) {
   q.leaf_length_m = 0.01;
   q.leaf_width_m = 0.05;
   EXPECT_EQ(Guided(q, r).beam_validity, "z stage leaves: L/b = 0.20 < 0.5");
-}
-
-// The end-zone rule: a gauge closer to a joint than one section depth (the larger side; a leaf's
-// thickness) is named, measured along its member from the nearer end.
-TEST(DesignGaugePlacement, EndZoneRuleOnAHandMadeMember) {
-  EXPECT_DOUBLE_EQ(GaugeEndZoneDepthM(0.0045, 0.006), 0.006);
-  EXPECT_DOUBLE_EQ(GaugeEndZoneDepthM(0.038, 0.0015), 0.0015);  // a leaf: its thickness
-  SolidMember mb;
-  mb.a_m = {0.010, 0, 0};
-  mb.b_m = {0.035, 0, 0};
-  mb.width_m = 0.0045;
-  mb.height_m = 0.006;
-  GaugeGrid g;
-  g.name = "side";
-  g.normal = Eigen::Vector3d::UnitY();
-  g.point_m = {0.032, 0.00225, 0.0015};  // 3 mm from end b, on the +y face, 1.5 mm up
-  EXPECT_EQ(GaugeEndZoneViolation({g}, {mb}),
-            "gauge 'side' 3.00 mm from a joint < section depth 6.00 mm");
-  g.point_m.x() = 0.0145;  // 4.5 mm from end a
-  EXPECT_EQ(GaugeEndZoneViolation({g}, {mb}),
-            "gauge 'side' 4.50 mm from a joint < section depth 6.00 mm");
-  g.point_m.x() = 0.029;  // 6 mm from end b: outside
-  EXPECT_EQ(GaugeEndZoneViolation({g}, {mb}), "");
-  g.point_m.y() = 0.02;  // off the member
-  EXPECT_THROW((void)GaugeEndZoneViolation({g}, {mb}), std::invalid_argument);
-  EXPECT_DOUBLE_EQ(GaugeStationOutsideEndZoneM(0.00525, 0.035, 0.01), 0.01);
-  EXPECT_DOUBLE_EQ(GaugeStationOutsideEndZoneM(0.012, 0.035, 0.01), 0.012);
-  EXPECT_DOUBLE_EQ(GaugeStationOutsideEndZoneM(0.002, 0.015, 0.01), 0.002);  // no room: flagged
-}
-
-// The families keep their gauges out of the end zones; the project's default body does too, and
-// its earlier gauges 3 mm from the rim are flagged (and then not ranked).
-TEST(DesignGaugePlacement, FamiliesAndTheDefaultBodyKeepOutOfEndZones) {
-  const Readout r;
-  const HubSpokeParams p;  // 35 mm beams 10 mm deep: 15 % of L = 5.25 mm, moved to 10 mm
-  const DesignModel hub = HubSpoke(p, r);
-  EXPECT_EQ(hub.gauge_placement, "");
-  EXPECT_TRUE(BeamFiguresTrusted(hub));
-  for (const GaugeGrid& g : hub.gauges) {  // beams along ±x, ±y: hub 15 mm + 10 mm
-    EXPECT_NEAR(std::max(std::abs(g.point_m.x()), std::abs(g.point_m.y())), 0.025, 1e-12) << g.name;
-  }
-  GuidedParams q;
-  q.leaf_length_m = 0.02;
-  q.leaf_thickness_m = q.leaf_thickness_z_m = 0.0025;  // 10 % of L = 2 mm, moved to t
-  EXPECT_EQ(Guided(q, r).gauge_placement, "");
-  const auto check_default = [&](const std::string& json) {
-    const auto phys = ParsePhysicalSensor(json, "test");
-    FlexureSensorSpec spec = phys->spec();
-    spec.body.shear_deformable = true;
-    return FromPhysicalSensor(PhysicalSensorModel(spec), Aluminium7075(), 1e-4, 1000)
-        .gauge_placement;
-  };
-  std::string json = DefaultSensorJson();
-  EXPECT_EQ(check_default(json), "");
-  for (std::size_t at = json.find("0.019"); at != std::string::npos; at = json.find("0.019"))
-    json.replace(at, 5, "0.022");
-  EXPECT_EQ(check_default(json),
-            "gauge 'beam 0, top, 0 deg' 3.00 mm from a joint < section depth 6.00 mm");
 }
 
 // Gauge rows by position: row i of the guided family's gauge matrix is the gauge its documented
