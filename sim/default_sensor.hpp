@@ -12,7 +12,8 @@ namespace ftstack::sim {
 
 /// The built-in sensor, the physical model of sim/sensors/default.json: a three-beam aluminium
 /// flexure (hub 10 mm, rim 35 mm, beams 4.5 × 6 mm) with six full bending bridges — at 0°, 120°,
-/// 240° one out-of-plane bridge (Fz, Mx, My) and one in-plane bridge (Fx, Fy, Mz) per beam —,
+/// 240° one out-of-plane bridge (Fz, Mx, My) and one in-plane bridge (Fx, Fy, Mz, its grids on the
+/// side faces' mid-height line) per beam —,
 /// 0.8 … 1.9 mV/V per term at rated load.
 [[nodiscard]] std::unique_ptr<SensorModel> MakeDefaultSensor();
 

@@ -138,7 +138,10 @@ def write_deck(path, nodes, hexes, bodies, material, n_bodies, members, radial_c
     axial translation held by equations, radial translation on a spring of 1/compliance."""
     top = max(nodes)
     ref = {b: top + 100 + 4 * b for b in range(1, n_bodies)}
-    radial = {m[7]: (m[1] - m[0]) / np.linalg.norm(m[1] - m[0]) for m in members if m[7] >= 2}
+    # only a hub-spoke body with a rim compliance has floating joints (a guided body's bodies 2 and 3
+    # are its rigid intermediate stages)
+    radial = {m[7]: (m[1] - m[0]) / np.linalg.norm(m[1] - m[0])
+              for m in members if m[7] >= 2 and radial_compliance > 0}
     with open(path, "w") as f:
         f.write("** independent FE check (tests/fe/independent_fe.py), SI units\n*NODE\n")
         for nid, p in nodes.items():

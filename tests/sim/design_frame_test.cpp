@@ -8,6 +8,8 @@
 #include "sim/design/families.hpp"
 #include "sim/design/frame.hpp"
 #include "sim/flexure_body.hpp"
+#include "sim/physical_sensor.hpp"
+#include "sim/sensor_description.hpp"
 
 namespace ftstack::sim::design {
 namespace {
@@ -186,6 +188,29 @@ TEST(DesignFrame, HubSpokeTimoshenkoAndSlenderFlag) {
   q.leaf_length_m = 0.01;
   q.leaf_width_m = 0.05;
   EXPECT_EQ(Guided(q, r).beam_validity, "z stage leaves: L/b = 0.20 < 0.5");
+}
+
+// The project's default body: its in-plane bridge's grids sit on the side faces' mid-height line
+// (the out-of-plane neutral axis), so no out-of-plane load (Fz, Mx, My) strains them — off that
+// line they also read the restrained-warping strain of twisted beams that beam theory lacks
+// (docs/design.md). The top and bottom grids do carry those loads.
+TEST(DesignFrame, DefaultBodyInPlaneGridsSitOnTheNeutralAxis) {
+  const auto phys = ParsePhysicalSensor(DefaultSensorJson(), "builtin");
+  const DesignModel m = FromPhysicalSensor(*phys, Aluminium7075(), 1e-4, 1000);
+  double top = 0;
+  for (Eigen::Index i = 0; i < m.gauge_strain.rows(); ++i)
+    top = std::max(top, m.gauge_strain.row(i).segment(2, 3).cwiseAbs().maxCoeff());
+  ASSERT_GT(top, 0);
+  int side = 0;
+  for (std::size_t i = 0; i < m.gauges.size(); ++i) {
+    if (std::abs(m.gauges[i].normal.z()) > 0.5) continue;  // top or bottom face
+    ++side;
+    EXPECT_NEAR(m.gauges[i].point_m.z(), 0.0, 1e-12) << m.gauges[i].name;
+    const Row6 row = m.gauge_strain.row(static_cast<Eigen::Index>(i));
+    EXPECT_LT(row.segment(2, 3).cwiseAbs().maxCoeff(), 1e-9 * top) << m.gauges[i].name;
+    EXPECT_GT(std::abs(row(5)), 0.1 * top) << m.gauges[i].name;  // Mz bends them in plane
+  }
+  EXPECT_EQ(side, 12);
 }
 
 // Gauge rows by position: row i of the guided family's gauge matrix is the gauge its documented
