@@ -435,11 +435,34 @@ bool FitCreepTwo(const Context& cx, const Series& target, double log_tau1, doubl
 
 namespace ftstack::diag {
 
+namespace {
+
+/// Creep's physical ranges: time constants from 3 samples (and 0.2 s: the search's lower bound) to
+/// a third of the record (a slower one is a drift the record cannot tell from creep), fractions of
+/// the load up to 5 % (a load cell creeping more is broken, or the fit is absorbing another
+/// mismatch).
+std::vector<ParamRange> CreepRanges(const Context& cx) {
+  const auto& t = cx.data->t_s;
+  const double lo = std::max(3.0 * cx.dt, 0.2);
+  const double hi = std::max((t.back() - t.front()) / 3.0, 1.0);
+  const char* lo_what = "3 samples or 0.2 s";
+  const char* hi_what = "a third of the record";
+  return {{"tau_s", lo, hi, lo_what, hi_what},
+          {"tau1_s", lo, hi, lo_what, hi_what},
+          {"tau2_s", lo, hi, lo_what, hi_what},
+          {"fraction", 0.0, 0.05, "", "5 % of the load"},
+          {"fraction1", 0.0, 0.05, "", "5 % of the load"},
+          {"fraction2", 0.0, 0.05, "", "5 % of the load"}};
+}
+
+}  // namespace
+
 EffectSpec CreepPlugin() {
   return {.kind = EffectKind::kCreep,
           .fit = &fx::FitBy<&fx::CreepSearch>,
           .refit = &fx::RefitBy<&fx::CreepSearch>,
-          .cost = 4};
+          .cost = 4,
+          .ranges = &CreepRanges};
 }
 
 }  // namespace ftstack::diag
