@@ -29,7 +29,8 @@ Scored ScoreFit(const Context& cx, const Series& target, EffectFit fit, double b
   s.score = s.delta - fit.n_params * HoldPenalty(cx);
   // A fit on a search bound or outside its physical range is never claimed, however it scores.
   fit.not_resolved = NotResolved(cx, fit);
-  s.eligible = s.z > z_claim && s.score > 0 && fit.not_resolved.empty();
+  s.significant = s.z > z_claim && s.score > 0;
+  s.eligible = s.significant && fit.not_resolved.empty();
   s.fit = std::move(fit);
   return s;
 }
@@ -121,9 +122,10 @@ std::vector<std::vector<Partner>> FitPartners(const Context& cx, const DiagnoseO
   std::vector<std::vector<std::size_t>> todo(top.size());  // per start: effects j
   std::size_t total = 0;
   for (std::size_t j : CostOrder(effects)) {
-    // Partners come from the effects that were claimable on their own.
+    // Partners come from the effects that were significant on their own (resolved or not: fitted
+    // to what the start leaves, a partner may resolve; the pair is claimed only if it does).
     const bool claimable = std::any_of(singles.begin(), singles.end(), [&](const Scored& q) {
-      return q.eligible && q.fit.name == effects[j].name;
+      return q.significant && q.fit.name == effects[j].name;
     });
     for (std::size_t t = 0; t < top.size(); ++t) {
       if (claimable && singles[top[t]].fit.name != effects[j].name) {
