@@ -2,6 +2,7 @@
 #include "measurement/wrench.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -187,15 +188,9 @@ void Reduce(const PlotSeries& s, double x0, double x1, int cols, std::vector<dou
   flush();
 }
 
-}  // namespace
-
-std::string SvgPlot(const PlotSpec& spec, const std::vector<PlotSeries>& series) {
-  const int ml = 70;
-  const int mr = 20;
-  const int mt = 28;
-  const int mb = 42;
-  const int pw = spec.width - ml - mr;
-  const int ph = spec.height - mt - mb;
+/// The plotted x and y range of `series` (y in log10 for a log plot, padded by 5 %): x0, x1, y0,
+/// y1.
+std::array<double, 4> PlotRange(const PlotSpec& spec, const std::vector<PlotSeries>& series) {
   double x0 = std::numeric_limits<double>::infinity();
   double x1 = -x0;
   double y0 = x0;
@@ -221,6 +216,20 @@ std::string SvgPlot(const PlotSpec& spec, const std::vector<PlotSeries>& series)
   const double pad = 0.05 * (y1 - y0);
   y0 -= pad;
   y1 += pad;
+  return {x0, x1, y0, y1};
+}
+
+}  // namespace
+
+std::string SvgPlot(const PlotSpec& spec, const std::vector<PlotSeries>& series) {
+  const int ml = 70;
+  const int mr = 20;
+  const int mt = 28;
+  const int mb = 42;
+  const int pw = spec.width - ml - mr;
+  const int ph = spec.height - mt - mb;
+  auto ty = [&](double v) { return spec.log_y ? std::log10(std::max(v, 1e-300)) : v; };
+  const auto [x0, x1, y0, y1] = PlotRange(spec, series);
   auto px = [&](double x) { return ml + (x - x0) / (x1 - x0) * pw; };
   auto py = [&](double y) { return mt + (1.0 - (ty(y) - y0) / (y1 - y0)) * ph; };
   auto pyl = [&](double yl) { return mt + (1.0 - (yl - y0) / (y1 - y0)) * ph; };
