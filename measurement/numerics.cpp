@@ -1,11 +1,14 @@
 #include "measurement/numerics.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
+#include <functional>
 #include <limits>
 #include <numbers>
 #include <unsupported/Eigen/FFT>
 #include <unsupported/Eigen/MatrixFunctions>
+#include <vector>
 
 namespace ftstack::numerics {
 
@@ -60,9 +63,14 @@ std::size_t WelchSegment(std::size_t n) {
   return seg;
 }
 
-Spectrum Welch(const double* x, std::size_t n, double rate_hz, std::size_t segment) {
-  Spectrum s;
-  if (segment < 8 || n < segment) return s;
+namespace {
+
+/// Calls each(power) with |FFT|² of every Hann-windowed, linearly detrended segment of x
+/// (half-overlapping); fills s's frequencies and counts its segments. Returns the window's Σw² (the
+/// periodogram's scale), 0 when x is too short.
+double ForWelchSegments(const double* x, std::size_t n, double rate_hz, std::size_t segment,
+                        Spectrum* s, const std::function<void(const std::vector<double>&)>& each) {
+  if (segment < 8 || n < segment) return 0.0;
   const std::size_t half = segment / 2;
   const auto seg_d = static_cast<double>(segment);
   std::vector<double> win(segment);
@@ -71,11 +79,11 @@ Spectrum Welch(const double* x, std::size_t n, double rate_hz, std::size_t segme
     win[j] = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * static_cast<double>(j) / seg_d);
     wsum2 += win[j] * win[j];
   }
-  s.power.assign(half + 1, 0.0);
-  s.freq_hz.resize(half + 1);
-  for (std::size_t k = 0; k <= half; ++k) s.freq_hz[k] = static_cast<double>(k) * rate_hz / seg_d;
+  s->freq_hz.resize(half + 1);
+  for (std::size_t k = 0; k <= half; ++k) s->freq_hz[k] = static_cast<double>(k) * rate_hz / seg_d;
   Eigen::FFT<double> fft;
   std::vector<double> buf(segment);
+  std::vector<double> power(half + 1);
   std::vector<std::complex<double>> out;
   // Linear-trend removal: least-squares line over j = 0 … segment − 1, centred at jm.
   const double jm = (seg_d - 1.0) / 2.0;
@@ -96,10 +104,43 @@ Spectrum Welch(const double* x, std::size_t n, double rate_hz, std::size_t segme
       buf[j] = (x[start + j] - mean - slope * (static_cast<double>(j) - jm)) * win[j];
     }
     fft.fwd(out, buf);
-    for (std::size_t k = 0; k <= half; ++k) s.power[k] += std::norm(out[k]);
-    ++s.segments;
+    for (std::size_t k = 0; k <= half; ++k) power[k] = std::norm(out[k]);
+    each(power);
+    ++s->segments;
   }
+  return wsum2;
+}
+
+}  // namespace
+
+Spectrum Welch(const double* x, std::size_t n, double rate_hz, std::size_t segment) {
+  Spectrum s;
+  std::vector<double> sum;
+  const double wsum2 =
+      ForWelchSegments(x, n, rate_hz, segment, &s, [&](const std::vector<double>& p) {
+        if (sum.empty()) sum.assign(p.size(), 0.0);
+        for (std::size_t k = 0; k < p.size(); ++k) sum[k] += p[k];
+      });
+  if (wsum2 == 0.0) return s;
+  s.power = std::move(sum);
   for (auto& p : s.power) p /= static_cast<double>(s.segments) * wsum2;
+  return s;
+}
+
+Spectrum WelchMedian(const double* x, std::size_t n, double rate_hz, std::size_t segment) {
+  Spectrum s;
+  std::vector<std::vector<double>> all;
+  const double wsum2 = ForWelchSegments(x, n, rate_hz, segment, &s,
+                                        [&](const std::vector<double>& p) { all.push_back(p); });
+  if (wsum2 == 0.0) return s;
+  s.power.resize(all.front().size());
+  std::vector<double> column(all.size());
+  for (std::size_t k = 0; k < s.power.size(); ++k) {
+    for (std::size_t q = 0; q < all.size(); ++q) column[q] = all[q][k];
+    const auto mid = column.begin() + static_cast<std::ptrdiff_t>(column.size() / 2);
+    std::nth_element(column.begin(), mid, column.end());
+    s.power[k] = *mid / wsum2;
+  }
   return s;
 }
 

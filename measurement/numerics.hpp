@@ -46,6 +46,11 @@ struct Spectrum {
   int segments = 0;
 };
 [[nodiscard]] Spectrum Welch(const double* x, std::size_t n, double rate_hz, std::size_t segment);
+/// The same periodograms, their median per bin instead of their mean: the spectrum of the record's
+/// typical segment, which a few transients (load steps) do not lift. Not scaled to a density's
+/// mean (the median of a χ²₂ periodogram is ln 2 of its mean); for lines against their neighbours.
+[[nodiscard]] Spectrum WelchMedian(const double* x, std::size_t n, double rate_hz,
+                                   std::size_t segment);
 
 /// The segment length used for a record of n rows: a power of two ≤ 1024 giving ≥ 8 segments.
 [[nodiscard]] std::size_t WelchSegment(std::size_t n);

@@ -64,6 +64,45 @@ void FinishCreep(const Context& cx, const Series& target, bool two, const std::v
           RowCorr(cx, target, e->pred, c));
 }
 
+/// The one-τ variants at τ = e^lt (plain, with a gain term), both fitted over every row in one
+/// streamed pass of LP_τ[load]; the lower training BIC's into *best, *best_f, *best_gamma (σ of τ
+/// from the curvature of sse_for(log τ, gamma) when `uncertainty`). Returns that BIC.
+double PickOneTau(const Context& cx, const Series& target, double lt,
+                  const std::function<double(double, bool)>& sse_for, bool uncertainty,
+                  EffectFit* best, ChannelFit* best_f, bool* best_gamma) {
+  const double tau = std::exp(lt);
+  ChannelSums sums[2] = {ChannelSums(cx, 1), ChannelSums(cx, 2)};
+  ForLaggedLoad(cx, &tau, 1, [&](int i, int c, const double* lag) {
+    if (!cx.train[static_cast<std::size_t>(i)]) return;
+    const double x[2] = {lag[0], cx.load(i, c)};
+    sums[0].Add(c, x, target(i, c));
+    sums[1].Add(c, x, target(i, c));
+  });
+  double best_bic = std::numeric_limits<double>::infinity();
+  for (bool gamma : {false, true}) {
+    const int p = cx.nc * (gamma ? 2 : 1) + 1;
+    EffectFit e;
+    e.name = "creep";
+    e.variant = gamma ? "first-order creep with a gain term" : "first-order creep";
+    e.n_params = p;
+    const double sl = uncertainty
+                          ? CurvatureSigma([&](double v) { return sse_for(v, gamma); }, lt, 0.02)
+                          : std::numeric_limits<double>::quiet_NaN();
+    const ChannelFit f = sums[gamma ? 1 : 0].Solve(cx);
+    e.train_sse_w = f.sse_w;
+    const double bic = f.sse_w + p * Penalty(cx);
+    if (bic >= best_bic) continue;
+    best_bic = bic;
+    e.params["tau_s"] = tau;
+    e.sigma["tau_s"] = JsonNum(tau * sl);
+    PutChannelCoef(cx, f, 0, "fraction", &e);
+    *best = std::move(e);
+    *best_f = f;
+    *best_gamma = gamma;
+  }
+  return best_bic;
+}
+
 }  // namespace
 
 std::optional<EffectFit> CreepSearch(const Context& cx, const Series& target, const EffectFit* near,
@@ -108,7 +147,6 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Series& target, co
   const double lo = std::log(std::max(3.0 * cx.dt, 0.2));
   const double hi = std::log(std::max(duration, 1.0));
   for (int j = 0; j <= 12; ++j) grid.push_back(lo + (hi - lo) * j / 12.0);
-  double best_bic = std::numeric_limits<double>::infinity();
   // τ is searched with the plain model; the variant with a gain term reuses it. Near a fit: 5
   // points 0.25 apart in log τ around its τ (τ1 of a two-τ fit: the one-τ model is then only the
   // baseline the pair must beat), the full grid when the optimum is on the window's edge.
@@ -117,35 +155,9 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Series& target, co
   const double lt =
       WindowOrGrid([&](double v) { return sse_for(v, false); }, near_lt, grid, lo, hi);
   const double tau = std::exp(lt);
-  // Both variants' fits over every row in one streamed pass of LP_τ[load].
-  ChannelSums sums[2] = {ChannelSums(cx, 1), ChannelSums(cx, 2)};
-  ForLaggedLoad(cx, &tau, 1, [&](int i, int c, const double* lag) {
-    if (!cx.train[static_cast<std::size_t>(i)]) return;
-    const double x[2] = {lag[0], cx.load(i, c)};
-    sums[0].Add(c, x, target(i, c));
-    sums[1].Add(c, x, target(i, c));
-  });
-  for (bool gamma : {false, true}) {
-    const int p = cx.nc * (gamma ? 2 : 1) + 1;
-    EffectFit e;
-    e.name = "creep";
-    e.variant = gamma ? "first-order creep with a gain term" : "first-order creep";
-    e.n_params = p;
-    const double sl = uncertainty
-                          ? CurvatureSigma([&](double v) { return sse_for(v, gamma); }, lt, 0.02)
-                          : std::numeric_limits<double>::quiet_NaN();
-    const ChannelFit f = sums[gamma ? 1 : 0].Solve(cx);
-    e.train_sse_w = f.sse_w;
-    const double bic = f.sse_w + p * Penalty(cx);
-    if (bic >= best_bic) continue;
-    best_bic = bic;
-    e.params["tau_s"] = tau;
-    e.sigma["tau_s"] = JsonNum(tau * sl);
-    PutChannelCoef(cx, f, 0, "fraction", &e);
-    best = std::move(e);
-    best_f = f;
-    best_gamma = gamma;
-  }
+  const double best_bic = PickOneTau(
+      cx, target, lt, [&](double v, bool gamma) { return sse_for(v, gamma); }, uncertainty, &best,
+      &best_f, &best_gamma);
   lp = Mat();
   // The kept variant's prediction, streamed.
   PredictStreamed(
@@ -435,11 +447,34 @@ bool FitCreepTwo(const Context& cx, const Series& target, double log_tau1, doubl
 
 namespace ftstack::diag {
 
+namespace {
+
+/// Creep's physical ranges: time constants from 3 samples (and 0.2 s: the search's lower bound) to
+/// a third of the record (a slower one is a drift the record cannot tell from creep), fractions of
+/// the load up to 5 % (a load cell creeping more is broken, or the fit is absorbing another
+/// mismatch).
+std::vector<ParamRange> CreepRanges(const Context& cx) {
+  const auto& t = cx.data->t_s;
+  const double lo = std::max(3.0 * cx.dt, 0.2);
+  const double hi = std::max((t.back() - t.front()) / 3.0, 1.0);
+  const char* lo_what = "3 samples or 0.2 s";
+  const char* hi_what = "a third of the record";
+  return {{"tau_s", lo, hi, lo_what, hi_what},
+          {"tau1_s", lo, hi, lo_what, hi_what},
+          {"tau2_s", lo, hi, lo_what, hi_what},
+          {"fraction", 0.0, 0.05, "", "5 % of the load"},
+          {"fraction1", 0.0, 0.05, "", "5 % of the load"},
+          {"fraction2", 0.0, 0.05, "", "5 % of the load"}};
+}
+
+}  // namespace
+
 EffectSpec CreepPlugin() {
   return {.kind = EffectKind::kCreep,
           .fit = &fx::FitBy<&fx::CreepSearch>,
           .refit = &fx::RefitBy<&fx::CreepSearch>,
-          .cost = 4};
+          .cost = 4,
+          .ranges = &CreepRanges};
 }
 
 }  // namespace ftstack::diag

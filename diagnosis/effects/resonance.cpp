@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "diagnosis/effects/families.hpp"
+#include "diagnosis/engine/nonlinear_search.hpp"
 #include "diagnosis/engine/signal.hpp"
 
 namespace ftstack::diag::fx {
@@ -28,12 +29,33 @@ int FastLoadChanges(const Context& cx, int c) {
   return fast;
 }
 
-/// The coarse frequency grid: ±8 % around each of the 3 strongest lines of the residual spectrum,
-/// or 12 log-spaced points from 1 Hz to 0.9 × Nyquist without any.
-std::vector<double> ResonanceGrid(const Context& cx) {
+/// The physical range of a mode, which is also its search's: below 0.98 × Nyquist, above
+/// kMinFreqHz; damping ratio from kMinZeta (Q 500: a swinging weight, a fixture mode) to kMaxZeta
+/// (beyond it a step response barely rings: a lag, not a resonance).
+constexpr double kMinFreqHz = 0.05;
+constexpr double kMinZeta = 1e-3;
+constexpr double kMaxZeta = 0.5;
+double MaxFreqHz(const Context& cx) { return 0.98 * 0.5 * cx.rate_hz; }
+bool InRange(const Context& cx, double f_hz, double zeta) {
+  return f_hz >= kMinFreqHz && f_hz <= MaxFreqHz(cx) && zeta >= kMinZeta && zeta <= kMaxZeta;
+}
+
+/// The coarse frequency grid: ±8 % around each of the 3 strongest lines of the residual spectrum
+/// and of the 3 lines standing most out of their neighbourhood (LocalLines: a light ringing under
+/// a red spectrum), or 12 log-spaced points from 1 Hz to 0.9 × Nyquist without any.
+std::vector<double> ResonanceGrid(const Context& cx, const Series& target) {
+  std::vector<double> lines(
+      cx.peak_hz.begin(), cx.peak_hz.begin() + std::min<std::ptrdiff_t>(std::ssize(cx.peak_hz), 3));
+  int local = 0;
+  for (const auto& [level, f_hz] : LocalLines(cx, target)) {
+    const bool apart = std::none_of(lines.begin(), lines.end(), [f = f_hz](double g) {
+      return std::fabs(std::log(f / g)) < 0.08;
+    });
+    if (apart && local++ < 3) lines.push_back(f_hz);
+  }
   std::vector<double> fgrid;
-  for (std::size_t p = 0; p < std::min<std::size_t>(cx.peak_hz.size(), 3); ++p) {
-    for (double m : {0.92, 1.0, 1.08}) fgrid.push_back(cx.peak_hz[p] * m);
+  for (double line : lines) {
+    for (double m : {0.92, 1.0, 1.08}) fgrid.push_back(line * m);
   }
   if (fgrid.empty()) {
     for (int j = 0; j < 12; ++j) fgrid.push_back(std::exp(std::log(0.45 * cx.rate_hz) * j / 11.0));
@@ -108,25 +130,20 @@ double FitRingingAll(const Context& cx, const Series& target, double f, double z
   return cf->sse_w;
 }
 
-}  // namespace
-
-std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target,
-                                         const EffectFit* near, bool uncertainty) {
-  const double nyq = 0.5 * cx.rate_hz;
-  // The searches keep the ringing only where they read it (the window's rows, or every row_step-th
-  // row, of their channels); the final fit streams it over every row (memory: no n × N buffer).
-  Mat h;
-  // Coarse search on the two channels with the most residual energy, on all rows or (long records)
-  // the window with the most load-step energy.
-  const std::vector<int> coarse = StrongestTwo(cx, target);
-  const auto [w0, w1] = CoarseWindow(cx, coarse);
+/// The one-mode search's objective: the whitened training SSE of the ringing at (f, ζ) on
+/// `chans`, on the coarse window's rows (`windowed`) or every row_step-th row. It keeps the ringing
+/// only where it reads it (memory: no n × N buffer).
+struct OneModeObjective {
+  const Context& cx;
+  const Series& target;
+  int w0 = 0;
+  int w1 = 0;
   bool windowed = false;
-  int row_step = cx.search_stride;
-  const auto in_range = [&](double f, double z) {
-    return f > 0.05 && f < 0.98 * nyq && z > 1e-4 && z <= 2.0;
-  };
-  auto sse_for = [&](double f, double z, const std::vector<int>& chans) {
-    if (!in_range(f, z)) return std::numeric_limits<double>::infinity();
+  int row_step = 1;
+  Mat h;
+
+  double operator()(double f, double z, const std::vector<int>& chans) {
+    if (!InRange(cx, f, z)) return std::numeric_limits<double>::infinity();
     if (windowed) {
       RingingAt(cx, f, z, chans, w0, w1 - w0, 1, &h);
       return WindowSse(cx, target, h, chans, w0, w1);
@@ -142,92 +159,114 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target
     double s = 0.0;
     for (int c : chans) s += r.sse(c) * cx.weight(c);
     return s;
-  };
-  const std::vector<int> all = AllChannels(cx);
-  std::vector<double> fgrid = ResonanceGrid(cx);
-  const double zgrid[] = {0.01, 0.03, 0.1, 0.3};
-  double best_freq = 0.0;
-  double best_zeta = 0.0;
-  double best_sse = std::numeric_limits<double>::infinity();
+  }
+};
+
+/// (log f, log ζ) of one mode: the coarse grid (ResonanceGrid × damping ratios from kMinZeta) on
+/// the coarse window, or near's optimum; then golden rounds on the coarse channels (a refit only
+/// the finer second). False when no point is in range.
+bool SearchOneMode(const Context& cx, const Series& target, const EffectFit* near,
+                   const std::vector<int>& coarse, OneModeObjective* sse, double* log_fz) {
   const bool warm = near != nullptr && near->search_state.size() >= 2;
+  std::vector<double> best = {0.0, 0.0};
+  const LogObjective on_coarse = [&](const std::vector<double>& x) {
+    return (*sse)(std::exp(x[0]), std::exp(x[1]), coarse);
+  };
+  double best_sse = std::numeric_limits<double>::infinity();
   if (warm) {
-    best_freq = std::exp(near->search_state[0]);
-    best_zeta = std::exp(near->search_state[1]);
-    if (in_range(best_freq, best_zeta))
-      best_sse = 0.0;  // only its finiteness is used below: no filter pass needed
-    fgrid.clear();
-  }
-  windowed = w1 - w0 < cx.n;  // the coarse grid and the first round
-  for (double f : fgrid) {
-    for (double z : zgrid) {
-      const double s = sse_for(f, z, coarse);
-      if (s < best_sse) {
-        best_sse = s;
-        best_freq = f;
-        best_zeta = z;
-      }
+    best = {near->search_state[0], near->search_state[1]};
+    if (InRange(cx, std::exp(best[0]), std::exp(best[1]))) best_sse = 0.0;  // no filter pass
+  } else {
+    std::vector<std::vector<double>> points;
+    for (double f : ResonanceGrid(cx, target)) {
+      for (double z : {0.001, 0.003, 0.01, 0.03, 0.1, 0.3})
+        points.push_back({std::log(f), std::log(z)});
     }
+    sse->windowed = sse->w1 - sse->w0 < cx.n;  // the coarse grid and the first round
+    best_sse = BestPoint(on_coarse, points, &best);
   }
-  if (!std::isfinite(best_sse)) return std::nullopt;
-  // Alternate golden refinements in log f and log ζ on the coarse channels (a refit starts near
-  // its optimum: only the finer second round).
-  double log_freq = std::log(best_freq);
-  double log_zeta = std::log(best_zeta);
-  for (int round = warm ? 1 : 0; round < 2; ++round) {
-    const std::vector<int>& chans = coarse;  // all channels only in the final fit
-    if (round == 1) {
-      row_step = std::max(1, row_step / 2);
-      windowed = false;
-    }
-    std::vector<double> g1;
-    for (int j = -2; j <= 2; ++j) g1.push_back(log_freq + 0.04 * j / (round + 1));
-    log_freq = MinimizeOnGrid(
-        [&](double v) { return sse_for(std::exp(v), std::exp(log_zeta), chans); }, g1, 7, nullptr);
-    std::vector<double> g2;
-    for (int j = -2; j <= 2; ++j) g2.push_back(log_zeta + 0.3 * j / (round + 1));
-    log_zeta = MinimizeOnGrid(
-        [&](double v) { return sse_for(std::exp(log_freq), std::exp(v), chans); }, g2, 7, nullptr);
-  }
+  if (!std::isfinite(best_sse)) return false;
+  // A light damping has a narrow optimum in f: the frequency steps shrink with ζ.
+  const double f_step = std::clamp(4.0 * std::exp(best[1]), 0.004, 0.04);
+  const std::vector<LogBounds> bounds = {{std::log(kMinFreqHz), std::log(MaxFreqHz(cx))},
+                                         {std::log(kMinZeta), std::log(kMaxZeta)}};
+  GoldenRounds(
+      on_coarse, bounds, {f_step, 0.3}, warm ? 1 : 0, 2,
+      [&](int round) {
+        if (round != 1) return;
+        sse->row_step = std::max(1, sse->row_step / 2);
+        sse->windowed = false;
+      },
+      &best);
+  log_fz[0] = best[0];
+  log_fz[1] = best[1];
+  return true;
+}
+
+/// The evidence of a finished resonance fit (second: the second mode's words).
+std::string RingingEvidence(const Context& cx, const Series& target, const EffectFit& e,
+                            const std::string& second) {
+  const int c = DominantChannel(cx, e.pred);
+  return Fmt("ringing at %.3g Hz (damping ratio %.3g, Q %.0f) after the %d fast load changes on "
+             "b%d, quiet during slow ramps and holds, r = %.2f",
+             e.params["damped_freq_hz"].get<double>(), e.params["damping_ratio"].get<double>(),
+             0.5 / e.params["damping_ratio"].get<double>(), FastLoadChanges(cx, c), c,
+             RowCorr(cx, target, e.pred, c)) +
+         second;
+}
+
+}  // namespace
+
+std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target,
+                                         const EffectFit* near, bool uncertainty) {
+  // Coarse search on the two channels with the most residual energy, on all rows or (long records)
+  // the window with the most load-step energy; the final fit streams the ringing over every row.
+  const std::vector<int> coarse = StrongestTwo(cx, target);
+  const auto [w0, w1] = CoarseWindow(cx, coarse);
+  OneModeObjective sse{cx, target, w0, w1, false, cx.search_stride, Mat()};
+  double log_fz[2] = {0.0, 0.0};
+  if (!SearchOneMode(cx, target, near, coarse, &sse, log_fz)) return std::nullopt;
   EffectFit e;
   e.name = "resonance";
   e.n_params = cx.nc + 2;
   ChannelFit cf;
-  const double f = std::exp(log_freq);
-  const double z = std::exp(log_zeta);
+  const double f = std::exp(log_fz[0]);
+  const double z = std::exp(log_fz[1]);
   e.train_sse_w = FitRingingAll(cx, target, f, z, &cf, &e.pred);
   e.params["freq_hz"] = f;
   e.params["damping_ratio"] = z;
   e.params["damped_freq_hz"] = f * std::sqrt(std::max(0.0, 1.0 - z * z));
   if (uncertainty) {
-    e.sigma["freq_hz"] =
-        JsonNum(f * CurvatureSigma([&](double v) { return sse_for(std::exp(v), z, all); }, log_freq,
-                                   0.002));
+    const std::vector<int> all = AllChannels(cx);
+    // The curvature step in log f stays inside the optimum's width (about ζ).
+    const double step = std::min(0.002, 0.25 * z);
+    e.sigma["freq_hz"] = JsonNum(
+        f * CurvatureSigma([&](double v) { return sse(std::exp(v), z, all); }, log_fz[0], step));
     e.sigma["damping_ratio"] = JsonNum(
-        z * CurvatureSigma([&](double v) { return sse_for(f, std::exp(v), all); }, log_zeta, 0.02));
+        z * CurvatureSigma([&](double v) { return sse(f, std::exp(v), all); }, log_fz[1], 0.02));
   }
   PutChannelCoef(cx, cf, 0, "participation", &e);
-  h = Mat();
+  sse.h = Mat();
   e.variant = "one mode";
-  e.search_state = {log_freq, log_zeta};
-  const bool near_two = warm && near->search_state.size() >= 4;
+  e.search_state = {log_fz[0], log_fz[1]};
+  const bool near_two = near != nullptr && near->search_state.size() >= 4;
   const std::string second =
       near == nullptr || near_two
           ? AddResonanceMode(cx, target, f, z, &e, near_two ? &near->search_state[2] : nullptr,
                              uncertainty)
           : "";
   e.channels = ActiveChannels(cx, e.pred);
-  const int c = DominantChannel(cx, e.pred);
-  const int fast = FastLoadChanges(cx, c);
-  e.evidence =
-      Fmt("ringing at %.2f Hz (damping ratio %.3f) after the %d fast load changes on b%d, quiet "
-          "during slow ramps and holds, r = %.2f",
-          e.params["damped_freq_hz"].get<double>(), e.params["damping_ratio"].get<double>(), fast,
-          c, RowCorr(cx, target, e.pred, c)) +
-      second;
+  e.evidence = RingingEvidence(cx, target, e, second);
   return e;
 }
 
 namespace {
+
+/// Whether a mode at (log f, log ζ) ended within 2 % of its search's bounds (not resolved).
+bool OnBound(const Context& cx, double log_f, double log_z) {
+  return log_f < std::log(kMinFreqHz) + 0.02 || log_f > std::log(MaxFreqHz(cx)) - 0.02 ||
+         log_z < std::log(kMinZeta) + 0.02 || log_z > std::log(kMaxZeta) - 0.02;
+}
 
 /// Whether two modes are far enough apart to be told apart (more than 15 % in frequency).
 bool Apart(double fa_hz, double fb_hz) { return std::fabs(std::log(fa_hz / fb_hz)) > 0.14; }
@@ -265,11 +304,10 @@ int PutModes(const Context& cx, const ChannelFit& cf, const double* log_freq,
   return 1 - lo;
 }
 
-/// Whether mode (f, ζ) can be searched: below 0.98 × Nyquist, ζ in (1e-4, 2] and apart from the
-/// other mode at other_hz.
+/// Whether mode (f, ζ) can be searched: in range (InRange) and apart from the other mode at
+/// other_hz.
 bool ModeInRange(const Context& cx, double f_hz, double zeta, double other_hz) {
-  return f_hz > 0.05 && f_hz < 0.98 * 0.5 * cx.rate_hz && zeta > 1e-4 && zeta <= 2.0 &&
-         Apart(f_hz, other_hz);
+  return InRange(cx, f_hz, zeta) && Apart(f_hz, other_hz);
 }
 
 /// The two modes' (log f, log ζ) in log_freq, log_zeta (mode 1 given in log_freq[0], log_zeta[0]):
@@ -423,11 +461,12 @@ std::string AddResonanceMode(const Context& cx, const Series& target, double f1_
   const double f2_hz = std::exp(log_freq[1]);
   // Materiality: the weaker mode must carry ≥ 1 % of the ringing's whitened energy (10 % of its
   // amplitude), else a small mismatch of one mode would be named a second one.
-  if (gain <= 0.0 || share < 0.01) {
+  if (gain <= 0.0 || share < 0.01 || OnBound(cx, log_freq[0], log_zeta[0]) ||
+      OnBound(cx, log_freq[1], log_zeta[1])) {
     return Fmt(
         "; a second mode near %.2f Hz was tried and not kept (training BIC %+.1f, share %.1f "
-        "%% of the ringing)",
-        f2_hz, gain, 100.0 * share);
+        "%% of the ringing, damping ratio %.3g)",
+        f2_hz, gain, 100.0 * share, std::exp(log_zeta[1]));
   }
   const int hi = PutModes(cx, cf, log_freq, log_zeta, slf, slz, e);
   e->variant = "two modes";
@@ -452,11 +491,25 @@ std::string AddResonanceMode(const Context& cx, const Series& target, double f1_
 
 namespace ftstack::diag {
 
+namespace {
+
+/// Resonance's physical ranges (those of its search): every mode below Nyquist, lightly damped.
+std::vector<ParamRange> ResonanceRanges(const Context& cx) {
+  const double f_hi = fx::MaxFreqHz(cx);
+  return {{"freq_hz", fx::kMinFreqHz, f_hi, "0.05 Hz", "0.98 × Nyquist"},
+          {"damping_ratio", fx::kMinZeta, fx::kMaxZeta, "Q 500", "a step response that rings"},
+          {"freq2_hz", fx::kMinFreqHz, f_hi, "0.05 Hz", "0.98 × Nyquist"},
+          {"damping_ratio2", fx::kMinZeta, fx::kMaxZeta, "Q 500", "a step response that rings"}};
+}
+
+}  // namespace
+
 EffectSpec ResonancePlugin() {
   return {.kind = EffectKind::kResonance,
           .fit = &fx::FitBy<&fx::ResonanceSearch>,
           .refit = &fx::RefitBy<&fx::ResonanceSearch>,
-          .cost = 8};
+          .cost = 8,
+          .ranges = &ResonanceRanges};
 }
 
 }  // namespace ftstack::diag

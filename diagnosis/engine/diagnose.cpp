@@ -1,6 +1,7 @@
 #include "diagnosis/engine/diagnose.hpp"
 
 #include "diagnosis/engine/identifiability.hpp"
+#include "diagnosis/engine/plausibility.hpp"
 #include "diagnosis/engine/ranking.hpp"
 
 #include <algorithm>
@@ -314,6 +315,21 @@ void RefineClaims(const Context& cx, std::vector<EffectFit>* claimed_effects) {
   }
 }
 
+/// Each claimed fit's parameter spreads across pieces of the record (PieceSpreads), each refitted
+/// to what the other claimed effects leave; pieces that disagree are said in its evidence.
+void SpreadClaims(Context* cx, std::vector<EffectFit>* claimed_effects) {
+  std::vector<EffectFit>& claimed = *claimed_effects;
+  for (std::size_t k = 0; k < claimed.size(); ++k) {
+    Series rest = cx->resid;
+    for (std::size_t o = 0; o < claimed.size(); ++o) {
+      if (o != k) rest -= claimed[o].pred;
+    }
+    PieceSpreads(cx, rest, &claimed[k]);
+    const std::string words = SpreadWords(claimed[k]);
+    if (!words.empty()) claimed[k].evidence += "; the pieces of the record disagree: " + words;
+  }
+}
+
 /// The claimed effects into the report, each with its held-out gain and confounders; the verdict.
 void RecordClaims(Report& r, const DiagnoseOptions& options, std::vector<EffectFit>& claimed,
                   const std::vector<Confounding>& partner_conf) {
@@ -447,6 +463,8 @@ Report DiagnoseWith(Context context, const DiagnoseOptions& options) {
   const std::vector<Confounding> partner_conf =
       DropUnidentifiedPartner(cx, options.z_claim, &claimed, &r.dropped);
   DebugTime("claims", "partner identifiability", t0);
+  SpreadClaims(&r.cx, &claimed);
+  DebugTime("claims", "spreads across pieces", t0);
   RecordClaims(r, options, claimed, partner_conf);
   DebugTime("claims", "claims and confounders", t0);
   LocateByModel(r);

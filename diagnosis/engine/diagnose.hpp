@@ -30,6 +30,7 @@ struct CandidateScore {
   double z = 0.0;               ///< held-out improvement in units of its own standard deviation
   double score = 0.0;           ///< held-out Δχ² minus the parameter penalty
   bool eligible = false;        ///< passed the claim thresholds
+  std::string not_resolved;     ///< why the fit is not resolved (NotResolved), or ""
 };
 
 /// A claimed effect with its fitted model and held-out figures.

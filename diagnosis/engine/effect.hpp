@@ -26,7 +26,25 @@ struct EffectFit {
   double train_sse_w = 0.0;  ///< whitened training SSE after the fit
   /// The nonlinear parameters as the search left them (a RefitFn's start; not reported).
   std::vector<double> search_state;
+  /// Empty when every ranged parameter (EffectSpec::ranges) ended inside its range; else why the
+  /// fit is not resolved (a parameter on a search bound or outside its physical range): such a
+  /// fit is never claimed.
+  std::string not_resolved;
+  /// Per reported parameter, its spread across independent pieces of the record (PieceSpreads).
+  nlohmann::json spread = nlohmann::json::object();
 };
+
+/// A parameter's physical range, which is also its search's bounds: a fit ending within 2 % of a
+/// bound (in log, for positive ranges) or outside it is not resolved.
+struct ParamRange {
+  const char* key = "";  ///< params key: a number, or per-channel numbers (their largest |value|)
+  double lo = 0.0;  ///< lower bound; 0 for per-channel numbers (only |value| ≤ hi is checked)
+  double hi = 0.0;  ///< upper bound
+  const char* lo_what = "";  ///< the lower bound's meaning in words ("3 samples")
+  const char* hi_what = "";  ///< the upper bound's ("a third of the record")
+};
+/// The ranges of an effect's parameters on a context (sample interval, record length, Nyquist).
+using RangesFn = std::vector<ParamRange> (*)(const Context&);
 
 using FitFn = std::optional<EffectFit> (*)(const Context&, const Series& target);
 /// Refits an effect near an earlier fit of the same effect: `near`'s nonlinear parameters start a
@@ -72,6 +90,7 @@ struct EffectSpec {
   RefitFn refit = nullptr;  ///< nullptr: the effect has no costly search; fit() is used
   int cost = 1;  ///< relative cost of a fit: when fits run in parallel, costlier ones start first
   RefineFn refine_claim = nullptr;  ///< nullptr: a claim is reported as ranked
+  RangesFn ranges = nullptr;        ///< nullptr: no stated range (linear parameters only)
   /// The vocabulary's name of `kind` (the report's and the confounders' key).
   const char* name = EffectOf(kind).name.data();
 

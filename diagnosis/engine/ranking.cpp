@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "diagnosis/engine/parallel.hpp"
+#include "diagnosis/engine/plausibility.hpp"
 
 namespace ftstack::diag {
 namespace {
@@ -26,7 +27,10 @@ Scored ScoreFit(const Context& cx, const Series& target, EffectFit fit, double b
   s.delta = base_hold - sums.hold_sse;
   s.z = sums.hold_pp > 0 ? s.delta / (2.0 * std::sqrt(sums.hold_pp)) : 0.0;
   s.score = s.delta - fit.n_params * HoldPenalty(cx);
-  s.eligible = s.z > z_claim && s.score > 0;
+  // A fit on a search bound or outside its physical range is never claimed, however it scores.
+  fit.not_resolved = NotResolved(cx, fit);
+  s.significant = s.z > z_claim && s.score > 0;
+  s.eligible = s.significant && fit.not_resolved.empty();
   s.fit = std::move(fit);
   return s;
 }
@@ -118,9 +122,10 @@ std::vector<std::vector<Partner>> FitPartners(const Context& cx, const DiagnoseO
   std::vector<std::vector<std::size_t>> todo(top.size());  // per start: effects j
   std::size_t total = 0;
   for (std::size_t j : CostOrder(effects)) {
-    // Partners come from the effects that were claimable on their own.
+    // Partners come from the effects that were significant on their own (resolved or not: fitted
+    // to what the start leaves, a partner may resolve; the pair is claimed only if it does).
     const bool claimable = std::any_of(singles.begin(), singles.end(), [&](const Scored& q) {
-      return q.eligible && q.fit.name == effects[j].name;
+      return q.significant && q.fit.name == effects[j].name;
     });
     for (std::size_t t = 0; t < top.size(); ++t) {
       if (claimable && singles[top[t]].fit.name != effects[j].name) {
@@ -204,7 +209,8 @@ std::optional<PairResult> TryPair(const Context& cx, const DiagnoseOptions& opti
                  "pair %s + %s: score %.1f (best single %.1f) z_inc %.1f inc %.1f excess %.1f\n",
                  p.fa.name.c_str(), p.fb.name.c_str(), p.score, best_score, z_inc, inc, excess);
   }
-  p.won = z_inc > options.z_claim && inc > 0.002 * excess;
+  p.won = z_inc > options.z_claim && inc > 0.002 * excess && NotResolved(cx, p.fa).empty() &&
+          NotResolved(cx, p.fb).empty();
   return p;
 }
 
@@ -259,9 +265,13 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
   for (auto& q : slot) {
     if (q) singles.push_back(std::move(*q));
   }
-  // Stable: of equal scores the earlier effect first.
-  std::stable_sort(singles.begin(), singles.end(),
-                   [](const Scored& a, const Scored& b) { return a.score > b.score; });
+  // Stable: of equal scores the earlier effect first; a fit that is not resolved after every
+  // resolved one (it never starts a claim, whatever its score).
+  std::stable_sort(singles.begin(), singles.end(), [](const Scored& a, const Scored& b) {
+    const bool ra = a.fit.not_resolved.empty();
+    const bool rb = b.fit.not_resolved.empty();
+    return ra != rb ? ra : a.score > b.score;
+  });
   for (const auto& s : singles) {
     CandidateScore c;
     c.name = s.fit.name;
@@ -271,6 +281,7 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
     c.z = s.z;
     c.score = s.score;
     c.eligible = s.eligible;
+    c.not_resolved = s.fit.not_resolved;
     r.candidates.push_back(c);
   }
   return singles;

@@ -18,7 +18,8 @@ struct Scored {
   double delta = 0.0;
   double z = 0.0;
   double score = 0.0;
-  bool eligible = false;
+  bool significant = false;     ///< held-out z and score pass the claim thresholds
+  bool eligible = false;        ///< significant and resolved (NotResolved): may be claimed
   double hold_rms_after = 0.0;  ///< held-out RMS after removing the prediction
 
   /// Whether the prediction is held (only the pair starts keep theirs: memory).

@@ -223,30 +223,75 @@ HatBasis MakeHat(const Context& cx, int k) {
   return b;
 }
 
-std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Series& r) {
+namespace {
+
+/// r's Welch spectra (mean or, with `median`, median periodograms) whitened and summed over
+/// channels (empty when r is too short for a spectrum).
+void WhitenedSpectrum(const Context& cx, const Series& r, std::vector<double>* freq,
+                      std::vector<double>* total, bool median = false) {
   const auto rows = static_cast<std::size_t>(cx.n);
   const std::size_t seg = WelchSegment(rows);
-  std::vector<std::pair<double, double>> peaks;
-  if (rows < seg || seg < 32) return peaks;
-  std::vector<double> total;
-  std::vector<double> freq;
+  if (rows < seg || seg < 32) return;
   for (int c = 0; c < cx.nc; ++c) {
     const Vec col = ColD(r, c);
-    const Spectrum s = Welch(col.data(), rows, cx.rate_hz, seg);
-    if (total.empty()) {
-      total.assign(s.power.size(), 0.0);
-      freq = s.freq_hz;
+    const Spectrum s = median ? numerics::WelchMedian(col.data(), rows, cx.rate_hz, seg)
+                              : Welch(col.data(), rows, cx.rate_hz, seg);
+    if (total->empty()) {
+      total->assign(s.power.size(), 0.0);
+      *freq = s.freq_hz;
     }
-    for (std::size_t k = 0; k < s.power.size(); ++k) total[k] += s.power[k] * cx.weight(c);
+    for (std::size_t k = 0; k < s.power.size(); ++k) (*total)[k] += s.power[k] * cx.weight(c);
   }
-  std::vector<double> band(total.begin() + 1, total.end());
-  std::nth_element(band.begin(), band.begin() + static_cast<std::ptrdiff_t>(band.size() / 2),
-                   band.end());
-  const double floor = std::max(band[band.size() / 2], 1e-300);
+}
+
+/// The median of v[lo, hi) without v[skip_lo, skip_hi).
+double MedianOutside(const std::vector<double>& v, std::size_t lo, std::size_t hi,
+                     std::size_t skip_lo, std::size_t skip_hi) {
+  std::vector<double> w;
+  for (std::size_t k = lo; k < hi; ++k) {
+    if (k < skip_lo || k >= skip_hi) w.push_back(v[k]);
+  }
+  if (w.empty()) return 1e-300;
+  std::nth_element(w.begin(), w.begin() + static_cast<std::ptrdiff_t>(w.size() / 2), w.end());
+  return std::max(w[w.size() / 2], 1e-300);
+}
+
+}  // namespace
+
+std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Series& r) {
+  std::vector<double> total;
+  std::vector<double> freq;
+  std::vector<std::pair<double, double>> peaks;
+  WhitenedSpectrum(cx, r, &freq, &total);
+  if (total.size() < 4) return peaks;
+  const double floor = MedianOutside(total, 1, total.size(), 0, 0);
   for (std::size_t k = 3; k + 1 < total.size(); ++k) {
     if (total[k] > total[k - 1] && total[k] >= total[k + 1] && total[k] > 4.0 * floor) {
       peaks.emplace_back(total[k] / floor, freq[k]);
     }
+  }
+  std::sort(peaks.rbegin(), peaks.rend());
+  return peaks;
+}
+
+std::vector<std::pair<double, double>> LocalLines(const Context& cx, const Series& r) {
+  std::vector<double> total;
+  std::vector<double> freq;
+  std::vector<std::pair<double, double>> peaks;
+  WhitenedSpectrum(cx, r, &freq, &total, true);
+  constexpr std::size_t kSide = 16;  // bins each side of the local floor
+  for (std::size_t k = 3; k + 1 < total.size(); ++k) {
+    if (total[k] <= total[k - 1] || total[k] < total[k + 1]) continue;
+    const double floor = MedianOutside(total, k > kSide ? k - kSide : 1,
+                                       std::min(total.size(), k + kSide + 1), k - 2, k + 3);
+    if (total[k] < 8.0 * floor) continue;
+    // The line between bins: the vertex of the parabola through the log powers of k − 1, k, k + 1.
+    const double a = std::log(total[k - 1]);
+    const double b = std::log(total[k]);
+    const double c = std::log(total[k + 1]);
+    const double den = a - 2.0 * b + c;
+    const double shift = den < 0.0 ? std::clamp(0.5 * (a - c) / den, -0.5, 0.5) : 0.0;
+    peaks.emplace_back(total[k] / floor, freq[k] + shift * (freq[k + 1] - freq[k]));
   }
   std::sort(peaks.rbegin(), peaks.rend());
   return peaks;

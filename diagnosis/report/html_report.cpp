@@ -2,6 +2,7 @@
 #include "measurement/wrench.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -68,14 +69,30 @@ std::string Cell(const nlohmann::json& v) {
   return Esc(v.is_string() ? v.get<std::string>() : v.dump());
 }
 
-/// The fitted parameters as a table: name, value, 1-σ uncertainty, unit.
+/// A parameter's spread across pieces of the record: "min … max (σ pieces); disagree", or "—".
+std::string SpreadCell(const EffectFit& f, const std::string& key) {
+  if (!f.spread.contains(key)) return "—";
+  const auto& s = f.spread[key];
+  if (!s.contains("min")) {
+    return std::to_string(s["pieces"].get<int>()) + " resolved piece(s): no spread";
+  }
+  std::string h = Cell(s["min"]) + " … " + Cell(s["max"]) + " (± " + Cell(s["sigma"]) + " from " +
+                  std::to_string(s["pieces"].get<int>()) + " pieces)";
+  if (s["agree"].is_boolean() && !s["agree"].get<bool>()) h += " <b>pieces disagree</b>";
+  return h;
+}
+
+/// The fitted parameters as a table: name, value, 1-σ uncertainty (curvature), the spread across
+/// pieces of the record, unit.
 std::string ParamTable(const EffectFit& f) {
   if (f.params.empty()) return "";
-  std::string h = "<table><tr><th>parameter</th><th>value</th><th>± 1σ</th><th>unit</th></tr>";
+  std::string h =
+      "<table><tr><th>parameter</th><th>value</th><th>± 1σ (curvature)</th><th>across pieces of "
+      "the record: min … max (± σ)</th><th>unit</th></tr>";
   for (const auto& [key, value] : f.params.items()) {
     const std::string sigma = f.sigma.contains(key) ? Cell(f.sigma[key]) : "—";
     h += "<tr><td>" + Esc(key) + "</td><td>" + Cell(value) + "</td><td>" + sigma + "</td><td>" +
-         Esc(UnitOf(key, f.name)) + "</td></tr>";
+         SpreadCell(f, key) + "</td><td>" + Esc(UnitOf(key, f.name)) + "</td></tr>";
   }
   return h + "</table>";
 }
@@ -171,15 +188,9 @@ void Reduce(const PlotSeries& s, double x0, double x1, int cols, std::vector<dou
   flush();
 }
 
-}  // namespace
-
-std::string SvgPlot(const PlotSpec& spec, const std::vector<PlotSeries>& series) {
-  const int ml = 70;
-  const int mr = 20;
-  const int mt = 28;
-  const int mb = 42;
-  const int pw = spec.width - ml - mr;
-  const int ph = spec.height - mt - mb;
+/// The plotted x and y range of `series` (y in log10 for a log plot, padded by 5 %): x0, x1, y0,
+/// y1.
+std::array<double, 4> PlotRange(const PlotSpec& spec, const std::vector<PlotSeries>& series) {
   double x0 = std::numeric_limits<double>::infinity();
   double x1 = -x0;
   double y0 = x0;
@@ -205,6 +216,20 @@ std::string SvgPlot(const PlotSpec& spec, const std::vector<PlotSeries>& series)
   const double pad = 0.05 * (y1 - y0);
   y0 -= pad;
   y1 += pad;
+  return {x0, x1, y0, y1};
+}
+
+}  // namespace
+
+std::string SvgPlot(const PlotSpec& spec, const std::vector<PlotSeries>& series) {
+  const int ml = 70;
+  const int mr = 20;
+  const int mt = 28;
+  const int mb = 42;
+  const int pw = spec.width - ml - mr;
+  const int ph = spec.height - mt - mb;
+  auto ty = [&](double v) { return spec.log_y ? std::log10(std::max(v, 1e-300)) : v; };
+  const auto [x0, x1, y0, y1] = PlotRange(spec, series);
   auto px = [&](double x) { return ml + (x - x0) / (x1 - x0) * pw; };
   auto py = [&](double y) { return mt + (1.0 - (ty(y) - y0) / (y1 - y0)) * ph; };
   auto pyl = [&](double yl) { return mt + (1.0 - (yl - y0) / (y1 - y0)) * ph; };
@@ -382,11 +407,14 @@ std::string HtmlCandidates(const Report& r) {
     h += "<tr><td>" + Esc(cand.name) + "</td><td>" + Esc(cand.variant) + "</td><td>" +
          std::to_string(cand.n_params) + "</td><td>" + Num(cand.hold_rms_after) + "</td><td>" +
          Num(cand.z, "%.1f") + "</td><td>" + Num(cand.score, "%.1f") + "</td><td>" +
-         (cand.eligible ? "yes" : "") + "</td></tr>";
+         (cand.eligible ? "yes" : "") +
+         (cand.not_resolved.empty() ? "" : "not resolved: " + Esc(cand.not_resolved)) +
+         "</td></tr>";
   }
   h += "</table><p>Held-out rows: every third block of " + Num(r.cx.block_s) +
        " s. Score = held-out Δχ² − parameters × ln(held-out samples); an effect is claimed when "
-       "its held-out z &gt; 6 and score &gt; 0.</p>";
+       "its held-out z &gt; 6 and score &gt; 0 and its fit is resolved (no parameter on a search "
+       "bound or outside its physical range).</p>";
   return h;
 }
 

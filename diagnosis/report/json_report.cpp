@@ -32,6 +32,7 @@ nlohmann::json ToJson(const Report& r) {
     ej["channels"] = e.fit.channels;
     ej["params"] = e.fit.params;
     ej["uncertainty"] = e.fit.sigma;
+    if (!e.fit.spread.empty()) ej["spread"] = e.fit.spread;
     if (!e.fit.standard.empty()) ej["standard"] = e.fit.standard;
     ej["evidence"] = e.fit.evidence;
     ej["rms_after"] = vec(e.rms_after);
@@ -64,6 +65,7 @@ nlohmann::json ToJson(const Report& r) {
                      {"z", c.z},
                      {"score", c.score},
                      {"eligible", c.eligible}});
+    if (!c.not_resolved.empty()) cands.back()["not_resolved"] = c.not_resolved;
   }
   j["candidates"] = cands;
   return j;

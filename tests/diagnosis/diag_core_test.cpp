@@ -6,6 +6,7 @@
 
 #include "diagnosis/engine/diagnose.hpp"
 #include "diagnosis/engine/effect.hpp"
+#include "diagnosis/engine/plausibility.hpp"
 #include "diagnosis/engine/signal.hpp"
 #include "diagnosis/filters/lowpass.hpp"
 #include "diagnosis/report/html_report.hpp"
@@ -209,6 +210,61 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"saturation", 5, 14}, Case{"overload_shift", 3, 15},
                       Case{"mains_interference", 2, 16}, Case{"resonance", 4, 17}),
     [](const ::testing::TestParamInfo<Case>& i) { return std::string(i.param.name); });
+
+// A fit on a bound or outside the stated range is not resolved. The bounds in closed form: at
+// 200 Hz creep τ runs from max(3 samples, 0.2 s) = 0.2 s to a third of the record, fractions to 5
+// %.
+TEST(DiagHonesty, FitOnABoundOrOutsideItsRangeIsNotResolved) {
+  const auto fx = testing::MakeFixture({}, 3, 200.0, kNoise, 4.0);
+  const Context cx = MakeContext(fx.data);
+  const double third = (fx.data.t_s.back() - fx.data.t_s.front()) / 3.0;
+  EffectFit f;
+  f.name = "creep";
+  f.params["fraction"] = {0.004, -0.01, 0.0};
+  f.params["tau_s"] = 12.0;
+  EXPECT_EQ(NotResolved(cx, f), "");
+  f.params["tau_s"] = 0.2;
+  EXPECT_NE(NotResolved(cx, f).find("tau_s = 0.2 at its lower bound"), std::string::npos)
+      << NotResolved(cx, f);
+  f.params["tau_s"] = third / 1.01;  // 1 % inside a bound (in log) is still on it
+  EXPECT_NE(NotResolved(cx, f).find("at its upper bound"), std::string::npos);
+  f.params["tau_s"] = 2.0 * third;
+  EXPECT_NE(NotResolved(cx, f).find("above its range"), std::string::npos);
+  f.params["tau_s"] = 12.0;
+  f.params["fraction"] = {0.004, -0.08, 0.0};  // either sign: |fraction| ≤ 5 %
+  EXPECT_NE(NotResolved(cx, f).find("fraction up to 0.08 beyond its range"), std::string::npos);
+  // Resonance: lightly damped down to ζ = 1e-3, below 0.98 × Nyquist (98 Hz here).
+  EffectFit r;
+  r.name = "resonance";
+  r.params["freq_hz"] = 12.0;
+  r.params["damping_ratio"] = 0.002;
+  EXPECT_EQ(NotResolved(cx, r), "");
+  r.params["damping_ratio"] = 0.5;
+  EXPECT_NE(NotResolved(cx, r).find("at its upper bound"), std::string::npos);
+  r.params["damping_ratio"] = 0.05;
+  r.params["freq_hz"] = 99.0;
+  EXPECT_NE(NotResolved(cx, r).find("above its range"), std::string::npos);
+}
+
+// The spread across pieces of the record covers the truth on data the creep model describes, and
+// the pieces agree with the curvature σ; the JSON report carries it next to the σ.
+TEST(DiagHonesty, CreepSpreadAcrossPiecesCoversTheTruth) {
+  const auto fx = testing::MakeFixture({{"creep", 6}}, 6, 200.0, kNoise, 4.0);
+  const Report r = Diagnose(fx.data);
+  ASSERT_EQ(r.verdict, "creep");
+  const auto& e = r.effects.front().fit;
+  ASSERT_TRUE(e.spread.contains("tau_s")) << e.spread.dump();
+  const auto& s = e.spread["tau_s"];
+  EXPECT_GE(s["pieces"].get<int>(), 3) << s.dump();
+  const double larger = s["larger"].get<double>();
+  EXPECT_GE(larger, e.sigma["tau_s"].get<double>());
+  EXPECT_LE(s["min"].get<double>(), s["max"].get<double>());
+  EXPECT_NEAR(e.params["tau_s"].get<double>(), fx.truth, 3.0 * larger + 0.05 * fx.truth);
+  EXPECT_LE(s["min"].get<double>(), fx.truth * 1.2) << s.dump();
+  EXPECT_GE(s["max"].get<double>(), fx.truth * 0.8) << s.dump();
+  EXPECT_TRUE(s["agree"].get<bool>()) << s.dump();
+  EXPECT_EQ(ToJson(r)["effects"][0]["spread"]["tau_s"], s);
+}
 
 TEST(DiagFixtureNone, NoiseOnlyMakesNoClaim) {
   for (unsigned seed : {21u, 22u}) {

@@ -89,7 +89,7 @@ TEST(DiagShapes, LaggingThermometerIsThermalZeroDriftWithTheLag) {
       WriteHtml(html, d, r);
       std::ifstream in(html);
       const std::string text((std::istreambuf_iterator<char>(in)), {});
-      EXPECT_NE(text.find("<th>± 1σ</th><th>unit</th>"), std::string::npos);
+      EXPECT_NE(text.find("<th>± 1σ (curvature)</th>"), std::string::npos);
       EXPECT_NE(text.find("<tr><td>lag_s</td>"), std::string::npos);
       EXPECT_NE(text.find("mV/V per K"), std::string::npos);
       if (test::HaveChromium()) {

@@ -1,0 +1,169 @@
+#include "diagnosis/engine/plausibility.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "diagnosis/engine/separable_fit.hpp"
+
+namespace ftstack::diag {
+
+using fx::Fmt;
+
+namespace {
+
+/// Closeness to a bound that counts as "on" it: 2 % in log (positive ranges) or of the range.
+constexpr double kOnBound = 0.02;
+
+/// Why one scalar value is not resolved against range r, or "".
+std::string ScalarWords(const ParamRange& r, double v) {
+  if (!std::isfinite(v)) return Fmt("%s is not finite", r.key);
+  const bool log_scale = r.lo > 0.0 && v > 0.0;
+  const double below = log_scale ? std::log(v / r.lo) : (v - r.lo) / (r.hi - r.lo);
+  const double above = log_scale ? std::log(r.hi / v) : (r.hi - v) / (r.hi - r.lo);
+  if (below < 0.0) return Fmt("%s = %.4g below its range (%s, %.4g)", r.key, v, r.lo_what, r.lo);
+  if (above < 0.0) return Fmt("%s = %.4g above its range (%s, %.4g)", r.key, v, r.hi_what, r.hi);
+  if (below < kOnBound) {
+    return Fmt("%s = %.4g at its lower bound (%s, %.4g)", r.key, v, r.lo_what, r.lo);
+  }
+  if (above < kOnBound) {
+    return Fmt("%s = %.4g at its upper bound (%s, %.4g)", r.key, v, r.hi_what, r.hi);
+  }
+  return "";
+}
+
+/// The values of a parameter (one, or one per channel) as doubles; empty when not numbers.
+std::vector<double> Values(const nlohmann::json& v) {
+  std::vector<double> out;
+  if (v.is_number()) out.push_back(v.get<double>());
+  if (v.is_array()) {
+    for (const auto& x : v) {
+      if (!x.is_number()) return {};
+      out.push_back(x.get<double>());
+    }
+  }
+  return out;
+}
+
+/// Restricts cx's training rows to the piece [t_lo, t_hi) of the record (and back: `train`).
+void SelectPiece(Context* cx, const std::vector<std::uint8_t>& train, double t_lo, double t_hi) {
+  const auto& t = cx->data->t_s;
+  cx->n_train = 0;
+  for (int i = 0; i < cx->n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    cx->train[k] = train[k] != 0 && t[k] >= t_lo && t[k] < t_hi ? 1 : 0;
+    cx->n_train += cx->train[k];
+  }
+}
+
+/// The spread of one parameter from its per-piece values (piece × element) and curvature σ.
+nlohmann::json OneSpread(const std::vector<std::vector<double>>& pieces,
+                         const nlohmann::json& sigma) {
+  const std::vector<double> curv = Values(sigma);
+  const std::size_t m = pieces.size();
+  const std::size_t dim = pieces.front().size();
+  nlohmann::json lo = nlohmann::json::array();
+  nlohmann::json hi = nlohmann::json::array();
+  nlohmann::json sd = nlohmann::json::array();
+  nlohmann::json larger = nlohmann::json::array();
+  bool agree = true;
+  for (std::size_t e = 0; e < dim; ++e) {
+    double mn = std::numeric_limits<double>::infinity();
+    double mx = -mn;
+    double sum = 0.0;
+    for (const auto& p : pieces) {
+      mn = std::min(mn, p[e]);
+      mx = std::max(mx, p[e]);
+      sum += p[e];
+    }
+    const double mean = sum / static_cast<double>(m);
+    double ss = 0.0;
+    for (const auto& p : pieces) ss += (p[e] - mean) * (p[e] - mean);
+    const double sd_piece = std::sqrt(ss / static_cast<double>(m - 1));
+    const double s_whole = sd_piece / std::sqrt(static_cast<double>(m));
+    const double c = e < curv.size() ? curv[e] : std::numeric_limits<double>::quiet_NaN();
+    if (std::isfinite(c) && sd_piece > 3.0 * std::sqrt(static_cast<double>(m)) * c) agree = false;
+    lo.push_back(mn);
+    hi.push_back(mx);
+    sd.push_back(s_whole);
+    larger.push_back(std::isfinite(c) ? std::max(c, s_whole) : s_whole);
+  }
+  const auto flat = [dim](nlohmann::json a) { return dim == 1 ? a[0] : a; };
+  return {{"pieces", m},       {"min", flat(lo)},        {"max", flat(hi)},
+          {"sigma", flat(sd)}, {"larger", flat(larger)}, {"agree", agree}};
+}
+
+}  // namespace
+
+std::string NotResolved(const Context& cx, const EffectFit& fit) {
+  const EffectSpec* spec = FindEffect(fit.name);
+  if (spec == nullptr || spec->ranges == nullptr) return "";
+  for (const ParamRange& r : spec->ranges(cx)) {
+    if (!fit.params.contains(r.key)) continue;
+    const std::vector<double> v = Values(fit.params[r.key]);
+    if (v.size() == 1 && fit.params[r.key].is_number()) {
+      std::string words = ScalarWords(r, v[0]);
+      if (!words.empty()) return words;
+      continue;
+    }
+    double largest = 0.0;
+    for (double x : v) largest = std::max(largest, std::fabs(x));
+    if (largest > r.hi) {
+      return Fmt("%s up to %.4g beyond its range (%s, %.4g)", r.key, largest, r.hi_what, r.hi);
+    }
+  }
+  return "";
+}
+
+void PieceSpreads(Context* cx, const Series& target, EffectFit* fit) {
+  const EffectSpec* spec = FindEffect(fit->name);
+  if (spec == nullptr || fit->sigma.empty()) return;
+  const std::vector<std::uint8_t> train = cx->train;
+  const std::size_t n_train = cx->n_train;
+  const auto& t = cx->data->t_s;
+  const double span = (t.back() - t.front()) / kSpreadPieces;
+  std::vector<std::pair<std::string, std::vector<std::vector<double>>>> values;
+  for (auto it = fit->sigma.begin(); it != fit->sigma.end(); ++it) values.push_back({it.key(), {}});
+  int unresolved = 0;
+  for (int p = 0; p < kSpreadPieces; ++p) {
+    const double t_lo = t.front() + span * p;
+    SelectPiece(cx, train, t_lo, p + 1 == kSpreadPieces ? t.back() + 1.0 : t_lo + span);
+    std::optional<EffectFit> piece = FitNear(*spec, *cx, target, fit, false);
+    if (!piece || !NotResolved(*cx, *piece).empty()) {
+      ++unresolved;
+      continue;
+    }
+    for (auto& [key, per_piece] : values) {
+      if (piece->params.contains(key)) per_piece.push_back(Values(piece->params[key]));
+    }
+  }
+  cx->train = train;
+  cx->n_train = n_train;
+  for (auto& [key, per_piece] : values) {
+    const std::vector<double> whole = Values(fit->params[key]);
+    std::erase_if(per_piece, [&](const auto& v) { return v.size() != whole.size() || v.empty(); });
+    nlohmann::json s = {{"pieces", per_piece.size()}, {"agree", nullptr}};
+    if (per_piece.size() >= 2) s = OneSpread(per_piece, fit->sigma[key]);
+    s["unresolved_pieces"] = unresolved;
+    fit->spread[key] = s;
+  }
+}
+
+std::string SpreadWords(const EffectFit& fit) {
+  std::string out;
+  for (auto it = fit.spread.begin(); it != fit.spread.end(); ++it) {
+    const auto& s = it.value();
+    if (!s.contains("agree") || !s["agree"].is_boolean() || s["agree"].get<bool>()) continue;
+    if (!s["min"].is_number()) continue;
+    out += Fmt("%s%s per piece %.4g–%.4g", out.empty() ? "" : "; ", it.key().c_str(),
+               s["min"].get<double>(), s["max"].get<double>());
+  }
+  return out;
+}
+
+}  // namespace ftstack::diag

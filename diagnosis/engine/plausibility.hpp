@@ -1,0 +1,32 @@
+// The honesty of a fit: whether its nonlinear parameters are resolved (inside their stated range,
+// off the search bounds) and how far they move across independent pieces of the record.
+#pragma once
+
+#include <string>
+
+#include "diagnosis/engine/context.hpp"
+#include "diagnosis/engine/effect.hpp"
+
+namespace ftstack::diag {
+
+/// Why `fit` is not resolved ("tau_s = 0.30 s at its lower bound (3 samples)"), or "" when every
+/// ranged parameter of its plug-in lies inside its range, more than 2 % (in log) from each bound.
+[[nodiscard]] std::string NotResolved(const Context& cx, const EffectFit& fit);
+
+/// Number of independent pieces PieceSpreads refits on.
+inline constexpr int kSpreadPieces = 4;
+
+/// Refits `fit` (near itself, on `target`) once per piece of the record: kSpreadPieces
+/// consecutive spans of equal length, each fit reading only its span's training rows. For every
+/// parameter with a σ, fit->spread[key] = {"pieces", "min", "max" (per channel for per-channel
+/// parameters), "sigma" (the pieces' standard deviation / √pieces: the spread σ of the whole
+/// record's estimate), "larger" (max of that and the curvature σ), "agree"} — "agree" false when
+/// the pieces scatter over 3 × what the curvature σ allows (√pieces σ per piece). A piece whose
+/// refit fails or is not resolved is left out and counted in "unresolved_pieces". cx's hold-out
+/// mask is restored before returning.
+void PieceSpreads(Context* cx, const Series& target, EffectFit* fit);
+
+/// "τ per piece 28–95 s"-style words for a fit's spreads that disagree, or "".
+[[nodiscard]] std::string SpreadWords(const EffectFit& fit);
+
+}  // namespace ftstack::diag
