@@ -360,10 +360,11 @@ std::string HtmlPlots(const DiagData& data, const Report& r) {
     if (t.excluded) p1.excluded.emplace_back(t.excluded_from_s, t.excluded_to_s);
   }
   for (const Glitch& g : cx.conditioning.glitches) p1.marks.push_back(g.t_s);
+  h += "<h2>Residual against time</h2>";
   if (!p1.excluded.empty() || !p1.marks.empty()) {
-    p1.title += "; blue: load transitions kept out of the fits; red: converter glitches";
+    h += "<p>Blue bands: load transitions kept out of the fits; red lines: converter glitches.</p>";
   }
-  h += "<h2>Residual against time</h2>" + SvgPlot(p1, {res, model});
+  h += SvgPlot(p1, {res, model});
   PlotSpec p2 = p1;
   p2.title = "Before (grey) and after removing the model (blue), b" + std::to_string(c);
   p2.spans.clear();
@@ -430,11 +431,12 @@ std::string HtmlConditioning(const DiagData& data, const Report& r) {
     lagging += t.excluded ? 1 : 0;
     if (t.excluded) app_max = std::max(app_max, t.application_s);
   }
-  h += "<p>Load transitions: " + std::to_string(k.transitions.size()) + ", of which " +
-       std::to_string(lagging) + " lag the reference (real load applied over up to " +
-       Num(app_max, "%.2g") +
-       " s): their rows are <b>excluded</b> from every fit and hold-out score (" +
-       std::to_string(k.excluded_rows) + " rows in all, with the glitches).</p>";
+  h += "<p>Load transitions measured: " + std::to_string(k.transitions.size()) + "; " +
+       std::to_string(lagging) + " lag the reference" +
+       (lagging > 0 ? " (real load applied over up to " + Num(app_max, "%.2g") +
+                          " s): their rows are <b>excluded</b> from every fit and hold-out score"
+                    : std::string()) +
+       ". Rows excluded with the glitches: " + std::to_string(k.excluded_rows) + ".</p>";
   if (!k.glitches.empty()) {
     h += "<h2>" + Esc(std::string(EffectOf(EffectKind::kConverterGlitch).name)) + "</h2><p>" +
          std::to_string(k.glitches.size()) +
