@@ -29,6 +29,7 @@ enum class EffectKind {
   kOverloadShift,
   kMainsInterference,
   kResonance,
+  kConverterGlitch,
 };
 
 /// How a parameter's value is written in `--effect NAME:key=value`.
@@ -139,10 +140,15 @@ inline constexpr std::array kResonance = {
     P{"participation2", T::kNumber, "",
       "mode 2's share of the output, per channel (two-mode variant)", kReported, ""},
     kChannels};
+inline constexpr std::array kConverterGlitch = {
+    P{"count", T::kNumber, "", "isolated wrong codes (report: how many were found)", kBoth, ""},
+    P{"offset_mvv", T::kNumber, "mV/V", "each wrong code's distance from the true value", kInjected,
+      ""},
+    P{"times_s", T::kList, "s", "time of every wrong code found", kReported, ""}, kChannels};
 }  // namespace vocabulary_detail
 
 /// The vocabulary, in EffectKind order.
-inline constexpr std::array<EffectDef, 18> kEffectVocabulary = {{
+inline constexpr std::array<EffectDef, 19> kEffectVocabulary = {{
     {"none", EffectKind::kNone, vocabulary_detail::kNone},
     {"zero_offset", EffectKind::kZeroOffset, vocabulary_detail::kZeroOffset},
     {"zero_drift", EffectKind::kZeroDrift, vocabulary_detail::kZeroDrift},
@@ -163,6 +169,7 @@ inline constexpr std::array<EffectDef, 18> kEffectVocabulary = {{
     {"overload_shift", EffectKind::kOverloadShift, vocabulary_detail::kOverloadShift},
     {"mains_interference", EffectKind::kMainsInterference, vocabulary_detail::kMainsInterference},
     {"resonance", EffectKind::kResonance, vocabulary_detail::kResonance},
+    {"converter_glitch", EffectKind::kConverterGlitch, vocabulary_detail::kConverterGlitch},
 }};
 
 /// The entry of `kind` (the table is in kind order; checked at compile time in the source).

@@ -370,6 +370,18 @@ void ResolveLoadSide(const EffectSpec& s, const EffectContext& ctx, SeededRandom
       e.num["amplitude_mvv"] = NumOr(s, "amplitude_mvv", 2.5e-4);
       e.num["phase_deg"] = NumOr(s, "phase_deg", 0.0);
       break;
+    case EffectKind::kConverterGlitch: {
+      e.channels = ChannelsOr(s, n, {});
+      const double count = NumOr(s, "count", 5.0);
+      if (!(count >= 1.0) || count > 1e6 || count != std::floor(count)) {
+        Range(s, "count must be a whole number of wrong codes, 1 … 1e6");
+      }
+      e.num["count"] = count;
+      // Default: about 10^5 codes of a 24-bit converter at gain 128 (an HX711 bit error).
+      e.num["offset_mvv"] = NumOr(s, "offset_mvv", 0.05);
+      if (!(std::fabs(e.num["offset_mvv"]) > 0.0)) Range(s, "offset_mvv must be non-zero");
+      break;
+    }
     case EffectKind::kResonance:
       e.channels = ChannelsOr(s, n, {});
       e.num["freq_hz"] = positive("freq_hz", NumOr(s, "freq_hz", 25.0));

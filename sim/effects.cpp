@@ -197,6 +197,26 @@ void AdditiveEffects(const std::vector<Effect>& effects, const ComposeInput& in,
   }
 }
 
+/// `count` wrong codes at seeded rows (never the first or last two, at least five rows apart),
+/// each on one of the effect's channels, ± offset_mvv with a seeded sign.
+void AddConverterGlitches(const Effect& e, Eigen::MatrixXd& out) {
+  const auto ns = static_cast<int>(out.cols());
+  const auto count = static_cast<int>(e.num.at("count"));
+  if (ns < 5 || e.channels.empty()) return;
+  SeededRandom rng(e.seed ^ 0x6C62272E07BB0142ULL);
+  std::vector<int> rows;
+  for (int tries = 0; static_cast<int>(rows.size()) < count && tries < 100 * count; ++tries) {
+    const int row = 2 + rng.Index(ns - 4);
+    const bool near =
+        std::any_of(rows.begin(), rows.end(), [row](int r) { return std::abs(r - row) < 5; });
+    if (near) continue;
+    rows.push_back(row);
+    const int ch =
+        e.channels[static_cast<std::size_t>(rng.Index(static_cast<int>(e.channels.size())))];
+    out(ch, row) += (rng.Uniform() < 0.5 ? -1.0 : 1.0) * e.num.at("offset_mvv");
+  }
+}
+
 }  // namespace
 
 std::vector<double> Wander(const std::vector<double>& t_s, double amplitude, double corner_hz,
@@ -273,6 +293,10 @@ Eigen::MatrixXd Compose(const std::vector<Effect>& effects, const ComposeInput& 
       const double lim = e.num.at("limit");
       for (const int ch : e.channels) out.row(ch) = out.row(ch).cwiseMax(-lim).cwiseMin(lim);
     }
+  }
+  // 7. Isolated wrong codes of the converter: after everything the analogue side does.
+  for (const auto& e : effects) {
+    if (e.kind == EffectKind::kConverterGlitch) AddConverterGlitches(e, out);
   }
   return out;
 }

@@ -24,7 +24,8 @@ namespace ftstack::diag {
   X(Saturation)                    \
   X(OverloadShift)                 \
   X(MainsInterference)             \
-  X(Resonance)
+  X(Resonance)                     \
+  X(ConverterGlitch)
 
 #define FTSTACK_DECLARE_PLUGIN(Family) EffectSpec Family##Plugin();
 FTSTACK_EFFECT_FAMILIES(FTSTACK_DECLARE_PLUGIN)

@@ -39,13 +39,15 @@ bool UniformClock(const DiagData& d, double dt) {
 }
 
 /// The robust noise per channel (or the given one) and its weights.
-void EstimateNoise(Context& cx, const Mat& sim, const Eigen::VectorXd* sigma) {
+void EstimateNoise(Context& cx, const Eigen::VectorXd* sigma) {
   cx.sigma.resize(cx.nc);
   cx.weight.resize(cx.nc);
   for (int c = 0; c < cx.nc; ++c) {
     double s = RobustNoise(ColD(cx.resid, c).data(), static_cast<std::size_t>(cx.n), cx.rate_hz);
     // Floor: a tiny fraction of the channel's signal scale, so identical files do not divide by 0.
-    const double scale = std::max(1e-9, sim.col(c).cwiseAbs().maxCoeff() * 1e-9);
+    const double peak = std::max(std::fabs(cx.load.col(c).maxCoeff() + cx.zero(c)),
+                                 std::fabs(cx.load.col(c).minCoeff() + cx.zero(c)));
+    const double scale = std::max(1e-9, peak * 1e-9);
     s = std::max(s, scale);
     if (sigma != nullptr) s = (*sigma)(c);
     cx.sigma(c) = s;
@@ -139,9 +141,10 @@ Context Build(const DiagData& d, Series resid, Mat sim, double block_s,
   cx.rate_hz = d.rate_hz();
   cx.dt = 1.0 / cx.rate_hz;
   cx.uniform = UniformClock(d, cx.dt);
-  EstimateNoise(cx, sim, sigma);
   SplitHoldOut(cx, d, block_s);
   SplitSim(cx, d, std::move(sim));
+  ConditionData(&cx);
+  EstimateNoise(cx, sigma);
   SetTemperature(cx, d);
   FindSpectralLines(cx);
   return cx;
@@ -185,7 +188,7 @@ Sums ScoreWith(const Context& cx, const Series& target, P pred) {
       const double e = static_cast<double>(target(i, c)) - p;
       if (cx.train[static_cast<std::size_t>(i)]) {
         tr += e * e;
-      } else {
+      } else if (cx.held_out(static_cast<std::size_t>(i))) {
         ho += e * e;
         pp += p * p;
       }

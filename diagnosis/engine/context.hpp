@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "diagnosis/engine/conditioning.hpp"
 #include "diagnosis/engine/data.hpp"
 
 namespace ftstack::diag {
@@ -24,7 +25,11 @@ struct Context {
   Series resid;                     ///< n × N real − sim, mV/V
   Eigen::VectorXd sigma;            ///< robust noise per channel, mV/V
   Eigen::VectorXd weight;           ///< 1/σ² per channel
-  std::vector<std::uint8_t> train;  ///< 1 = row used for fitting, 0 = held out
+  std::vector<std::uint8_t> train;  ///< 1 = row used for fitting, 0 = held out (or excluded)
+  /// 1 = row kept out of every fit and every hold-out score (a converter glitch, a load transition
+  /// the real load lagged: conditioning.hpp); empty when none is.
+  std::vector<std::uint8_t> excluded;
+  Conditioning conditioning;  ///< glitches, transitions and quiet noise found before the fits
   std::size_t n_train = 0;
   std::size_t n_hold = 0;
   double block_s = 0.0;        ///< length of the interleaved hold-out blocks
@@ -44,6 +49,11 @@ struct Context {
   int segments = 1;             ///< number of joined recordings
   std::vector<double> peak_hz;  ///< prominent lines of the residual spectrum, strongest first
   std::vector<double> peak_ratio;
+
+  /// Whether row i is a held-out row (not trained on, not excluded).
+  [[nodiscard]] bool held_out(std::size_t i) const {
+    return train[i] == 0 && (excluded.empty() || excluded[i] == 0);
+  }
 
   /// The sim's output of row i, channel c, mV/V (load + zero: the data's sim_mvv may be released).
   [[nodiscard]] double sim_mvv(int i, int c) const { return load(i, c) + zero(c); }

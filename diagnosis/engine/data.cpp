@@ -27,8 +27,22 @@ void Relay(std::size_t done, std::size_t total, void* user) {
 
 /// Converts `rec`'s bridge columns from their declared unit to mV/V, refusing values outside the
 /// declared converter's codes or, undeclared, outside the assumed converter (±3.90625 mV/V).
-std::string ToMvv(Recording* rec, bool check_assumed) {
+/// The declared unit's symbol and its values per mV/V (0 when the scale is not known).
+void UnitScale(const InputUnit& u, std::string* symbol, double* per_mvv) {
+  *symbol = ToString(u.unit);
+  *per_mvv = 1.0;
+  if (u.unit == BridgeUnit::kCounts) {
+    const double mvv_per_count = MvvPerCount(u.converter, u.excitation_v);
+    *per_mvv = mvv_per_count > 0 ? 1.0 / mvv_per_count : 0.0;
+  } else if (u.unit == BridgeUnit::kVolts) {
+    *per_mvv = u.excitation_v * 1e-3;
+  }
+}
+
+std::string ToMvv(Recording* rec, bool check_assumed, std::string* symbol = nullptr,
+                  double* per_mvv = nullptr) {
   const InputUnit u = ResolveInputUnit(*rec);
+  if (symbol != nullptr && per_mvv != nullptr) UnitScale(u, symbol, per_mvv);
   const std::size_t n = rec->BridgeCount();
   ValueRange r;
   r.unit = ToString(u.unit);
@@ -48,7 +62,7 @@ std::string ToMvv(Recording* rec, bool check_assumed) {
   return Describe(u);
 }
 
-Recording Read(const std::string& path, ProgressRelay* relay, std::string* unit,
+Recording Read(const std::string& path, ProgressRelay* relay, DiagData* unit_of,
                bool check_assumed) {
   ReadOptions opt;
   opt.required = {"t"};
@@ -58,7 +72,12 @@ Recording Read(const std::string& path, ProgressRelay* relay, std::string* unit,
     opt.progress_user = relay;
   }
   Recording rec = ReadRecording(path, opt);
-  *unit = ToMvv(&rec, check_assumed);
+  if (unit_of != nullptr) {
+    unit_of->real_unit =
+        ToMvv(&rec, check_assumed, &unit_of->real_unit_symbol, &unit_of->real_units_per_mvv);
+  } else {
+    (void)ToMvv(&rec, check_assumed);
+  }
   return rec;
 }
 
@@ -190,18 +209,19 @@ DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path, 
   ProgressRelay r1{progress, user, 0.0, 0.5, "reading sim"};
   ProgressRelay r2{progress, user, 0.5, 0.5, "reading real"};
   try {
-    std::string sim_unit;
-    std::string real_unit;
+    DiagData units;
     // Memory: the sim's bridges are copied and released before the real file is read, and the
     // real's once copied; the peak is about one recording plus the diagnosis data.
-    Recording sim = Read(sim_path, &r1, &sim_unit, false);
+    Recording sim = Read(sim_path, &r1, nullptr, false);
     const std::size_t ns = sim.BridgeCount();
     Eigen::MatrixXd sim_mvv = Bridges(sim, ns);
     ReleaseBridges(&sim, ns);
     std::vector<std::size_t>().swap(sim.data_lines);
-    Recording real = Read(real_path, &r2, &real_unit, true);
+    Recording real = Read(real_path, &r2, &units, true);
     DiagData d = Assemble(sim, ns, std::move(sim_mvv), real, &real);
-    d.real_unit = real_unit;
+    d.real_unit = units.real_unit;
+    d.real_unit_symbol = units.real_unit_symbol;
+    d.real_units_per_mvv = units.real_units_per_mvv;
     return d;
   } catch (const RecordingError& e) {
     throw DiagInputError(e.what());
@@ -214,6 +234,8 @@ DiagData LoadPredictedReal(const std::string& real_path, const std::string& mode
   ProgressRelay r1{progress, user, 0.0, 0.8, "reading real"};
   Recording real;
   std::string unit;
+  std::string symbol;
+  double per_mvv = 1.0;
   try {
     ReadOptions opt;
     opt.required = {"t"};
@@ -224,7 +246,7 @@ DiagData LoadPredictedReal(const std::string& real_path, const std::string& mode
       opt.progress_user = &r1;
     }
     real = ReadRecording(real_path, opt);
-    unit = ToMvv(&real, true);
+    unit = ToMvv(&real, true, &symbol, &per_mvv);
   } catch (const RecordingError& e) {
     throw DiagInputError(e.what());
   }
@@ -238,6 +260,8 @@ DiagData LoadPredictedReal(const std::string& real_path, const std::string& mode
   d.sim_name = model_name;
   d.real_name = real_path;
   d.real_unit = unit;
+  d.real_unit_symbol = symbol;
+  d.real_units_per_mvv = per_mvv;
   d.t_s = real.Column("t");
   d.real_mvv = Bridges(real, nr);
   d.wrench = WrenchOf(real);

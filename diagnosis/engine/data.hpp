@@ -37,6 +37,8 @@ struct DiagData {
   /// periods. Empty: one recording.
   std::vector<int> segment;
   std::string real_unit = "mV/V";  ///< the real file's declared bridge unit (converted to mV/V)
+  std::string real_unit_symbol = "mV/V";  ///< that unit's symbol: mV/V, V or counts
+  double real_units_per_mvv = 1.0;  ///< the declared unit's values per mV/V (0: scale unknown)
   /// Bridges whose sim_mvv and real_mvv became a context's load and residual
   /// (MakeContext(DiagData*), which leaves both matrices empty to save their memory); 0 while they
   /// are held here.

@@ -223,7 +223,7 @@ void LocateByModel(Report& r) {
     double delta = 0.0;
     double pp = 0.0;
     for (int i = 0; i < cx.n; ++i) {
-      if (cx.train[static_cast<std::size_t>(i)]) continue;
+      if (!cx.held_out(static_cast<std::size_t>(i))) continue;
       const double e = cx.resid(i, c);
       const double m = r.model(i, c);
       delta += (e * e - (e - m) * (e - m)) * cx.weight(c);

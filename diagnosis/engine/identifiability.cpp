@@ -240,7 +240,7 @@ double JointBeyond(const Context& cx, const Series& target, const EffectFit& fit
   for (int c = 0; c < cx.nc; ++c) {
     double pp = 0.0;
     for (int i = 0; i < cx.n; ++i) {
-      if (cx.train[static_cast<std::size_t>(i)]) continue;
+      if (!cx.held_out(static_cast<std::size_t>(i))) continue;
       const double p = static_cast<double>(conf(i, c)) + eff(i, c) - alone(i, c);
       pp += p * p;
     }

@@ -194,7 +194,7 @@ std::optional<PairResult> TryPair(const Context& cx, const DiagnoseOptions& opti
   double dd = 0.0;
   for (int c = 0; c < cx.nc; ++c) {
     for (int i = 0; i < cx.n; ++i) {
-      if (cx.train[static_cast<std::size_t>(i)]) continue;
+      if (!cx.held_out(static_cast<std::size_t>(i))) continue;
       const double diff = (static_cast<double>(p.fa.pred(i, c)) + p.fb.pred(i, c)) -
                           static_cast<double>(first.fit.pred(i, c));
       dd += diff * diff * cx.weight(c);
@@ -220,7 +220,7 @@ double HoldRms(const Context& cx, const Series& target, const Series* pred) {
   double s = 0.0;
   for (int c = 0; c < cx.nc; ++c) {
     for (int i = 0; i < cx.n; ++i) {
-      if (cx.train[static_cast<std::size_t>(i)]) continue;
+      if (!cx.held_out(static_cast<std::size_t>(i))) continue;
       const double e = static_cast<double>(target(i, c)) - (pred != nullptr ? (*pred)(i, c) : 0.0);
       s += e * e;
     }

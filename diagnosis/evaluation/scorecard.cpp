@@ -222,6 +222,23 @@ void Judge(const sim::RecordResult& rec, const Report& r, const sim::Effect& t,
   if (check->gates_location) out->located = out->located && out->param_ok;
 }
 
+/// Wrong codes are found by the conditioning, not claimed as a model: right when every injected
+/// one is found on an injected channel and no effect is claimed from them.
+void JudgeGlitches(const sim::Effect& t, const Report& r, ScoreResult* out) {
+  const auto& found = r.cx.conditioning.glitches;
+  const double want = t.num.at("count");
+  out->named_right = r.effects.empty() && !found.empty();
+  out->located = std::all_of(found.begin(), found.end(), [&t](const Glitch& g) {
+    return std::find(t.channels.begin(), t.channels.end(), g.channel) != t.channels.end();
+  });
+  out->param = "count";
+  out->param_error = RelErr(static_cast<double>(found.size()), want);
+  out->param_ok = out->param_error == 0.0;
+  out->detected = out->named_right && out->param_ok;
+  // Found wrong codes are excluded rows, not a model: the held-out rows keep none of their excess.
+  out->excess_removed = out->detected ? 1.0 : 0.0;
+}
+
 }  // namespace
 
 std::vector<ScoreCase> StandardCases(int seeds, double duration_s) {
@@ -280,6 +297,10 @@ ScoreResult RunCase(const ScoreCase& c) {
     out.named_right = out.detected;
     out.located = r.mismatch_channels.empty();
     out.excess_removed = 1.0;
+    return out;
+  }
+  if (rec.effects.size() == 1 && rec.effects.front().kind == EffectKind::kConverterGlitch) {
+    JudgeGlitches(rec.effects.front(), r, &out);
     return out;
   }
   out.detected = true;

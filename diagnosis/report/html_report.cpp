@@ -1,4 +1,5 @@
 #include "diagnosis/report/html_report.hpp"
+#include "measurement/effect_vocabulary.hpp"
 #include "measurement/wrench.hpp"
 
 #include <algorithm>
@@ -188,6 +189,27 @@ void Reduce(const PlotSeries& s, double x0, double x1, int cols, std::vector<dou
   flush();
 }
 
+/// The excluded ranges (blue bands) and the marks (red lines) of a plot area [top, top + height].
+template <class Px>
+std::string SvgMarks(const PlotSpec& spec, Px px, double x0, double x1, int top, int height) {
+  std::string o;
+  for (const auto& [a, b] : spec.excluded) {
+    if (b < x0 || a > x1) continue;
+    const double xa = px(std::max(a, x0));
+    const double xb = px(std::min(b, x1));
+    o += "<rect x=\"" + Num(xa) + "\" y=\"" + std::to_string(top) + "\" width=\"" +
+         Num(std::max(1.0, xb - xa)) + "\" height=\"" + std::to_string(height) +
+         "\" fill=\"#9ec5f0\" opacity=\"0.6\"/>";
+  }
+  for (const double m : spec.marks) {
+    if (m < x0 || m > x1) continue;
+    o += "<line x1=\"" + Num(px(m)) + "\" x2=\"" + Num(px(m)) + "\" y1=\"" + std::to_string(top) +
+         "\" y2=\"" + std::to_string(top + height) +
+         "\" stroke=\"#e00\" stroke-width=\"1\" opacity=\"0.8\"/>";
+  }
+  return o;
+}
+
 /// The plotted x and y range of `series` (y in log10 for a log plot, padded by 5 %): x0, x1, y0,
 /// y1.
 std::array<double, 4> PlotRange(const PlotSpec& spec, const std::vector<PlotSeries>& series) {
@@ -247,6 +269,7 @@ std::string SvgPlot(const PlotSpec& spec, const std::vector<PlotSeries>& series)
          Num(std::max(1.0, xb - xa)) + "\" height=\"" + std::to_string(ph) +
          "\" fill=\"#f6d7a7\" opacity=\"0.6\"/>";
   }
+  o += SvgMarks(spec, px, x0, x1, mt, ph);
   o += "<rect x=\"" + std::to_string(ml) + "\" y=\"" + std::to_string(mt) + "\" width=\"" +
        std::to_string(pw) + "\" height=\"" + std::to_string(ph) +
        "\" fill=\"none\" stroke=\"#444\"/>";
@@ -358,7 +381,15 @@ std::string HtmlPlots(const DiagData& data, const Report& r) {
   p1.x_label = "t (s)";
   p1.y_label = "mV/V";
   p1.spans = r.windows;
-  h += "<h2>Residual against time</h2>" + SvgPlot(p1, {res, model});
+  for (const Transition& t : cx.conditioning.transitions) {
+    if (t.excluded) p1.excluded.emplace_back(t.excluded_from_s, t.excluded_to_s);
+  }
+  for (const Glitch& g : cx.conditioning.glitches) p1.marks.push_back(g.t_s);
+  h += "<h2>Residual against time</h2>";
+  if (!p1.excluded.empty() || !p1.marks.empty()) {
+    h += "<p>Blue bands: load transitions kept out of the fits; red lines: converter glitches.</p>";
+  }
+  h += SvgPlot(p1, {res, model});
   PlotSpec p2 = p1;
   p2.title = "Before (grey) and after removing the model (blue), b" + std::to_string(c);
   p2.spans.clear();
@@ -398,6 +429,53 @@ std::string HtmlPlots(const DiagData& data, const Report& r) {
 }
 
 /// Every single effect tried, in held-out ranking order.
+/// Data conditioning: the quiet noise per channel and where it was measured, the load
+/// transitions kept out of the fits, the converter's wrong codes.
+std::string HtmlConditioning(const DiagData& data, const Report& r) {
+  const Conditioning& k = r.cx.conditioning;
+  std::string h =
+      "<h2>Data conditioning</h2><table><tr><th>channel</th><th>quiet noise "
+      "(mV/V)</th><th>in " +
+      Esc(data.real_unit_symbol) + "</th><th>measured in</th></tr>";
+  for (std::size_t c = 0; c < k.noise.size(); ++c) {
+    const QuietNoise& q = k.noise[c];
+    const bool have = q.holds > 0;
+    h += "<tr><td>b" + std::to_string(c) + "</td><td>" + (have ? Num(q.sigma_mvv) : "—") +
+         "</td><td>" +
+         (have && data.real_units_per_mvv > 0 ? Num(q.sigma_mvv * data.real_units_per_mvv) : "—") +
+         "</td><td>" +
+         (have ? "hold " + Num(q.from_s) + "–" + Num(q.to_s) + " s (quietest of " +
+                     std::to_string(q.holds) + " holds)"
+               : "no hold long enough") +
+         "</td></tr>";
+  }
+  h += "</table><p>Quiet noise: robust σ of first differences inside holds of the reference.</p>";
+  std::size_t lagging = 0;
+  double app_max = 0.0;
+  for (const Transition& t : k.transitions) {
+    lagging += t.excluded ? 1 : 0;
+    if (t.excluded) app_max = std::max(app_max, t.application_s);
+  }
+  h += "<p>Load transitions measured: " + std::to_string(k.transitions.size()) + "; " +
+       std::to_string(lagging) + " lag the reference" +
+       (lagging > 0 ? " (real load applied over up to " + Num(app_max, "%.2g") +
+                          " s): their rows are <b>excluded</b> from every fit and hold-out score"
+                    : std::string()) +
+       ". Rows excluded with the glitches: " + std::to_string(k.excluded_rows) + ".</p>";
+  if (!k.glitches.empty()) {
+    h += "<h2>" + Esc(std::string(EffectOf(EffectKind::kConverterGlitch).name)) + "</h2><p>" +
+         std::to_string(k.glitches.size()) +
+         " isolated wrong codes, each kept out of every fit:</p><table><tr><th>t (s)</th>"
+         "<th>channel</th><th>offset (mV/V)</th></tr>";
+    for (const Glitch& g : k.glitches) {
+      h += "<tr><td>" + Num(g.t_s) + "</td><td>b" + std::to_string(g.channel) + "</td><td>" +
+           Num(g.offset_mvv) + "</td></tr>";
+    }
+    h += "</table>";
+  }
+  return h;
+}
+
 std::string HtmlCandidates(const Report& r) {
   std::string h;
   h += "<h2>All candidates (held-out "
@@ -463,6 +541,7 @@ std::string HtmlReport(const DiagData& data, const Report& r) {
          Esc(why) + "</p>";
   }
   h += HtmlChannels(r);
+  h += HtmlConditioning(data, r);
   h += HtmlPlots(data, r);
   h += HtmlCandidates(r);
   h += "</body></html>\n";

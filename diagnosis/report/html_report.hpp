@@ -23,6 +23,9 @@ struct PlotSpec {
   std::string x_label;
   std::string y_label;
   std::vector<std::pair<double, double>> spans;  ///< shaded x ranges
+  std::vector<std::pair<double, double>>
+      excluded;               ///< x ranges kept out of the fits (hatched blue)
+  std::vector<double> marks;  ///< x positions marked by a red line
   bool log_y = false;
   int width = 1000;
   int height = 300;

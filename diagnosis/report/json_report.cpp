@@ -1,10 +1,90 @@
 #include "diagnosis/report/json_report.hpp"
 
+#include <algorithm>
 #include <string>
+#include <vector>
+
+#include "measurement/effect_vocabulary.hpp"
 
 namespace ftstack::diag {
 
 using Vec = Eigen::VectorXd;
+
+namespace {
+
+/// Glitches, transitions and the quiet noise (engine/conditioning.hpp), with where and how.
+nlohmann::json ConditioningJson(const Report& r) {
+  const Conditioning& k = r.cx.conditioning;
+  const DiagData& d = *r.cx.data;
+  auto noise = nlohmann::json::array();
+  for (std::size_t c = 0; c < k.noise.size(); ++c) {
+    const QuietNoise& q = k.noise[c];
+    nlohmann::json nj = {{"channel", c}, {"holds", q.holds}};
+    if (q.holds > 0) {
+      nj["sigma_mvv"] = q.sigma_mvv;
+      nj["unit"] = d.real_unit_symbol;
+      if (d.real_units_per_mvv > 0) nj["sigma_in_unit"] = q.sigma_mvv * d.real_units_per_mvv;
+      nj["measured_s"] = {q.from_s, q.to_s};
+    }
+    noise.push_back(nj);
+  }
+  auto transitions = nlohmann::json::array();
+  std::size_t lagging = 0;
+  for (const Transition& t : k.transitions) {
+    nlohmann::json tj = {{"t_s", t.t_s},
+                         {"channel", t.channel},
+                         {"step_mvv", t.step_mvv},
+                         {"application_s", t.application_s},
+                         {"excluded", t.excluded}};
+    if (t.excluded) {
+      tj["excluded_s"] = {t.excluded_from_s, t.excluded_to_s};
+      ++lagging;
+    }
+    transitions.push_back(tj);
+  }
+  return {{"noise_quiet",
+           {{"method",
+             "robust sigma of first differences (median |diff| / 0.6745 / sqrt 2) in every hold "
+             "of the reference (>= 20 rows and 1 s, glitch and transition rows out); the "
+             "quietest hold of >= 200 rows (else of any length)"},
+            {"channels", noise}}},
+          {"transitions",
+           {{"handling",
+             "rows where the real load had not reached the reference (its normalised value more "
+             "than 0.1 from the reference's) are excluded from every fit and hold-out score when "
+             "the real 10-90 % rise is >= 2 rows slower than the reference's"},
+            {"count", k.transitions.size()},
+            {"excluded", lagging},
+            {"list", transitions}}},
+          {"excluded_rows", k.excluded_rows}};
+}
+
+/// Findings that are not models of the residual: the converter's wrong codes.
+nlohmann::json FindingsJson(const Report& r) {
+  const auto& g = r.cx.conditioning.glitches;
+  auto out = nlohmann::json::array();
+  if (g.empty()) return out;
+  std::vector<int> channels;
+  std::vector<double> times;
+  auto list = nlohmann::json::array();
+  for (const Glitch& x : g) {
+    if (std::find(channels.begin(), channels.end(), x.channel) == channels.end())
+      channels.push_back(x.channel);
+    times.push_back(x.t_s);
+    list.push_back({{"t_s", x.t_s}, {"channel", x.channel}, {"offset_mvv", x.offset_mvv}});
+  }
+  std::sort(channels.begin(), channels.end());
+  out.push_back({{"name", EffectOf(EffectKind::kConverterGlitch).name},
+                 {"channels", channels},
+                 {"params", {{"count", g.size()}, {"times_s", times}}},
+                 {"glitches", list},
+                 {"handling",
+                  "each sample replaced by its neighbours' median in the residual and "
+                  "its row excluded from every fit and hold-out score"}});
+  return out;
+}
+
+}  // namespace
 
 nlohmann::json ToJson(const Report& r) {
   auto vec = [](const Vec& v) {
@@ -24,6 +104,8 @@ nlohmann::json ToJson(const Report& r) {
   if (!r.cx.peak_hz.empty()) {
     j["mismatch"]["spectral_peaks_hz"] = r.cx.peak_hz;
   }
+  j["conditioning"] = ConditioningJson(r);
+  j["findings"] = FindingsJson(r);
   j["verdict"] = r.verdict;
   auto effects = nlohmann::json::array();
   for (const auto& e : r.effects) {

@@ -31,7 +31,8 @@ TEST(EffectVocabulary, NamesAreTheSpecsInOrder) {
                                          "saturation",
                                          "overload_shift",
                                          "mains_interference",
-                                         "resonance"};
+                                         "resonance",
+                                         "converter_glitch"};
   ASSERT_EQ(kEffectVocabulary.size(), spec.size());
   for (std::size_t i = 0; i < spec.size(); ++i) {
     EXPECT_EQ(kEffectVocabulary[i].name, spec[i]);
@@ -60,6 +61,7 @@ TEST(EffectVocabulary, ReportedParametersAreTheSpecsColumn) {
       {EffectKind::kResonance,
        "freq_hz, damping_ratio, participation, freq2_hz, damping_ratio2, participation2"},
       {EffectKind::kHysteresis, "none"},
+      {EffectKind::kConverterGlitch, "count, times_s"},
   };
   for (const auto& [kind, keys] : want) {
     EXPECT_EQ(ValidKeys(EffectOf(kind), kReported), keys) << EffectOf(kind).name;

@@ -492,6 +492,31 @@ TEST(RecordEffects, EffectsCombineAdditivelyWhenIndependent) {
   EXPECT_EQ(r.truth["effects"].size(), 2u);
 }
 
+TEST(RecordEffects, ConverterGlitchesAreIsolatedWrongCodesOnTheChosenChannels) {
+  RecordRequest q =
+      TestRequest("thermal", {"converter_glitch:count=9,offset_mvv=0.03,channels=[2,5]"}, 60.0);
+  const RecordResult r = MakeRecording(q);
+  int found = 0;
+  for (int ch = 0; ch < 6; ++ch) {
+    const auto res = Residual(r, ch);
+    for (std::size_t i = 0; i < res.size(); ++i) {
+      if (std::abs(res[i]) < 0.015) continue;
+      ++found;
+      EXPECT_TRUE(ch == 2 || ch == 5) << ch;
+      EXPECT_NEAR(std::abs(res[i]), 0.03, 0.001);  // the offset, give or take noise
+      if (i > 0) {
+        EXPECT_LT(std::abs(res[i - 1]), 0.015);
+      }
+      if (i + 1 < res.size()) {
+        EXPECT_LT(std::abs(res[i + 1]), 0.015);
+      }
+    }
+  }
+  EXPECT_EQ(found, 9);
+  EXPECT_THROW((void)MakeRecording(TestRequest("thermal", {"converter_glitch:count=2.5"}, 10.0)),
+               std::exception);
+}
+
 TEST(RecordEffects, EveryVocabularyNameInjectsWithDefaults) {
   // The spec's vocabulary, written out independently of the implementation's table.
   const std::vector<std::string> vocab = {"none",
@@ -511,7 +536,8 @@ TEST(RecordEffects, EveryVocabularyNameInjectsWithDefaults) {
                                           "saturation",
                                           "overload_shift",
                                           "mains_interference",
-                                          "resonance"};
+                                          "resonance",
+                                          "converter_glitch"};
   EXPECT_EQ(EffectNames(), vocab);
   for (const auto& name : vocab) {
     RecordRequest q = TestRequest("thermal", {name}, 120.0);
