@@ -2,8 +2,8 @@
 #include <cstdint>
 #include <string>
 
-#include "calibration/fit/ati.hpp"
 #include "calibration/file/cal_file.hpp"
+#include "calibration/fit/ati.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

@@ -4,14 +4,14 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "calibration/file/payload_file.hpp"
+#include "calibration/file/slots.hpp"
 #include "calibration/fit/apply.hpp"
 #include "calibration/fit/excitation.hpp"
 #include "calibration/fit/fit_report.hpp"
 #include "calibration/fit/input_units.hpp"
 #include "calibration/fit/known_mass.hpp"
 #include "calibration/fit/payload.hpp"
-#include "calibration/file/payload_file.hpp"
-#include "calibration/file/slots.hpp"
 
 namespace ftstack::cal {
 namespace {

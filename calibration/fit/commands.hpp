@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "calibration/fit/ati.hpp"
 #include "calibration/file/cal_file.hpp"
+#include "calibration/fit/ati.hpp"
 #include "calibration/fit/check.hpp"
 #include "calibration/fit/fit.hpp"
 #include "firmware/fixed_calibration.hpp"

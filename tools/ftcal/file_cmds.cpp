@@ -2,8 +2,8 @@
 
 #include <cstdio>
 
-#include "calibration/fit/commands.hpp"
 #include "calibration/file/slots.hpp"
+#include "calibration/fit/commands.hpp"
 
 namespace ftstack::tools {
 
