@@ -106,7 +106,8 @@ case "$cmd" in
     cmake --build "$DBG" -j "$(nproc)"
     cd "$DBG"
     # Tests labelled python-only run none of our compiled code: nothing for a sanitizer to check.
-    exec ctest --output-on-failure -j "$(nproc)" --timeout 600 -LE python-only "$@"
+    # Tests labelled sanitize-redundant run code other tests already run under the sanitizers.
+    exec ctest --output-on-failure -j "$(nproc)" --timeout 600 -LE 'python-only|sanitize-redundant' "$@"
     ;;
   mqtt-demo)
     build
