@@ -48,11 +48,11 @@ struct Conditioning {
   std::size_t excluded_rows = 0;  ///< rows out of every fit and score (glitches, transitions)
 };
 
-/// A glitch lies this many robust σ of first differences from its neighbours' median (a load step
-/// never does: its neighbours disagree by as much as it does).
+/// A glitch lies this many robust σ of first differences from the line through its neighbours (a
+/// load step never does: its neighbours leave that line by as much as it does).
 inline constexpr double kGlitchSigmas = 30.0;
-/// ... and as many σ of the first differences within kGlitchReach rows each side of it (a knock or
-/// a bouncing weight raises those).
+/// ... and as many σ of the first differences about their median within kGlitchReach rows each
+/// side of it (a knock or a bouncing weight raises those; a steady ramp does not).
 inline constexpr int kGlitchReach = 10;
 /// Rows a hold needs before its noise is preferred (the robust σ of n differences scatters by about
 /// 1.17/√n: 8 % here), so the quietest hold is not merely the luckiest short one.
