@@ -79,14 +79,52 @@ LogBounds RecoveryBounds(const Context& cx, double onset) {
   return {std::log(lo), std::log(hi)};
 }
 
+/// The whitened training SSE of the partly recovering shift with time constant tau_s, up to a
+/// constant (what the step and the recovery explain, negated): per channel a 2 × 2 solve on sums
+/// over the training rows after the onset, one exponential per row for all channels.
+double RecoveryObjective(const Context& cx, const Series& target, const std::vector<int>& after,
+                         double onset, double tau_s) {
+  const auto& t = cx.data->t_s;
+  double se = 0.0;
+  double see = 0.0;
+  std::vector<double> sy(static_cast<std::size_t>(cx.nc), 0.0);
+  std::vector<double> sye(static_cast<std::size_t>(cx.nc), 0.0);
+  for (const int i : after) {
+    const double e = std::exp(-(t[static_cast<std::size_t>(i)] - onset) / tau_s);
+    se += e;
+    see += e * e;
+    for (int c = 0; c < cx.nc; ++c) {
+      const double y = target(i, c);
+      sy[static_cast<std::size_t>(c)] += y;
+      sye[static_cast<std::size_t>(c)] += y * e;
+    }
+  }
+  const double n = static_cast<double>(after.size());
+  const double det = n * see - se * se;
+  if (!(det > 1e-12 * n * see)) return std::numeric_limits<double>::infinity();
+  double explained = 0.0;
+  for (int c = 0; c < cx.nc; ++c) {
+    const double b0 = sy[static_cast<std::size_t>(c)];
+    const double b1 = sye[static_cast<std::size_t>(c)];
+    explained += cx.weight(c) * (see * b0 * b0 - 2.0 * se * b0 * b1 + n * b1 * b1) / det;
+  }
+  return -explained;
+}
+
 /// The recovery time constant of least training SSE (log grid, then golden rounds), and its
 /// log-σ; nullopt when it ends within 2 % (in log) of a bound of RecoveryBounds (not resolved:
 /// the lasting step alone is kept).
 std::optional<double> RecoveryTau(const Context& cx, const Series& target, double onset,
                                   double* log_sigma) {
   const LogBounds b = RecoveryBounds(cx, onset);
+  std::vector<int> after;
+  for (int i = 0; i < cx.n; ++i) {
+    if (cx.train[static_cast<std::size_t>(i)] && cx.data->t_s[static_cast<std::size_t>(i)] >= onset)
+      after.push_back(i);
+  }
+  if (after.size() < 10) return std::nullopt;
   const LogObjective sse = [&](const std::vector<double>& lt) {
-    return FitShift(cx, target, onset, std::exp(lt[0]), nullptr).sse_w;
+    return RecoveryObjective(cx, target, after, onset, std::exp(lt[0]));
   };
   std::vector<std::vector<double>> grid;
   for (int k = 0; k <= 12; ++k) grid.push_back({b.lo + (b.hi - b.lo) * k / 12.0});
@@ -94,7 +132,7 @@ std::optional<double> RecoveryTau(const Context& cx, const Series& target, doubl
   if (!std::isfinite(BestPoint(sse, grid, &x))) return std::nullopt;
   GoldenRounds(
       sse, {b}, {(b.hi - b.lo) / 12.0}, 0, 2, [](int) {}, &x);
-  const double margin = 0.02 * (b.hi - b.lo);
+  const double margin = 0.02;  // 2 % in log, as EffectSpec::ranges
   if (x[0] <= b.lo + margin || x[0] >= b.hi - margin) return std::nullopt;
   *log_sigma = CurvatureSigma([&](double v) { return sse({v}); }, x[0], 0.02);
   return std::exp(x[0]);
