@@ -16,7 +16,7 @@ struct Glitch {
   int row = 0;
   int channel = 0;
   double t_s = 0.0;
-  double offset_mvv = 0.0;  ///< the sample minus its neighbours' median, mV/V
+  double offset_mvv = 0.0;  ///< the sample minus the line through its four neighbours, mV/V
 };
 
 /// One change of the reference load between two holds, and the rows where the real load had not
