@@ -62,7 +62,7 @@ inline constexpr int kQuietHoldRows = 200;
 inline constexpr double kTransitionBand = 0.1;
 
 /// Finds glitches and transitions in the context's residual and load, replaces glitch samples of
-/// the residual by their neighbours' median, marks glitch and lagging-transition rows in
+/// the residual by the line through their neighbours, marks glitch and lagging-transition rows in
 /// cx->excluded (out of train and hold-out rows, counts updated) and measures the quiet noise.
 void ConditionData(Context* cx);
 
