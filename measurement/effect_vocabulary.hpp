@@ -122,7 +122,12 @@ inline constexpr std::array kOverloadShift = {
     P{"onset_s", T::kNumber, "s", "time of the overload and the shift", kBoth, ""},
     P{"shift", T::kNumber, "mV/V", "zero shift on the most sensitive channel", kInjected, ""},
     P{"axis", T::kLoadAxis, "", "overloaded wrench axis (Fx…Mz)", kInjected, ""},
-    P{"factor", T::kNumber, "", "overload as a multiple of rated load", kInjected, ""}};
+    P{"factor", T::kNumber, "", "overload as a multiple of rated load", kInjected, ""},
+    P{"recovery_tau_s", T::kNumber, "s",
+      "time constant of the part of the shift that recovers (partly recovering variant)", kReported,
+      ""},
+    P{"recovering_shift", T::kNumber, "mV/V",
+      "part of the shift that recovers, per channel (partly recovering variant)", kReported, ""}};
 inline constexpr std::array kMainsInterference = {
     P{"freq_hz", T::kNumber, "Hz", "pick-up frequency", kBoth, ""},
     P{"amplitude_mvv", T::kNumber, "mV/V", "peak amplitude (report: per channel)", kBoth,

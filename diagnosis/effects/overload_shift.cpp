@@ -1,4 +1,4 @@
-// overload_shift: a permanent zero step after an overload.
+// overload_shift: a zero step after an overload, lasting or partly recovering.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -6,18 +6,24 @@
 #include <vector>
 
 #include "diagnosis/effects/families.hpp"
+#include "diagnosis/engine/nonlinear_search.hpp"
 #include "diagnosis/engine/signal.hpp"
 
 namespace ftstack::diag::fx {
 
-std::optional<EffectFit> FitOverloadShift(const Context& cx, const Series& target) {
+namespace {
+
+/// The time the zero steps: the split of the training rows after which a constant per channel
+/// explains most of the target (whitened). Also the training times either side of it.
+bool FindOnset(const Context& cx, const Series& target, double* onset, double* t_before,
+               double* t_after) {
   const auto& d = *cx.data;
   std::vector<int> rows;
   for (int i = 0; i < cx.n; ++i) {
     if (cx.train[static_cast<std::size_t>(i)]) rows.push_back(i);
   }
   const auto m = rows.size();
-  if (m < 40) return std::nullopt;
+  if (m < 40) return false;
   // Suffix sums per channel: a step from 0 to a_c after the split explains Σ_c w_c·S_c²/n_after.
   Mat suffix = Mat::Zero(static_cast<Eigen::Index>(m + 1), cx.nc);
   for (std::size_t j = m; j-- > 0;) {
@@ -39,49 +45,165 @@ std::optional<EffectFit> FitOverloadShift(const Context& cx, const Series& targe
       bj = j;
     }
   }
-  const double t_after = d.t_s[static_cast<std::size_t>(rows[bj])];
-  const double t_before = d.t_s[static_cast<std::size_t>(rows[bj - 1])];
-  const double onset = rows[bj] - rows[bj - 1] > 1 ? 0.5 * (t_before + t_after) : t_after;
+  *t_after = d.t_s[static_cast<std::size_t>(rows[bj])];
+  *t_before = d.t_s[static_cast<std::size_t>(rows[bj - 1])];
+  *onset = rows[bj] - rows[bj - 1] > 1 ? 0.5 * (*t_before + *t_after) : *t_after;
+  return true;
+}
+
+/// The zero after `onset`: a lasting shift per channel and, with tau_s > 0, a part that recovers
+/// as exp(−(t − onset)/tau_s) (a yielded adhesive or flexure relaxing part of the way back).
+ChannelFit FitShift(const Context& cx, const Series& target, double onset, double tau_s,
+                    Series* pred) {
+  const auto& t = cx.data->t_s;
+  const auto since = [&t, onset](int i) { return t[static_cast<std::size_t>(i)] - onset; };
+  if (tau_s <= 0) {
+    return FitChannels(
+        cx, target, 1, [&](int i, int, double* x) { x[0] = since(i) >= 0 ? 1.0 : 0.0; }, pred);
+  }
+  return FitChannels(
+      cx, target, 2,
+      [&](int i, int, double* x) {
+        const double s = since(i);
+        x[0] = s >= 0 ? 1.0 : 0.0;
+        x[1] = s >= 0 ? std::exp(-s / tau_s) : 0.0;
+      },
+      pred);
+}
+
+/// The recovery's time-constant range: 3 samples (and 0.2 s) to a third of the time left after the
+/// onset (a slower recovery is a drift the record cannot tell from it).
+LogBounds RecoveryBounds(const Context& cx, double onset) {
+  const double lo = std::max(3.0 * cx.dt, 0.2);
+  const double hi = std::max((cx.data->t_s.back() - onset) / 3.0, 2.0 * lo);
+  return {std::log(lo), std::log(hi)};
+}
+
+/// The whitened training SSE of the partly recovering shift with time constant tau_s, up to a
+/// constant (what the step and the recovery explain, negated): per channel a 2 × 2 solve on sums
+/// over the training rows after the onset, one exponential per row for all channels.
+double RecoveryObjective(const Context& cx, const Series& target, const std::vector<int>& after,
+                         double onset, double tau_s) {
+  const auto& t = cx.data->t_s;
+  double se = 0.0;
+  double see = 0.0;
+  std::vector<double> sy(static_cast<std::size_t>(cx.nc), 0.0);
+  std::vector<double> sye(static_cast<std::size_t>(cx.nc), 0.0);
+  for (const int i : after) {
+    const double e = std::exp(-(t[static_cast<std::size_t>(i)] - onset) / tau_s);
+    se += e;
+    see += e * e;
+    for (int c = 0; c < cx.nc; ++c) {
+      const double y = target(i, c);
+      sy[static_cast<std::size_t>(c)] += y;
+      sye[static_cast<std::size_t>(c)] += y * e;
+    }
+  }
+  const double n = static_cast<double>(after.size());
+  const double det = n * see - se * se;
+  if (!(det > 1e-12 * n * see)) return std::numeric_limits<double>::infinity();
+  double explained = 0.0;
+  for (int c = 0; c < cx.nc; ++c) {
+    const double b0 = sy[static_cast<std::size_t>(c)];
+    const double b1 = sye[static_cast<std::size_t>(c)];
+    explained += cx.weight(c) * (see * b0 * b0 - 2.0 * se * b0 * b1 + n * b1 * b1) / det;
+  }
+  return -explained;
+}
+
+/// The recovery time constant of least training SSE (log grid, then golden rounds), and its
+/// log-σ; nullopt when it ends within 2 % (in log) of a bound of RecoveryBounds (not resolved:
+/// the lasting step alone is kept).
+std::optional<double> RecoveryTau(const Context& cx, const Series& target, double onset,
+                                  double* log_sigma) {
+  const LogBounds b = RecoveryBounds(cx, onset);
+  std::vector<int> after;
+  for (int i = 0; i < cx.n; ++i) {
+    if (cx.train[static_cast<std::size_t>(i)] && cx.data->t_s[static_cast<std::size_t>(i)] >= onset)
+      after.push_back(i);
+  }
+  if (after.size() < 10) return std::nullopt;
+  const LogObjective sse = [&](const std::vector<double>& lt) {
+    return RecoveryObjective(cx, target, after, onset, std::exp(lt[0]));
+  };
+  std::vector<std::vector<double>> grid;
+  for (int k = 0; k <= 12; ++k) grid.push_back({b.lo + (b.hi - b.lo) * k / 12.0});
+  std::vector<double> x;
+  if (!std::isfinite(BestPoint(sse, grid, &x))) return std::nullopt;
+  GoldenRounds(
+      sse, {b}, {(b.hi - b.lo) / 12.0}, 0, 2, [](int) {}, &x);
+  const double margin = 0.02;  // 2 % in log, as EffectSpec::ranges
+  if (x[0] <= b.lo + margin || x[0] >= b.hi - margin) return std::nullopt;
+  *log_sigma = CurvatureSigma([&](double v) { return sse({v}); }, x[0], 0.02);
+  return std::exp(x[0]);
+}
+
+/// The load peak nearest before the onset (an overload is the physical cause), in words.
+std::string OverloadNote(const Context& cx, double onset) {
+  const auto& d = *cx.data;
+  if (!d.has_wrench()) return "";
+  double peak = 0.0;
+  int pk = 0;
+  int pi = 0;
+  double scale[6];
+  for (int k = 0; k < 6; ++k)
+    scale[k] = std::max<double>(d.wrench.col(k).cwiseAbs().maxCoeff(), 1e-12);
+  for (int i = 0; i < cx.n && d.t_s[static_cast<std::size_t>(i)] <= onset + 2.0 * cx.block_s; ++i) {
+    for (int k = 0; k < 6; ++k) {
+      const double v = std::fabs(d.wrench(i, k)) / scale[k];
+      if (v > peak) {
+        peak = v;
+        pk = k;
+        pi = i;
+      }
+    }
+  }
+  return Fmt(", after the largest load so far (%s = %.4g at t = %.2f s)", kWrenchAxisNames[pk],
+             d.wrench(pi, pk), d.t_s[static_cast<std::size_t>(pi)]);
+}
+
+}  // namespace
+
+std::optional<EffectFit> FitOverloadShift(const Context& cx, const Series& target) {
+  double onset = 0.0;
+  double t_before = 0.0;
+  double t_after = 0.0;
+  if (!FindOnset(cx, target, &onset, &t_before, &t_after)) return std::nullopt;
   EffectFit e;
   e.name = "overload_shift";
   e.n_params = cx.nc + 1;
-  const auto f = FitChannels(
-      cx, target, 1,
-      [&](int i, int, double* x) {
-        x[0] = d.t_s[static_cast<std::size_t>(i)] >= onset ? 1.0 : 0.0;
-      },
-      &e.pred);
+  ChannelFit f = FitShift(cx, target, onset, 0.0, &e.pred);
+  // A shift that partly recovers: kept by the training BIC (nc + 1 more parameters) and only with
+  // its time constant resolved inside its range.
+  double log_sigma = 0.0;
+  const std::optional<double> tau = RecoveryTau(cx, target, onset, &log_sigma);
+  if (tau) {
+    Series pred;
+    ChannelFit g = FitShift(cx, target, onset, *tau, &pred);
+    const double log_n = std::log(std::max<double>(2.0, static_cast<double>(cx.n_train)));
+    if (g.sse_w + (cx.nc + 1) * log_n < f.sse_w) {
+      f = std::move(g);
+      e.pred = std::move(pred);
+      e.n_params = 2 * cx.nc + 2;
+      e.variant = "partly recovering";
+      e.params["recovery_tau_s"] = *tau;
+      e.sigma["recovery_tau_s"] = *tau * log_sigma;
+      PutChannelCoef(cx, f, 1, "recovering_shift", &e);
+    }
+  }
   e.train_sse_w = f.sse_w;
   const Vec a = PutChannelCoef(cx, f, 0, "shift", &e);
   e.params["onset_s"] = onset;
   e.sigma["onset_s"] = std::max(cx.dt, (t_after - t_before) / std::sqrt(12.0));
   e.channels = ActiveChannels(cx, e.pred);
-  // The load peak nearest before the onset (an overload is the physical cause).
-  std::string load_note;
-  if (d.has_wrench()) {
-    double peak = 0.0;
-    int pk = 0;
-    int pi = 0;
-    double scale[6];
-    for (int k = 0; k < 6; ++k)
-      scale[k] = std::max<double>(d.wrench.col(k).cwiseAbs().maxCoeff(), 1e-12);
-    for (int i = 0; i < cx.n && d.t_s[static_cast<std::size_t>(i)] <= onset + 2.0 * cx.block_s;
-         ++i) {
-      for (int k = 0; k < 6; ++k) {
-        const double v = std::fabs(d.wrench(i, k)) / scale[k];
-        if (v > peak) {
-          peak = v;
-          pk = k;
-          pi = i;
-        }
-      }
-    }
-    load_note = Fmt(", after the largest load so far (%s = %.4g at t = %.2f s)",
-                    kWrenchAxisNames[pk], d.wrench(pi, pk), d.t_s[static_cast<std::size_t>(pi)]);
-  }
   const int c = DominantChannel(cx, e.pred);
-  e.evidence = Fmt("zero of b%d steps by %+.3g mV/V (%.1f σ) at t = %.2f s and stays%s", c, a(c),
-                   std::fabs(a(c)) / cx.sigma(c), onset, load_note.c_str());
+  const std::string recovery = e.variant.empty()
+                                   ? "stays"
+                                   : Fmt("stays after %+.3g mV/V of it recovers with τ = %.3g s",
+                                         e.params["recovering_shift"][c].get<double>(), *tau);
+  e.evidence =
+      Fmt("zero of b%d steps by %+.3g mV/V (%.1f σ) at t = %.2f s and %s%s", c, a(c),
+          std::fabs(a(c)) / cx.sigma(c), onset, recovery.c_str(), OverloadNote(cx, onset).c_str());
   return e;
 }
 

@@ -38,6 +38,19 @@ double DiffSigma(Get x, int a, int b) {
   return Median(&d) / 0.6745 / std::sqrt(2.0);
 }
 
+/// Robust σ of white noise from the first differences of x over rows [a, b) taken about their
+/// median: a steady ramp (a constant difference) adds nothing, a knock or ringing does.
+template <class Get>
+double DetrendedDiffSigma(Get x, int a, int b) {
+  std::vector<double> d;
+  d.reserve(static_cast<std::size_t>(std::max(0, b - a)));
+  for (int i = a + 1; i < b; ++i) d.push_back(x(i) - x(i - 1));
+  std::vector<double> work = d;
+  const double mid = Median(&work);
+  for (double& v : d) v = std::fabs(v - mid);
+  return Median(&d) / 0.6745 / std::sqrt(2.0);
+}
+
 bool NearRestart(const Context& cx, int i, int reach) {
   if (cx.restart.empty()) return false;
   for (int k = std::max(1, i - reach + 1); k <= std::min(cx.n - 1, i + reach); ++k) {
@@ -52,9 +65,30 @@ void Exclude(Context* cx, int a, int b) {
     cx->excluded[static_cast<std::size_t>(i)] = 1;
 }
 
-/// Isolated wrong codes per channel: a sample further than kGlitchSigmas σ from the median of its
-/// four neighbours and more than four times their spread from it. The residual there becomes its
-/// neighbours' median (so spectra and filters see no spike) and the row is excluded.
+/// The line through the four neighbours of row i (rows i-2, i-1, i+1, i+2) of x: its value at i
+/// and the spread (max − min) of the neighbours about it. A ramp carries the neighbours apart but
+/// keeps them on the line; a knock, an edge or ringing does not.
+template <class Get>
+void NeighbourLine(Get x, int i, double* at_i, double* spread) {
+  const double v[4] = {x(i - 2), x(i - 1), x(i + 1), x(i + 2)};
+  const double t[4] = {-2.0, -1.0, 1.0, 2.0};
+  const double mean = 0.25 * (v[0] + v[1] + v[2] + v[3]);
+  const double slope = (-2.0 * v[0] - v[1] + v[2] + 2.0 * v[3]) / 10.0;
+  double lo = 0.0;
+  double hi = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    const double r = v[k] - mean - slope * t[k];
+    lo = std::min(lo, r);
+    hi = std::max(hi, r);
+  }
+  *at_i = mean;
+  *spread = hi - lo;
+}
+
+/// Isolated wrong codes per channel: a sample further than kGlitchSigmas σ from the line through
+/// its four neighbours and more than four times their spread about it (so a wrong code on a load
+/// ramp is found as on a hold). The residual there becomes the line's value through its
+/// neighbours' residuals (so spectra and filters see no spike) and the row is excluded.
 void FindGlitches(Context* cx, Conditioning* out) {
   for (int c = 0; c < cx->nc; ++c) {
     const std::vector<double> x = RealColumn(*cx, c);
@@ -63,22 +97,22 @@ void FindGlitches(Context* cx, Conditioning* out) {
     for (const double v : x) scale = std::max(scale, std::fabs(v));
     const double sigma = std::max(DiffSigma(at, 0, cx->n), 1e-9 * scale + 1e-12);
     for (int i = 2; i + 2 < cx->n; ++i) {
-      double nb[4] = {at(i - 2), at(i - 1), at(i + 1), at(i + 2)};
-      std::sort(nb, nb + 4);
-      const double med = 0.5 * (nb[1] + nb[2]);
-      const double dev = at(i) - med;
-      if (std::fabs(dev) <= kGlitchSigmas * sigma || std::fabs(dev) <= 4.0 * (nb[3] - nb[0]) ||
+      double line = 0.0;
+      double spread = 0.0;
+      NeighbourLine(at, i, &line, &spread);
+      const double dev = at(i) - line;
+      if (std::fabs(dev) <= kGlitchSigmas * sigma || std::fabs(dev) <= 4.0 * spread ||
           NearRestart(*cx, i, 2)) {
         continue;
       }
       // Against the local activity too: a knock or a bouncing weight moves the samples around it.
-      const double local =
-          DiffSigma(at, std::max(0, i - kGlitchReach), std::min(cx->n, i + kGlitchReach + 1));
+      const double local = DetrendedDiffSigma(at, std::max(0, i - kGlitchReach),
+                                              std::min(cx->n, i + kGlitchReach + 1));
       if (std::fabs(dev) <= kGlitchSigmas * local) continue;
-      float r[4] = {cx->resid(i - 2, c), cx->resid(i - 1, c), cx->resid(i + 1, c),
-                    cx->resid(i + 2, c)};
-      std::sort(r, r + 4);
-      cx->resid(i, c) = 0.5F * (r[1] + r[2]);
+      double repaired = 0.0;
+      NeighbourLine([cx, c](int k) { return static_cast<double>(cx->resid(k, c)); }, i, &repaired,
+                    &spread);
+      cx->resid(i, c) = static_cast<float>(repaired);
       out->glitches.push_back({i, c, cx->data->t_s[static_cast<std::size_t>(i)], dev});
       Exclude(cx, i, i);
     }

@@ -16,7 +16,7 @@ struct Glitch {
   int row = 0;
   int channel = 0;
   double t_s = 0.0;
-  double offset_mvv = 0.0;  ///< the sample minus its neighbours' median, mV/V
+  double offset_mvv = 0.0;  ///< the sample minus the line through its four neighbours, mV/V
 };
 
 /// One change of the reference load between two holds, and the rows where the real load had not
@@ -48,11 +48,11 @@ struct Conditioning {
   std::size_t excluded_rows = 0;  ///< rows out of every fit and score (glitches, transitions)
 };
 
-/// A glitch lies this many robust σ of first differences from its neighbours' median (a load step
-/// never does: its neighbours disagree by as much as it does).
+/// A glitch lies this many robust σ of first differences from the line through its neighbours (a
+/// load step never does: its neighbours leave that line by as much as it does).
 inline constexpr double kGlitchSigmas = 30.0;
-/// ... and as many σ of the first differences within kGlitchReach rows each side of it (a knock or
-/// a bouncing weight raises those).
+/// ... and as many σ of the first differences about their median within kGlitchReach rows each
+/// side of it (a knock or a bouncing weight raises those; a steady ramp does not).
 inline constexpr int kGlitchReach = 10;
 /// Rows a hold needs before its noise is preferred (the robust σ of n differences scatters by about
 /// 1.17/√n: 8 % here), so the quietest hold is not merely the luckiest short one.
@@ -62,7 +62,7 @@ inline constexpr int kQuietHoldRows = 200;
 inline constexpr double kTransitionBand = 0.1;
 
 /// Finds glitches and transitions in the context's residual and load, replaces glitch samples of
-/// the residual by their neighbours' median, marks glitch and lagging-transition rows in
+/// the residual by the line through their neighbours, marks glitch and lagging-transition rows in
 /// cx->excluded (out of train and hold-out rows, counts updated) and measures the quiet noise.
 void ConditionData(Context* cx);
 

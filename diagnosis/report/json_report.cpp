@@ -79,7 +79,7 @@ nlohmann::json FindingsJson(const Report& r) {
                  {"params", {{"count", g.size()}, {"times_s", times}}},
                  {"glitches", list},
                  {"handling",
-                  "each sample replaced by its neighbours' median in the residual and "
+                  "each sample replaced by the line through its neighbours in the residual and "
                   "its row excluded from every fit and hold-out score"}});
   return out;
 }

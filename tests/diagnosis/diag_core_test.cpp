@@ -337,5 +337,60 @@ TEST(DiagFixtureSubtle, WithoutTemperatureThermalDriftIsNotClaimed) {
   EXPECT_GE(ExcessRemoved(r), 0.7);
 }
 
+TEST(DiagConditioning, WrongCodesOnLoadRampsAreFoundAndStepsAreNot) {
+  // 6 bridges at 100 Hz, 60 s: loads ramp to a new random target in 0.5 s (up to ~0.03 mV/V per
+  // row), hold 1.5 s, and every third change is an instant step. Wrong codes of ±0.1 mV/V (100 σ
+  // of the noise, 3 times the detection threshold) sit at chosen rows, two of them mid-ramp, one
+  // right after a step; nothing else may be reported.
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const int nc = 6;
+  const Eigen::Index n = 6000;
+  Eigen::MatrixXd s(nc, 6);
+  for (int c = 0; c < nc; ++c) {
+    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
+  }
+  DiagData d;
+  d.sim_name = "ramps";
+  d.real_name = "ramps with wrong codes";
+  d.sim_mvv.resize(n, nc);
+  d.real_mvv.resize(n, nc);
+  d.wrench.resize(n, 6);
+  Eigen::VectorXd from = Eigen::VectorXd::Zero(6);
+  Eigen::VectorXd to = Eigen::VectorXd::Zero(6);
+  bool step = false;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (i % 200 == 0) {
+      from = to;
+      for (int a = 0; a < 6; ++a) to(a) = 40.0 * u(rng);
+      step = (i / 200) % 3 == 2;
+    }
+    const double f = step ? 1.0 : std::min(1.0, static_cast<double>(i % 200) / 50.0);
+    const Eigen::VectorXd w = from + f * (to - from);
+    d.t_s.push_back(0.01 * static_cast<double>(i));
+    d.wrench.row(i) = w.transpose().cast<float>();
+    const Eigen::VectorXd b = s * w;
+    for (int c = 0; c < nc; ++c) {
+      d.sim_mvv(i, c) = b(c);
+      d.real_mvv(i, c) = b(c) + 1e-3 * g(rng);
+    }
+  }
+  // (row, channel): rows 1025 and 3630 are mid-ramp (the changes at 1000 and 3600 ramp), 2220
+  // follows the step at 2200, 1180 and 4790 are in holds.
+  const std::vector<std::pair<int, int>> wrong = {
+      {1025, 1}, {1180, 4}, {2220, 0}, {3630, 5}, {4790, 2}};
+  for (const auto& [row, c] : wrong) d.real_mvv(row, c) += row % 2 == 0 ? 0.1 : -0.1;
+  const Report r = Diagnose(d);
+  const auto& found = r.cx.conditioning.glitches;
+  ASSERT_EQ(found.size(), wrong.size()) << ToJson(r)["findings"].dump();
+  for (std::size_t k = 0; k < wrong.size(); ++k) {
+    EXPECT_EQ(found[k].row, wrong[k].first);
+    EXPECT_EQ(found[k].channel, wrong[k].second);
+    EXPECT_NEAR(std::fabs(found[k].offset_mvv), 0.1, 0.005) << found[k].row;
+  }
+  EXPECT_EQ(r.verdict, "none");
+}
+
 }  // namespace
 }  // namespace ftstack::diag

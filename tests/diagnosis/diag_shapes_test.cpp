@@ -107,10 +107,12 @@ TEST(DiagShapes, LaggingThermometerIsThermalZeroDriftWithTheLag) {
 /// Rate-independent hysteresis of general shape: a Preisach sum of 60 relays per bridge (random
 /// up/down thresholds within the bridge's load range, random weights, all at rest "down" at the
 /// start) on each bridge's load, which ramps between random targets (8 bridges, 150 Hz, ±30 %
-/// jitter). Noise σ = 1e-3 mV/V. With `load_path` the relays sit on the 6 wrench axes instead
+/// jitter; a new target every `period` rows, reached in `ramp` rows). Noise σ = 1e-3 mV/V. With
+/// `load_path` the relays sit on the 6 wrench axes instead
 /// (thresholds within each axis's range, weights in N or N·m): the structure's hysteresis, which
 /// every bridge sees through the sensitivity.
-DiagData PreisachHysteresis(unsigned seed, bool load_path = false) {
+DiagData PreisachHysteresis(unsigned seed, bool load_path = false, int period = 180,
+                            int ramp = 120) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::normal_distribution<double> g(0.0, 1.0);
@@ -129,11 +131,11 @@ DiagData PreisachHysteresis(unsigned seed, bool load_path = false) {
   Eigen::VectorXd from = Eigen::VectorXd::Zero(6);
   Eigen::VectorXd to = Eigen::VectorXd::Zero(6);
   for (int i = 0; i < rows; ++i) {
-    if (i % 180 == 0) {
+    if (i % period == 0) {
       from = to;
       for (int a = 0; a < 6; ++a) to(a) = 40.0 * u(rng);
     }
-    const double f = std::min(1.0, (i % 180) / 120.0);
+    const double f = std::min(1.0, static_cast<double>(i % period) / ramp);
     loads.push_back(from + f * (to - from));
   }
   // One relay set per bridge (its load s_c·w) or per wrench axis (w_a).
@@ -206,6 +208,24 @@ TEST(DiagShapes, PreisachHysteresisIsNamedHysteresis) {
   std::printf("Preisach: verdict %s (%s), held-out %.3g -> %.3g mV/V\n", r.verdict.c_str(),
               r.effects.empty() ? "" : r.effects.front().fit.variant.c_str(), r.hold_rms_before,
               r.hold_rms_after);
+}
+
+TEST(DiagShapes, PreisachHysteresisUnderHeldLoadsIsNotCreepOrDrift) {
+  // Loads held for 10 s between 0.1 s ramps: within a hold the loop's output stays put (it depends
+  // on the load's history, not on time), where creep would keep moving and a drift would wander;
+  // the hold-to-hold offsets are what a time spline or a creep with a gain term could follow.
+  const DiagData d = PreisachHysteresis(12, false, 1500, 15);
+  const Report r = Diagnose(d);
+  EXPECT_EQ(r.verdict, "hysteresis") << ToJson(r)["candidates"].dump();
+  std::string claimed;
+  for (const auto& e : r.effects) claimed += e.fit.name + " (" + e.fit.variant + ") ";
+  EXPECT_EQ(r.effects.size(), 1u) << claimed;
+  const double noise2 = 1e-6;
+  const double before = r.hold_rms_before * r.hold_rms_before - noise2;
+  const double after = r.hold_rms_after * r.hold_rms_after - noise2;
+  EXPECT_LT(after, 0.5 * before) << r.hold_rms_before << " -> " << r.hold_rms_after;
+  std::printf("Preisach, held loads: verdict %s, %s; held-out %.3g -> %.3g mV/V\n",
+              r.verdict.c_str(), claimed.c_str(), r.hold_rms_before, r.hold_rms_after);
 }
 
 TEST(DiagShapes, HysteresisInTheLoadPathIsNamedHysteresisAlone) {
@@ -469,6 +489,84 @@ TEST(DiagShapes, PureMainsLineIsNotGivenHarmonics) {
   const EffectFit& f = r.effects.front().fit;
   EXPECT_EQ(f.variant, "mains fundamental") << f.params.dump();
   EXPECT_NEAR(f.params["freq_hz"].get<double>(), 59.7, 0.05);
+}
+
+/// A zero shift that starts at an overload and partly recovers (the gauge's adhesive or the
+/// flexure's micro-yield relaxes back part of the way): 6 bridges at 50 Hz for 240 s, steps of
+/// random loads every 6 s; at t = 120 s a 1.5 s press on Fz at 4 times the largest load so far,
+/// after which bridge c's zero moves by a_c·(r + (1 − r)·exp(−(t − t_end)/τ)), a_c of either sign,
+/// 8–16 σ. Noise σ = 1e-3 mV/V. `end_s` receives t_end.
+DiagData RecoveringOverloadShift(double tau_s, double kept, unsigned seed, double* end_s) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const int nc = 6;
+  Eigen::MatrixXd s(nc, 6);
+  for (int c = 0; c < nc; ++c) {
+    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
+  }
+  std::vector<double> shift(nc);
+  for (double& v : shift) v = (u(rng) < 0 ? -1.0 : 1.0) * (0.008 + 0.008 * std::fabs(u(rng)));
+  const double dt = 0.02;
+  const auto n = static_cast<Eigen::Index>(240.0 / dt);
+  const double press_s = 120.0;
+  *end_s = press_s + 1.5;
+  DiagData d;
+  d.sim_name = "independent generator";
+  d.real_name = "partly recovering overload shift";
+  d.sim_mvv.resize(n, nc);
+  d.real_mvv.resize(n, nc);
+  d.wrench.resize(n, 6);
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(6);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) * dt;
+    if (i % 300 == 0) {
+      for (int a = 0; a < 6; ++a) w(a) = 40.0 * u(rng);
+    }
+    Eigen::VectorXd load = w;
+    if (t >= press_s && t < *end_s) {
+      load.setZero();
+      load(2) = 160.0;
+    }
+    const double after = t >= *end_s ? kept + (1.0 - kept) * std::exp(-(t - *end_s) / tau_s) : 0.0;
+    d.t_s.push_back(t);
+    d.wrench.row(i) = load.transpose().cast<float>();
+    const Eigen::VectorXd b = s * load;
+    for (int c = 0; c < nc; ++c) {
+      d.sim_mvv(i, c) = b(c);
+      d.real_mvv(i, c) = b(c) + shift[static_cast<std::size_t>(c)] * after + 1e-3 * g(rng);
+    }
+  }
+  return d;
+}
+
+TEST(DiagShapes, PartlyRecoveringOverloadShiftIsNamedOverloadShift) {
+  double end_s = 0.0;
+  const DiagData d = RecoveringOverloadShift(15.0, 0.4, 4, &end_s);
+  const Report r = Diagnose(d);
+  ASSERT_FALSE(r.effects.empty());
+  EXPECT_EQ(r.verdict, "overload_shift") << ToJson(r)["candidates"].dump();
+  std::string claimed;
+  for (const auto& e : r.effects) claimed += e.fit.name + " (" + e.fit.variant + ") ";
+  EXPECT_EQ(r.effects.size(), 1u) << claimed;
+  const EffectFit& f = r.effects.front().fit;
+  EXPECT_NEAR(f.params.value("onset_s", -1.0), end_s, 1.0) << f.params.dump();
+  // The generator's time constant and the share of the shift that lasts, on every bridge.
+  EXPECT_EQ(f.variant, "partly recovering");
+  ASSERT_TRUE(f.params.contains("recovery_tau_s")) << f.params.dump();
+  EXPECT_NEAR(f.params["recovery_tau_s"].get<double>(), 15.0, 0.15 * 15.0);
+  for (int c = 0; c < 6; ++c) {
+    const double lasting = f.params["shift"][c].get<double>();
+    const double total = lasting + f.params["recovering_shift"][c].get<double>();
+    EXPECT_NEAR(lasting / total, 0.4, 0.1) << "b" << c << " " << f.params.dump();
+  }
+  const double noise2 = 1e-6;
+  const double before = r.hold_rms_before * r.hold_rms_before - noise2;
+  const double after = r.hold_rms_after * r.hold_rms_after - noise2;
+  EXPECT_LT(after, 0.3 * before) << r.hold_rms_before << " -> " << r.hold_rms_after;
+  std::printf("recovering overload shift: verdict %s, %s; held-out %.3g -> %.3g mV/V; %s\n",
+              r.verdict.c_str(), claimed.c_str(), r.hold_rms_before, r.hold_rms_after,
+              f.params.dump().c_str());
 }
 
 }  // namespace

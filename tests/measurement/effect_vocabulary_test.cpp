@@ -56,7 +56,7 @@ TEST(EffectVocabulary, ReportedParametersAreTheSpecsColumn) {
       {EffectKind::kGainError, "channels, gain"},
       {EffectKind::kTimeSkew, "delay_s"},
       {EffectKind::kSaturation, "limit"},
-      {EffectKind::kOverloadShift, "onset_s"},
+      {EffectKind::kOverloadShift, "onset_s, recovery_tau_s, recovering_shift"},
       {EffectKind::kMainsInterference, "freq_hz, amplitude_mvv (alias amplitude)"},
       {EffectKind::kResonance,
        "freq_hz, damping_ratio, participation, freq2_hz, damping_ratio2, participation2"},
