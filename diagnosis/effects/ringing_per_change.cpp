@@ -146,7 +146,9 @@ Series PredictRing(const Context& cx, const std::vector<int>& starts, double f_h
 /// then the strongest Welch lines, inside the bounds, none within 3 % of another; at most 4.
 std::vector<double> RingLines(const Context& cx, const Series& target, const LogBounds& f) {
   std::vector<double> cand;
-  for (const auto& [level, f_hz] : LocalLines(cx, target)) cand.push_back(f_hz);
+  // Weak lines too (1.5 × their neighbourhood): a ringing restarted at every change with its own
+  // phase spreads over the segments; the training BIC decides whether one is kept.
+  for (const auto& [level, f_hz] : LocalLines(cx, target, 1.5)) cand.push_back(f_hz);
   for (std::size_t j = 0; j < std::min<std::size_t>(3, cx.peak_hz.size()); ++j)
     cand.push_back(cx.peak_hz[j]);
   std::vector<double> out;
