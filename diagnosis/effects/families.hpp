@@ -91,11 +91,25 @@ std::optional<EffectFit> FitMains(const Context& cx, const Series& target);
 /// BIC penalty of its 2 coefficients per channel; refits pred jointly with the fundamental and
 /// puts h<k>_amplitude_mvv (σ) and h<k>_seen_at_hz. Returns a clause for the evidence.
 std::string AddMainsHarmonics(const Context& cx, const Series& target, double f0, EffectFit* e);
-/// resonance: a coarse grid at the residual's lines (a log grid without any) then golden
-/// refinements of (f, ζ), and the second-mode search (near == nullptr); or the refinements only,
-/// from near's mode(s), a second mode only when near has one (effects/timing.cpp).
+/// resonance: LockedRingingSearch and RingingPerChange, the better kept (a mode on its search bound
+/// loses, else the lower penalised training SSE); from near, only near's variant is refitted.
 std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target,
                                          const EffectFit* near, bool uncertainty);
+/// resonance's modes rung by the reference's steps themselves: a coarse grid at the residual's
+/// lines (a log grid without any) then golden refinements of (f, ζ), and the second-mode search
+/// (near == nullptr); or the refinements only, from near's mode(s), a second mode only when near
+/// has one (effects/resonance.cpp).
+std::optional<EffectFit> LockedRingingSearch(const Context& cx, const Series& target,
+                                             const EffectFit* near, bool uncertainty);
+/// resonance's variant name for RingingPerChange.
+inline constexpr const char* kRingingPerChange = "ringing per load change";
+/// resonance, variant kRingingPerChange (effects/ringing_per_change.cpp): a lightly damped mode
+/// (ζ 1e-3 … 0.05) restarted at every load change the conditioning found with a free amplitude and
+/// phase per change and channel (two decaying quadrature columns, linear given f and ζ); (f, ζ)
+/// shared, searched from the residual's median-periodogram lines (or from near's). nullopt without
+/// load changes or lines, or when the search ends on its bounds.
+std::optional<EffectFit> RingingPerChange(const Context& cx, const Series& target,
+                                          const EffectFit* near, bool uncertainty);
 /// The two-mode variant of a one-mode resonance fit *e at (f1_hz, zeta1) (effects/
 /// resonance_family.cpp): mode 2 searched at the lines of the residual spectrum, both refined in
 /// turn and fitted jointly (a participation per channel and mode); replaces *e (variant "two

@@ -215,10 +215,35 @@ std::string RingingEvidence(const Context& cx, const Series& target, const Effec
          second;
 }
 
+/// Whether a resonance fit's first mode ended within 2 % of its search's bounds.
+bool FirstModeOnBound(const Context& cx, const EffectFit& e);
+
+/// The ringing kept between the mode locked to the reference's steps and the one restarted per
+/// load change: a fit whose mode ended on a bound loses to one that did not; else the lower
+/// penalised training SSE (BIC: the per-change variant pays for its 2 coefficients per change and
+/// channel).
+std::optional<EffectFit> BetterRinging(const Context& cx, std::optional<EffectFit> locked,
+                                       std::optional<EffectFit> per_change) {
+  if (!per_change) return locked;
+  if (!locked || FirstModeOnBound(cx, *locked)) return per_change;
+  const auto bic = [&](const EffectFit& e) { return e.train_sse_w + e.n_params * Penalty(cx); };
+  return bic(*per_change) < bic(*locked) ? per_change : locked;
+}
+
 }  // namespace
 
 std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target,
                                          const EffectFit* near, bool uncertainty) {
+  if (near != nullptr && near->variant == kRingingPerChange) {
+    return RingingPerChange(cx, target, near, uncertainty);
+  }
+  auto locked = LockedRingingSearch(cx, target, near, uncertainty);
+  if (near != nullptr) return locked;
+  return BetterRinging(cx, std::move(locked), RingingPerChange(cx, target, nullptr, uncertainty));
+}
+
+std::optional<EffectFit> LockedRingingSearch(const Context& cx, const Series& target,
+                                             const EffectFit* near, bool uncertainty) {
   // Coarse search on the two channels with the most residual energy, on all rows or (long records)
   // the window with the most load-step energy; the final fit streams the ringing over every row.
   const std::vector<int> coarse = StrongestTwo(cx, target);
@@ -266,6 +291,14 @@ namespace {
 bool OnBound(const Context& cx, double log_f, double log_z) {
   return log_f < std::log(kMinFreqHz) + 0.02 || log_f > std::log(MaxFreqHz(cx)) - 0.02 ||
          log_z < std::log(kMinZeta) + 0.02 || log_z > std::log(kMaxZeta) - 0.02;
+}
+
+}  // namespace
+
+namespace {
+
+bool FirstModeOnBound(const Context& cx, const EffectFit& e) {
+  return e.search_state.size() >= 2 && OnBound(cx, e.search_state[0], e.search_state[1]);
 }
 
 /// Whether two modes are far enough apart to be told apart (more than 15 % in frequency).

@@ -283,6 +283,14 @@ void MeasureQuietNoise(const Context& cx, Conditioning* out,
     const auto& pick = found != per_hold.end() ? *found : per_hold.front();
     QuietNoise& q = out->noise[static_cast<std::size_t>(c)];
     q.sigma_mvv = pick.first;
+    std::vector<double> quiet_class;
+    for (const auto& h : per_hold) {
+      if ((found == per_hold.end() || long_enough(h)) && h.first <= kQuietClass * pick.first)
+        quiet_class.push_back(h.first);
+    }
+    std::nth_element(quiet_class.begin(), quiet_class.begin() + std::ssize(quiet_class) / 2,
+                     quiet_class.end());
+    q.typical_sigma_mvv = quiet_class[quiet_class.size() / 2];
     q.from_s = cx.data->t_s[static_cast<std::size_t>(holds[pick.second].first)];
     q.to_s = cx.data->t_s[static_cast<std::size_t>(holds[pick.second].second - 1)];
     q.holds = static_cast<int>(holds.size());

@@ -35,7 +35,10 @@ struct Transition {
 /// A channel's noise measured in its quietest holds (robust σ of first differences).
 struct QuietNoise {
   double sigma_mvv = 0.0;  ///< 0 when no hold was long enough
-  double from_s = 0.0;     ///< the hold it was measured in
+  /// The median σ of the long-enough holds within kQuietClass × the quietest (the quietest of many
+  /// holds alone reads low): what the fit weights use; 0 when no hold was long enough.
+  double typical_sigma_mvv = 0.0;
+  double from_s = 0.0;  ///< the hold it was measured in
   double to_s = 0.0;
   int holds = 0;  ///< holds long enough to measure in
 };
@@ -57,6 +60,8 @@ inline constexpr int kGlitchReach = 10;
 /// Rows a hold needs before its noise is preferred (the robust σ of n differences scatters by about
 /// 1.17/√n: 8 % here), so the quietest hold is not merely the luckiest short one.
 inline constexpr int kQuietHoldRows = 200;
+/// Holds within this factor of the quietest one's σ count as quiet for the typical quiet σ.
+inline constexpr double kQuietClass = 1.5;
 /// A transition's rows are those where the normalised real load is further than this from the
 /// normalised reference (bounce and ringing of a few % stay in).
 inline constexpr double kTransitionBand = 0.1;

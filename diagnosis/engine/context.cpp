@@ -38,12 +38,23 @@ bool UniformClock(const DiagData& d, double dt) {
   return true;
 }
 
+/// The whole-record floor over the quiet-hold noise beyond which the floor is not noise.
+constexpr double kQuietNoiseRatio = 5.0;
+
 /// The robust noise per channel (or the given one) and its weights.
 void EstimateNoise(Context& cx, const Eigen::VectorXd* sigma) {
   cx.sigma.resize(cx.nc);
   cx.weight.resize(cx.nc);
   for (int c = 0; c < cx.nc; ++c) {
+    // The quiet holds' noise (typical_sigma_mvv) where the conditioning measured one and the
+    // whole-record floor is over kQuietNoiseRatio × it: load changes and ringing lift that floor,
+    // which would make real structure look like noise. Within that ratio the floor is kept (a
+    // coloured noise's first differences understate it).
+    const auto cu = static_cast<std::size_t>(c);
+    const double quiet =
+        cu < cx.conditioning.noise.size() ? cx.conditioning.noise[cu].typical_sigma_mvv : 0.0;
     double s = RobustNoise(ColD(cx.resid, c).data(), static_cast<std::size_t>(cx.n), cx.rate_hz);
+    if (quiet > 0.0 && s > kQuietNoiseRatio * quiet) s = quiet;
     // Floor: a tiny fraction of the channel's signal scale, so identical files do not divide by 0.
     const double peak = std::max(std::fabs(cx.load.col(c).maxCoeff() + cx.zero(c)),
                                  std::fabs(cx.load.col(c).minCoeff() + cx.zero(c)));

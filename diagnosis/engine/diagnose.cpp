@@ -330,6 +330,23 @@ void SpreadClaims(Context* cx, std::vector<EffectFit>* claimed_effects) {
   }
 }
 
+/// Claims whose pieces of the record contradict them (PiecesContradict) are not findings: they
+/// leave the claims for r.dropped ("not_claimed"), with the reason. At least one claim is kept
+/// only when it stands (an empty list means nothing is claimed).
+void DropContradictedClaims(const Context& cx, std::vector<EffectFit>* claimed,
+                            std::vector<std::string>* dropped) {
+  std::vector<EffectFit> kept;
+  for (EffectFit& f : *claimed) {
+    const std::string why = PiecesContradict(cx, f);
+    if (why.empty()) {
+      kept.push_back(std::move(f));
+    } else {
+      dropped->push_back(f.name + ": " + why);
+    }
+  }
+  *claimed = std::move(kept);
+}
+
 /// The claimed effects into the report, each with its held-out gain and confounders; the verdict.
 void RecordClaims(Report& r, const DiagnoseOptions& options, std::vector<EffectFit>& claimed,
                   const std::vector<Confounding>& partner_conf) {
@@ -464,6 +481,7 @@ Report DiagnoseWith(Context context, const DiagnoseOptions& options) {
       DropUnidentifiedPartner(cx, options.z_claim, &claimed, &r.dropped);
   DebugTime("claims", "partner identifiability", t0);
   SpreadClaims(&r.cx, &claimed);
+  DropContradictedClaims(r.cx, &claimed, &r.dropped);
   DebugTime("claims", "spreads across pieces", t0);
   RecordClaims(r, options, claimed, partner_conf);
   DebugTime("claims", "claims and confounders", t0);

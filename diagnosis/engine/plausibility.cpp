@@ -166,4 +166,38 @@ std::string SpreadWords(const EffectFit& fit) {
   return out;
 }
 
+std::string PiecesContradict(const Context& cx, const EffectFit& fit) {
+  const EffectSpec* spec = FindEffect(fit.name);
+  if (spec == nullptr || spec->ranges == nullptr) return "";
+  std::vector<std::string> ranged;
+  for (const ParamRange& r : spec->ranges(cx)) ranged.emplace_back(r.key);
+  for (auto it = fit.spread.begin(); it != fit.spread.end(); ++it) {
+    const auto& s = it.value();
+    if (!s.contains("min") || !fit.params.contains(it.key())) continue;
+    if (std::find(ranged.begin(), ranged.end(), it.key()) == ranged.end()) continue;
+    const nlohmann::json& v = fit.params[it.key()];
+    // The element of largest |value| (per-channel parameters: the channel that carries it).
+    std::size_t e = 0;
+    double value = 0.0;
+    const std::size_t dim = v.is_array() ? v.size() : 1;
+    for (std::size_t k = 0; k < dim; ++k) {
+      const nlohmann::json& x = v.is_array() ? v[k] : v;
+      if (x.is_number() && std::fabs(x.get<double>()) > std::fabs(value)) {
+        value = x.get<double>();
+        e = k;
+      }
+    }
+    const nlohmann::json& lo_j = s["min"].is_array() ? s["min"][e] : s["min"];
+    const nlohmann::json& hi_j = s["max"].is_array() ? s["max"][e] : s["max"];
+    if (value == 0.0 || !lo_j.is_number() || !hi_j.is_number()) continue;
+    const double lo = lo_j.get<double>();
+    const double hi = hi_j.get<double>();
+    if (lo * hi < 0.0 || hi - lo > std::fabs(value)) {
+      return Fmt("not resolved: pieces disagree (%s = %.4g, per piece %.4g–%.4g)", it.key().c_str(),
+                 value, lo, hi);
+    }
+  }
+  return "";
+}
+
 }  // namespace ftstack::diag

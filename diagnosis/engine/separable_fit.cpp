@@ -274,7 +274,8 @@ std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Se
   return peaks;
 }
 
-std::vector<std::pair<double, double>> LocalLines(const Context& cx, const Series& r) {
+std::vector<std::pair<double, double>> LocalLines(const Context& cx, const Series& r,
+                                                  double min_ratio) {
   std::vector<double> total;
   std::vector<double> freq;
   std::vector<std::pair<double, double>> peaks;
@@ -284,7 +285,7 @@ std::vector<std::pair<double, double>> LocalLines(const Context& cx, const Serie
     if (total[k] <= total[k - 1] || total[k] < total[k + 1]) continue;
     const double floor = MedianOutside(total, k > kSide ? k - kSide : 1,
                                        std::min(total.size(), k + kSide + 1), k - 2, k + 3);
-    if (total[k] < 8.0 * floor) continue;
+    if (total[k] < min_ratio * floor) continue;
     // The line between bins: the vertex of the parabola through the log powers of k − 1, k, k + 1.
     const double a = std::log(total[k - 1]);
     const double b = std::log(total[k]);

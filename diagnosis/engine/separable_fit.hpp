@@ -262,8 +262,9 @@ HatBasis MakeHat(const Context& cx, int k);
 std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Series& r);
 /// Lines of r's median-periodogram spectra (WelchMedian: load steps in a few segments do not lift
 /// it), whitened and summed over channels, that stand out of their neighbourhood (over 8 × the
-/// median of the 16 bins each side; a red spectrum's slope does not hide them), most prominent
-/// first, as (level / local median, frequency in Hz interpolated between bins).
-std::vector<std::pair<double, double>> LocalLines(const Context& cx, const Series& r);
+/// median of the 16 bins each side — `min_ratio` × — a red spectrum's slope does not hide them),
+/// most prominent first, as (level / local median, frequency in Hz interpolated between bins).
+std::vector<std::pair<double, double>> LocalLines(const Context& cx, const Series& r,
+                                                  double min_ratio = 8.0);
 
 }  // namespace ftstack::diag::fx
