@@ -25,22 +25,21 @@ bool FindOnset(const Context& cx, const Series& target, double* onset, double* t
   const auto m = rows.size();
   if (m < 40) return false;
   // Suffix sums per channel: a step from 0 to a_c after the split explains Σ_c w_c·S_c²/n_after.
-  Mat suffix = Mat::Zero(static_cast<Eigen::Index>(m + 1), cx.nc);
-  for (std::size_t j = m; j-- > 0;) {
-    for (int c = 0; c < cx.nc; ++c)
-      suffix(static_cast<Eigen::Index>(j), c) =
-          suffix(static_cast<Eigen::Index>(j + 1), c) + target(rows[j], c);
-  }
+  // Accumulated from the last row and scored on the way (memory: no m × N table); ≥ keeps the
+  // earliest split of equal gains.
+  std::vector<double> suffix(static_cast<std::size_t>(cx.nc), 0.0);
   double best = -1.0;
   std::size_t bj = 0;
-  for (std::size_t j = 10; j + 10 < m; ++j) {
+  for (std::size_t j = m; j-- > 10;) {
+    for (int c = 0; c < cx.nc; ++c) suffix[static_cast<std::size_t>(c)] += target(rows[j], c);
+    if (j + 10 >= m) continue;
     const double na = static_cast<double>(m - j);
     double g = 0.0;
     for (int c = 0; c < cx.nc; ++c) {
-      const double s = suffix(static_cast<Eigen::Index>(j), c);
+      const double s = suffix[static_cast<std::size_t>(c)];
       g += cx.weight(c) * s * s / na;
     }
-    if (g > best) {
+    if (g >= best) {
       best = g;
       bj = j;
     }

@@ -303,6 +303,11 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Sco
       top.push_back(j);
     }
   }
+  // Memory: a kept prediction that starts no pair is not used again (only the best single's may
+  // be claimed): released before the partners and backfits run.
+  for (std::size_t j = 1; j < singles.size(); ++j) {
+    if (std::find(top.begin(), top.end(), j) == top.end()) singles[j].fit.pred = Series();
+  }
   std::vector<std::vector<Partner>> partners = FitPartners(cx, options, singles, top);
   // Every start with each of its kPairPartners best partners, backfitted: one parallel batch.
   std::vector<std::pair<std::size_t, std::size_t>> pairs;  // (start t, partner y)

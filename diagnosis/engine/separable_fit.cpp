@@ -212,7 +212,8 @@ nlohmann::json IntList(const std::vector<int>& ch) {
 }
 
 double RowCorr(const Context& cx, const Series& target, const Series& pred, int c) {
-  return Correlation(ColD(target, c).data(), ColD(pred, c).data(), static_cast<std::size_t>(cx.n));
+  // Memory: the columns are read in place (a Series is column-major), not copied to double.
+  return Correlation(target.col(c).data(), pred.col(c).data(), static_cast<std::size_t>(cx.n));
 }
 
 HatBasis MakeHat(const Context& cx, int k) {

@@ -127,13 +127,16 @@ double InterpolateNear(const double* t, const double* x, std::size_t n, double t
                    u * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + u * (3.0 * (p1 - p2) + p3 - p0)));
 }
 
-double Correlation(const double* a, const double* b, std::size_t n) {
+namespace {
+
+template <class T>
+double CorrelationOf(const T* a, const T* b, std::size_t n) {
   if (n < 2) return 0.0;
   double ma = 0.0;
   double mb = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    ma += a[i];
-    mb += b[i];
+    ma += static_cast<double>(a[i]);
+    mb += static_cast<double>(b[i]);
   }
   ma /= static_cast<double>(n);
   mb /= static_cast<double>(n);
@@ -141,11 +144,21 @@ double Correlation(const double* a, const double* b, std::size_t n) {
   double saa = 0.0;
   double sbb = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    sab += (a[i] - ma) * (b[i] - mb);
-    saa += (a[i] - ma) * (a[i] - ma);
-    sbb += (b[i] - mb) * (b[i] - mb);
+    const double da = static_cast<double>(a[i]) - ma;
+    const double db = static_cast<double>(b[i]) - mb;
+    sab += da * db;
+    saa += da * da;
+    sbb += db * db;
   }
   return saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0.0;
 }
+
+}  // namespace
+
+double Correlation(const double* a, const double* b, std::size_t n) {
+  return CorrelationOf(a, b, n);
+}
+
+double Correlation(const float* a, const float* b, std::size_t n) { return CorrelationOf(a, b, n); }
 
 }  // namespace ftstack::diag

@@ -62,5 +62,8 @@ void DahlOperator(const double* x, std::size_t n, double width, double* z);
 
 /// Pearson correlation of two equally long series.
 [[nodiscard]] double Correlation(const double* a, const double* b, std::size_t n);
+/// The same of single-precision series, each value widened to double (the same sums, in the same
+/// order, as Correlation of their double copies).
+[[nodiscard]] double Correlation(const float* a, const float* b, std::size_t n);
 
 }  // namespace ftstack::diag
