@@ -8,11 +8,14 @@ hal::Status Sampler::Start(const hal::AdcConfig& config) {
   info_ = adc_.Info();
   period_us_ = info_.rate_hz > 0 ? 1000000u / info_.rate_hz : 1000u;
   if (period_us_ == 0) period_us_ = 1;
+  block_samples_ = info_.block_samples > 0 ? info_.block_samples : 1;
   return hal::Status::kOk;
 }
 
 hal::Status Sampler::Step(PublishedSample& out) {
-  hal::Status s = adc_.WaitDataReady(2 * period_us_);
+  // A block's data-ready comes block_samples periods after the previous block's: one period of
+  // slack on top, as for a single sample.
+  hal::Status s = adc_.WaitDataReady((block_samples_ + 1u) * period_us_);
   if (s == hal::Status::kOk) s = adc_.Read(sample_);
   if (s == hal::Status::kEndOfData) return s;
   if (s != hal::Status::kOk) {
