@@ -1,5 +1,6 @@
 #include "firmware/device.hpp"
 
+#include <algorithm>
 #include <ctime>
 
 namespace ftstack::fw {
@@ -27,8 +28,11 @@ DeviceStatus Device::Start(const DeviceConfig& config) {
   const std::uint32_t rate = sampler_.info().rate_hz > 0 ? sampler_.info().rate_hz : 1;
   sample_period_us_ = 1000000u / rate > 0 ? 1000000u / rate : 1u;
   const std::uint32_t block = sampler_.info().block_samples > 0 ? sampler_.info().block_samples : 1;
-  late_after_us_ = block * sample_period_us_;
-  stale_after_us_ = (block + 1) * sample_period_us_;
+  // In 64 bits, saturated: a large block at a slow rate must not wrap the limits to small ones.
+  const std::uint64_t late_after = std::uint64_t{block} * sample_period_us_;
+  late_after_us_ = static_cast<std::uint32_t>(std::min<std::uint64_t>(late_after, 0xFFFFFFFFu));
+  stale_after_us_ = static_cast<std::uint32_t>(
+      std::min<std::uint64_t>(late_after + sample_period_us_, 0xFFFFFFFFu));
   tare_samples_ = config.tare_samples;
   if (tare_samples_ == 0) {
     const std::uint32_t n = rate / 10;

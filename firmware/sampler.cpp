@@ -1,5 +1,7 @@
 #include "firmware/sampler.hpp"
 
+#include <algorithm>
+
 namespace ftstack::fw {
 
 hal::Status Sampler::Start(const hal::AdcConfig& config) {
@@ -15,7 +17,9 @@ hal::Status Sampler::Start(const hal::AdcConfig& config) {
 hal::Status Sampler::Step(PublishedSample& out) {
   // A block's data-ready comes block_samples periods after the previous block's: one period of
   // slack on top, as for a single sample.
-  hal::Status s = adc_.WaitDataReady((block_samples_ + 1u) * period_us_);
+  const std::uint64_t timeout_us = (std::uint64_t{block_samples_} + 1u) * period_us_;
+  hal::Status s = adc_.WaitDataReady(
+      static_cast<std::uint32_t>(std::min<std::uint64_t>(timeout_us, 0xFFFFFFFFu)));
   if (s == hal::Status::kOk) s = adc_.Read(sample_);
   if (s == hal::Status::kEndOfData) return s;
   if (s != hal::Status::kOk) {
