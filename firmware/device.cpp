@@ -1,5 +1,6 @@
 #include "firmware/device.hpp"
 
+#include <algorithm>
 #include <ctime>
 
 namespace ftstack::fw {
@@ -20,9 +21,18 @@ DeviceStatus Device::Start(const DeviceConfig& config) {
   bool any_rated = false;
   for (const std::int32_t r : config.rated_lsb) any_rated = any_rated || r != 0;
   if (any_rated && !overload_.Configure(config.rated_lsb)) return DeviceStatus::kBadRated;
+  // The ADC's conversion times count from its configuration: that instant is the samples' time
+  // origin on the device clock.
+  const std::uint64_t adc_start_us = clock_();
   if (sampler_.Start(config.adc) != hal::Status::kOk) return DeviceStatus::kAdcConfig;
   const std::uint32_t rate = sampler_.info().rate_hz > 0 ? sampler_.info().rate_hz : 1;
   sample_period_us_ = 1000000u / rate > 0 ? 1000000u / rate : 1u;
+  const std::uint32_t block = sampler_.info().block_samples > 0 ? sampler_.info().block_samples : 1;
+  // In 64 bits, saturated: a large block at a slow rate must not wrap the limits to small ones.
+  const std::uint64_t late_after = std::uint64_t{block} * sample_period_us_;
+  late_after_us_ = static_cast<std::uint32_t>(std::min<std::uint64_t>(late_after, 0xFFFFFFFFu));
+  stale_after_us_ = static_cast<std::uint32_t>(
+      std::min<std::uint64_t>(late_after + sample_period_us_, 0xFFFFFFFFu));
   tare_samples_ = config.tare_samples;
   if (tare_samples_ == 0) {
     const std::uint32_t n = rate / 10;
@@ -46,12 +56,13 @@ DeviceStatus Device::Start(const DeviceConfig& config) {
   last_.cal_crc = config.slots[active_.cal_slot].crc32;
   last_.publish_period_us = sample_period_us_;
   last_.sample_period_us = sample_period_us_;
+  last_.stale_after_us = stale_after_us_;
   last_.publish_time_us = clock_();
-  start_us_ = last_.publish_time_us;
+  start_us_ = adc_start_us;
   stamped_ = false;
   last_stamp_us_ = 0;
   last_sample_us_.store(last_.publish_time_us, std::memory_order_release);
-  previous_read_us_ = 0;
+  gap_judged_ = false;
   late_samples_ = 0;
   last_.health_on = health_.configured();
   last_.sample.status = kStatusStale;  // nothing sampled yet
@@ -126,6 +137,40 @@ void Device::WatchHealth(const PublishedSample& p, std::uint16_t status) {
   health_.Step(in);
 }
 
+void Device::JudgeTiming(PublishedSample* p, std::uint64_t now_us) {
+  // The sample's time is when it converted, as the ADC reports it (µs since its configuration,
+  // which is start_us_ on the device clock): a sampler that reads a block at once, or falls
+  // behind, does not move it. Strictly increasing: a converter stamping two samples within one
+  // microsecond gives the second one microsecond more.
+  std::uint64_t since_start_us =
+      (static_cast<std::uint64_t>(p->timestamp_wraps) << 32) | p->timestamp_us;
+  if (stamped_ && since_start_us <= last_stamp_us_) since_start_us = last_stamp_us_ + 1;
+  const std::uint64_t previous_us = last_stamp_us_;
+  stamped_ = true;
+  last_stamp_us_ = since_start_us;
+  p->timestamp_us = static_cast<std::uint32_t>(since_start_us);
+  p->timestamp_wraps = static_cast<std::uint16_t>(since_start_us >> 32);
+  // A virtual timeline (the unpaced simulator) has no place on the clock: its samples count as
+  // converted when read.
+  const bool on_clock = sampler_.info().clock_timestamps;
+  const std::uint64_t converted_us = on_clock ? start_us_ + since_start_us : now_us;
+  last_sample_us_.store(converted_us, std::memory_order_release);
+  // Missed deadlines, judged on conversion times: conversions more than 1.5 periods apart lost
+  // the periods in between (a converter stamping at data-ready shows a sampler that fell behind
+  // this way), and a sample read more than one block after it converted was late itself.
+  std::uint64_t missed = 0;
+  if (gap_judged_ && since_start_us - previous_us > 3ull * sample_period_us_ / 2) {
+    missed = (since_start_us - previous_us + sample_period_us_ / 2) / sample_period_us_ - 1;
+  }
+  gap_judged_ = true;
+  if (now_us > converted_us && now_us - converted_us > late_after_us_) ++missed;
+  if (missed == 0) return;
+  late_samples_ = missed > 0xFFFFFFFFull - late_samples_
+                      ? 0xFFFFFFFFu
+                      : late_samples_ + static_cast<std::uint32_t>(missed);
+  sticky_status_ |= kStatusLate;
+}
+
 hal::Status Device::Step(bool* published) {
   *published = false;
   if (settings_.writes() != settings_seen_) ApplySettings();
@@ -134,7 +179,7 @@ hal::Status Device::Step(bool* published) {
   if (s == hal::Status::kEndOfData) return s;
   if (s != hal::Status::kOk) {
     // The gap a backend fault leaves is that fault's (bits 3 and 8), not a late sampler.
-    previous_read_us_ = 0;
+    gap_judged_ = false;
     // Publish the fault bits at once; the wrench and sequence stay those of the last sample.
     last_.sample.status = p.status;
     published_.Write(last_);
@@ -143,29 +188,7 @@ hal::Status Device::Step(bool* published) {
   }
   ++samples_;
   const std::uint64_t now_us = clock_();
-  last_sample_us_.store(now_us, std::memory_order_release);
-  // The sample's time is when it was read, on the device's monotonic clock since Start — not
-  // the backend's count × period, which stays regular while the sampler falls behind. Strictly
-  // increasing: a sample read within the microsecond of the previous one (a catch-up burst) is
-  // stamped one microsecond after it.
-  std::uint64_t since_start_us = now_us - start_us_;
-  if (stamped_ && since_start_us <= last_stamp_us_) since_start_us = last_stamp_us_ + 1;
-  stamped_ = true;
-  last_stamp_us_ = since_start_us;
-  p.timestamp_us = static_cast<std::uint32_t>(since_start_us);
-  p.timestamp_wraps = static_cast<std::uint16_t>(since_start_us >> 32);
-  if (previous_read_us_ != 0 && now_us - previous_read_us_ > 3ull * sample_period_us_ / 2) {
-    // Read late: the periods skipped (rounded) are deadlines missed. The status bit says so in
-    // the next publication; the counter keeps them.
-    const std::uint64_t periods =
-        (now_us - previous_read_us_ + sample_period_us_ / 2) / sample_period_us_;
-    const std::uint64_t missed = periods - 1;
-    late_samples_ = missed > 0xFFFFFFFFull - late_samples_
-                        ? 0xFFFFFFFFu
-                        : late_samples_ + static_cast<std::uint32_t>(missed);
-    sticky_status_ |= kStatusLate;
-  }
-  previous_read_us_ = now_us;
+  JudgeTiming(&p, now_us);
   const CoreOutput& core = sampler_.core_output();
   // Overload and peaks judge the load the body carries: untared, also while a bridge saturates.
   if (core.structural_valid && overload_.configured()) {
@@ -211,6 +234,7 @@ hal::Status Device::Step(bool* published) {
   d.cal_crc = config_.slots[active_.cal_slot].crc32;
   d.publish_period_us = sample_period_us_ * active_.decimation;
   d.sample_period_us = sample_period_us_;
+  d.stale_after_us = stale_after_us_;
   d.late_samples = late_samples_;
   d.payload_mass_ug = config_.payload.present ? config_.payload.mass_ug : 0;
   d.payload_crc = config_.payload_crc;

@@ -28,7 +28,10 @@ struct DeviceSample {
   std::uint8_t cal_slot = 0;            ///< active calibration slot
   std::uint64_t publish_time_us = 0;    ///< device clock at the last successful publication
   std::uint32_t publish_period_us = 0;  ///< expected time between publications
-  std::uint32_t sample_period_us = 0;   ///< expected time between samples (the stale limit's unit)
+  std::uint32_t sample_period_us = 0;   ///< expected time between samples
+  /// Stale limit: the newest sample converted more than this long ago (one ADC block and one
+  /// period: a block's first sample waits for its last).
+  std::uint32_t stale_after_us = 0;
   std::uint32_t late_samples = 0;       ///< samples read late since start (missed deadlines)
   std::int64_t payload_mass_ug = 0;     ///< payload of gravity compensation, µg (0: none)
   std::uint32_t payload_crc = 0;        ///< CRC-32 of its payload file (input registers 79–80)
@@ -117,18 +120,23 @@ class Device {
   [[nodiscard]] std::uint32_t sample_period_us() const { return sample_period_us_; }
   /// Samples processed by Step (successful reads).
   [[nodiscard]] std::uint64_t samples() const { return samples_; }
-  /// Device clock when the latest sample was read (any thread): what "stale" is judged on.
+  /// Device clock at which the newest sample read converted (any thread): what "stale" is judged
+  /// on.
   [[nodiscard]] std::uint64_t last_sample_us() const {
     return last_sample_us_.load(std::memory_order_acquire);
   }
-  /// Missed sampling deadlines since start: a read more than 1.5 periods after the previous one
-  /// counts the periods it skipped.
+  /// Missed sampling deadlines since start, judged on conversion times: a conversion more than
+  /// 1.5 periods after the previous one counts the periods it skipped, a sample read more than
+  /// one ADC block after its conversion counts one.
   [[nodiscard]] std::uint32_t late_samples() const { return late_samples_; }
 
  private:
   void ApplySettings();
   /// Feeds the health watch one processed sample (and tells it of a completed tare).
   void WatchHealth(const PublishedSample& p, std::uint16_t status);
+  /// Gives the sample its conversion time since Start (strictly increasing) and applies the late
+  /// rule to it, read at device time now_us.
+  void JudgeTiming(PublishedSample* p, std::uint64_t now_us);
 
   hal::Adc& adc_;
   WrenchCore& core_;
@@ -151,10 +159,12 @@ class Device {
   std::uint32_t publish_sequence_ = 0;
   std::uint64_t samples_ = 0;
   std::atomic<std::uint64_t> last_sample_us_{0};
-  std::uint64_t start_us_ = 0;       ///< device clock at Start: the samples' time origin
+  std::uint64_t start_us_ = 0;       ///< device clock when the ADC was configured: the time origin
   std::uint64_t last_stamp_us_ = 0;  ///< time given to the previous sample, since Start
   bool stamped_ = false;
-  std::uint64_t previous_read_us_ = 0;  ///< 0 until the first sample
+  bool gap_judged_ = false;  ///< the previous conversion counts for the gap rule (no fault since)
+  std::uint32_t late_after_us_ = 1000;   ///< a sample read later than this after converting is late
+  std::uint32_t stale_after_us_ = 2000;  ///< see DeviceSample::stale_after_us
   std::uint32_t late_samples_ = 0;
 };
 

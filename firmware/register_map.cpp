@@ -76,7 +76,7 @@ void BuildInputRegisters(const DeviceSample& d, const hal::AdcInfo& adc, std::ui
   const PublishedSample& s = d.sample;
   std::uint16_t status = s.status;
   if (now_us > last_sample_us &&
-      now_us - last_sample_us > 2ull * static_cast<std::uint64_t>(d.sample_period_us)) {
+      now_us - last_sample_us > static_cast<std::uint64_t>(d.stale_after_us)) {
     status |= kStatusStale;
   }
   r[kInMapVersion] = kMapVersion;

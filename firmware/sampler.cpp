@@ -1,5 +1,7 @@
 #include "firmware/sampler.hpp"
 
+#include <algorithm>
+
 namespace ftstack::fw {
 
 hal::Status Sampler::Start(const hal::AdcConfig& config) {
@@ -8,11 +10,16 @@ hal::Status Sampler::Start(const hal::AdcConfig& config) {
   info_ = adc_.Info();
   period_us_ = info_.rate_hz > 0 ? 1000000u / info_.rate_hz : 1000u;
   if (period_us_ == 0) period_us_ = 1;
+  block_samples_ = info_.block_samples > 0 ? info_.block_samples : 1;
   return hal::Status::kOk;
 }
 
 hal::Status Sampler::Step(PublishedSample& out) {
-  hal::Status s = adc_.WaitDataReady(2 * period_us_);
+  // A block's data-ready comes block_samples periods after the previous block's: one period of
+  // slack on top, as for a single sample.
+  const std::uint64_t timeout_us = (std::uint64_t{block_samples_} + 1u) * period_us_;
+  hal::Status s = adc_.WaitDataReady(
+      static_cast<std::uint32_t>(std::min<std::uint64_t>(timeout_us, 0xFFFFFFFFu)));
   if (s == hal::Status::kOk) s = adc_.Read(sample_);
   if (s == hal::Status::kEndOfData) return s;
   if (s != hal::Status::kOk) {

@@ -12,8 +12,8 @@ namespace ftstack::fw {
 /// One published sample: everything a Modbus reply or a log row is made of.
 struct PublishedSample {
   std::uint32_t sequence = 0;  ///< +1 per published sample, wraps
-  /// Time since start, wraps every 2^32 µs: the backend's conversion time from Sampler, replaced
-  /// by Device with the monotonic time the sample was read.
+  /// When the sample converted, µs since the ADC was configured (the backend's timestamp; Device
+  /// makes it strictly increasing), wraps every 2^32 µs.
   std::uint32_t timestamp_us = 0;
   std::uint16_t timestamp_wraps = 0;  ///< how often timestamp_us wrapped (bits 32–47 of the time)
   WrenchLsb wrench{};                 ///< mN and 10 µN·m
@@ -35,9 +35,9 @@ class Sampler {
   /// Configures the ADC. Must succeed before Step.
   [[nodiscard]] hal::Status Start(const hal::AdcConfig& config);
 
-  /// Waits up to two sample periods for data, reads and processes it, fills `out`. On kTimeout or
-  /// kReadError `out` repeats the last wrench with kStatusAdcFault (and kStatusStale on timeout)
-  /// set. kEndOfData when a replay ended.
+  /// Waits up to one sample period more than a block of the ADC (AdcInfo::block_samples) for data,
+  /// reads and processes it, fills `out`. On kTimeout or kReadError `out` repeats the last wrench
+  /// with kStatusAdcFault (and kStatusStale on timeout) set. kEndOfData when a replay ended.
   [[nodiscard]] hal::Status Step(PublishedSample& out);
 
   [[nodiscard]] const hal::AdcInfo& info() const { return info_; }
@@ -55,6 +55,7 @@ class Sampler {
   PublishedSample last_{};
   std::uint32_t sequence_ = 0;
   std::uint32_t period_us_ = 1000;
+  std::uint32_t block_samples_ = 1;
   std::uint32_t read_errors_ = 0;
   std::uint32_t timeouts_ = 0;
 };

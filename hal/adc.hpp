@@ -67,6 +67,14 @@ struct AdcInfo {
   std::int64_t full_scale_nvv = 0;  ///< bridge input at max_counts, nV/V
   std::uint32_t rate_hz = 0;        ///< configured sample rate, Hz
   bool simulated = false;           ///< true for the simulated backend (status bit 7)
+  /// Conversions per data-ready (a FIFO's watermark): WaitDataReady may wait until this many
+  /// samples have converted, which Read then delivers one by one without waiting, each with its
+  /// own conversion time. 1: one data-ready per conversion.
+  std::uint16_t block_samples = 1;
+  /// AdcSample::timestamp_us is on the caller's monotonic clock (since Configure). False for a
+  /// converter on a virtual timeline (the unpaced simulator): its times say nothing about when
+  /// a sample was due, so no lateness can be judged from them.
+  bool clock_timestamps = true;
 };
 
 /// One simultaneous reading of all channels.
@@ -74,7 +82,10 @@ struct AdcSample {
   std::uint8_t channel_count = 0;
   std::array<std::int32_t, kMaxChannels> counts{};  ///< signed raw ADC value per channel, counts
   std::array<std::uint8_t, kMaxChannels> flags{};   ///< ChannelFlag bits per channel
-  std::uint64_t timestamp_us = 0;      ///< time of conversion since the backend started, µs
+  /// When this sample converted, µs since the backend was configured (on the caller's
+  /// CLOCK_MONOTONIC unless AdcInfo::clock_timestamps is false): the converter's schedule for a
+  /// simulated ADC, data-ready for a hardware driver. Never the time it was read.
+  std::uint64_t timestamp_us = 0;
   std::int32_t temperature_mdegc = 0;  ///< sensor body temperature, m°C (valid if has_temperature)
   bool has_temperature = false;
 };

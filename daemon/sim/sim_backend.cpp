@@ -1,5 +1,6 @@
 #include "daemon/sim/sim_backend.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -16,6 +17,10 @@
 
 namespace ftstack::daemon {
 namespace {
+
+/// Wake-ups per second of the sampling thread at most: the simulated converter delivers
+/// rate / kBlockHz samples per data-ready (1 ms of latency for the block's first sample).
+constexpr std::uint32_t kBlockHz = 1000;
 
 /// Bridge outputs rendered once at start-up by the simulator's effect composition (what
 /// `ftsim record --effect` injects), read back at each conversion's time; after the rendered span
@@ -113,6 +118,10 @@ class SimulatedBackend final : public AdcBackend {
     params.speed = opt.sim_speed;
     params.stall_every = opt.sim_stall_every;
     params.stall_us = static_cast<std::uint32_t>(opt.sim_stall_ms * 1000.0);
+    // One wake-up of the sampling thread per millisecond of samples at most (a converter FIFO's
+    // watermark): the samples keep their own conversion times, the wake-ups cost the kernel.
+    params.block_samples = static_cast<std::uint16_t>(
+        std::clamp<std::uint32_t>(opt.rate_hz / kBlockHz, 1, hal::sim::kMaxBlockSamples));
     return params;
   }
 

@@ -30,7 +30,8 @@ Status SimAdc::DoConfigure(const AdcConfig& config) {
       config.gain == 0 || config.channel_count != source_.channel_count() ||
       config.rate_hz > 1000000 ||
       (params_.required_gain != 0 && config.gain != params_.required_gain) ||
-      (params_.required_rate_hz != 0 && config.rate_hz != params_.required_rate_hz)) {
+      (params_.required_rate_hz != 0 && config.rate_hz != params_.required_rate_hz) ||
+      params_.block_samples < 1 || params_.block_samples > kMaxBlockSamples) {
     return Status::kInvalidArgument;
   }
   const std::int64_t half = std::int64_t{1} << (params_.resolution_bits - 1);
@@ -41,6 +42,8 @@ Status SimAdc::DoConfigure(const AdcConfig& config) {
   info_.full_scale_nvv = std::llround(full_scale_mvv * 1e6);
   info_.rate_hz = config.rate_hz;
   info_.simulated = true;
+  info_.block_samples = params_.realtime ? params_.block_samples : 1;
+  info_.clock_timestamps = params_.realtime;
   counts_per_mvv_ = static_cast<double>(info_.max_counts) / full_scale_mvv;
   configured_ = true;
   ready_ = false;
@@ -56,19 +59,28 @@ Status SimAdc::DoWaitDataReady(std::uint32_t timeout_us) {
     return Status::kTimeout;
   }
   if (params_.realtime) {
-    const double speed = params_.speed > 0 ? params_.speed : 1.0;
-    const std::int64_t due_ns =
-        start_ns_ +
-        static_cast<std::int64_t>(static_cast<double>(index_) * 1e9 / (info_.rate_hz * speed));
+    // A converter with a FIFO: while converted samples wait in it, data-ready is already there;
+    // an empty FIFO signals when the last sample of the block (samples n·B … n·B + B − 1)
+    // holding the next one has converted.
     const std::int64_t now_ns = MonotonicNs();
-    if (due_ns > now_ns + std::int64_t{timeout_us} * 1000) {
-      SleepUntilNs(now_ns + std::int64_t{timeout_us} * 1000);
-      return Status::kTimeout;
+    if (DueNs(index_) > now_ns) {
+      const std::uint64_t block = info_.block_samples;
+      const std::int64_t wake_ns = DueNs(index_ / block * block + block - 1);
+      if (wake_ns > now_ns + std::int64_t{timeout_us} * 1000) {
+        SleepUntilNs(now_ns + std::int64_t{timeout_us} * 1000);
+        return Status::kTimeout;
+      }
+      SleepUntilNs(wake_ns);
     }
-    if (due_ns > now_ns) SleepUntilNs(due_ns);
   }
   ready_ = true;
   return Status::kOk;
+}
+
+std::int64_t SimAdc::DueNs(std::uint64_t index) const {
+  const double speed = params_.speed > 0 ? params_.speed : 1.0;
+  return start_ns_ +
+         static_cast<std::int64_t>(static_cast<double>(index) * 1e9 / (info_.rate_hz * speed));
 }
 
 Status SimAdc::DoRead(AdcSample& out) {
@@ -77,7 +89,9 @@ Status SimAdc::DoRead(AdcSample& out) {
   ready_ = false;
   const std::uint8_t n = info_.channel_count;
   const double t_s = static_cast<double>(index_) / info_.rate_hz;
-  const std::uint64_t timestamp_us = index_ * 1000000ULL / info_.rate_hz;
+  const std::uint64_t timestamp_us =
+      params_.realtime ? static_cast<std::uint64_t>(DueNs(index_) - start_ns_) / 1000u
+                       : index_ * 1000000ULL / info_.rate_hz;
   ++index_;
   if (params_.stall_every != 0 && params_.stall_us != 0 && index_ % params_.stall_every == 0) {
     SleepUntilNs(MonotonicNs() + std::int64_t{params_.stall_us} * 1000);

@@ -49,10 +49,17 @@ struct SimAdcParams {
   /// sampling thread were preempted there — deterministic late samples for tests.
   std::uint32_t stall_every = 0;
   std::uint32_t stall_us = 0;
+  /// With realtime: conversions per data-ready (1 … kMaxBlockSamples), like a converter's FIFO
+  /// with a watermark. The caller wakes once per block and reads the block without waiting.
+  std::uint16_t block_samples = 1;
 };
 
+/// Largest block of SimAdcParams::block_samples.
+inline constexpr std::uint16_t kMaxBlockSamples = 64;
+
 /// Simulated ratiometric delta-sigma ADC. counts = round(mV/V · max_counts / full_scale_mvv +
-/// noise), clipped to the rails. Time is n / rate_hz for the n-th sample.
+/// noise), clipped to the rails. The n-th sample converts at n / rate_hz (simulated time); its
+/// timestamp is that instant on the wall clock when paced (realtime), the simulated time if not.
 class SimAdc final : public Adc {
  public:
   SimAdc(BridgeSignalSource& source, const SimAdcParams& params);
@@ -72,6 +79,8 @@ class SimAdc final : public Adc {
   Status DoWaitDataReady(std::uint32_t timeout_us) override;
   Status DoRead(AdcSample& out) override;
   AdcInfo DoInfo() const override { return info_; }
+  /// Wall-clock instant (CLOCK_MONOTONIC, ns) at which sample `index` converts when paced.
+  [[nodiscard]] std::int64_t DueNs(std::uint64_t index) const;
 
   BridgeSignalSource& source_;
   SimAdcParams params_;

@@ -1,4 +1,5 @@
-// A scripted ADC for firmware tests: returns the counts and status the test sets, no timing.
+// A scripted ADC for firmware tests: returns the counts and status the test sets; stamps each
+// sample at data-ready on the test's clock when it has one.
 #pragma once
 
 #include <array>
@@ -13,8 +14,11 @@ class FakeAdc final : public hal::Adc {
  public:
   std::array<std::int32_t, hal::kMaxChannels> counts{};
   hal::Status next_status = hal::Status::kOk;  ///< what WaitDataReady returns
-  std::uint64_t timestamp_us = 0;
+  std::uint64_t timestamp_us = 0;  ///< without a clock: the next stamp, then + one period per read
   std::int32_t temperature_mdegc = 20000;
+  /// The test's clock (µs): with it a read is stamped when it happens, since Configure, as a
+  /// hardware driver stamps at data-ready.
+  std::uint64_t (*clock_us)() = nullptr;
 
  private:
   hal::Status DoConfigure(const hal::AdcConfig& config) override {
@@ -24,6 +28,7 @@ class FakeAdc final : public hal::Adc {
     info_.full_scale_nvv = 3906250;
     info_.rate_hz = config.rate_hz;
     info_.simulated = false;
+    if (clock_us != nullptr) start_us_ = clock_us();
     return hal::Status::kOk;
   }
   hal::Status DoWaitDataReady(std::uint32_t) override { return next_status; }
@@ -31,6 +36,7 @@ class FakeAdc final : public hal::Adc {
     out = hal::AdcSample{};
     out.channel_count = info_.channel_count;
     out.counts = counts;
+    if (clock_us != nullptr) timestamp_us = clock_us() - start_us_;
     out.timestamp_us = timestamp_us;
     timestamp_us += 1000000u / info_.rate_hz;
     out.has_temperature = true;
@@ -39,6 +45,7 @@ class FakeAdc final : public hal::Adc {
   }
   hal::AdcInfo DoInfo() const override { return info_; }
   hal::AdcInfo info_{};
+  std::uint64_t start_us_ = 0;
 };
 
 }  // namespace ftstack::test

@@ -43,6 +43,7 @@ class RegisterMapTest : public ::testing::Test {
     cfg_.rated_lsb = kRatedLsb;
     cfg_.tare_samples = 4;
     cfg_.clock_us = &FakeClock;
+    adc_.clock_us = &FakeClock;
   }
   void StartDevice() {
     ASSERT_EQ(device_.Start(cfg_), DeviceStatus::kOk);

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <ctime>
 #include <vector>
 
 #include "hal/sim/sim_adc.hpp"
@@ -136,6 +137,47 @@ TEST(SimAdc, FaultsAndLifecycle) {
   }
   EXPECT_EQ(st, Status::kEndOfData);
   EXPECT_EQ(adc.sample_index(), 12u);
+}
+
+std::int64_t NowUs() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000;
+}
+
+TEST(SimAdc, PacedBlocksDeliverEverySampleAfterItConvertedWithItsOwnConversionTime) {
+  // 8 kHz in blocks of 8: data-ready for a block comes once its last sample has converted, and
+  // every sample carries its own conversion time (k × 125 µs), not the time it was read.
+  RampSource src(2, 1.0);
+  SimAdcParams p = Quiet();
+  p.realtime = true;
+  p.block_samples = 8;
+  SimAdc adc(src, p);
+  const std::int64_t before_us = NowUs();  // the ADC's time origin is at or after this
+  ASSERT_EQ(adc.Configure(AdcConfig{2, 128, 8000}), Status::kOk);
+  EXPECT_EQ(adc.Info().block_samples, 8);
+  AdcSample s{};
+  for (std::uint64_t k = 0; k < 400; ++k) {
+    const std::int64_t asked_us = NowUs() - before_us;
+    ASSERT_EQ(adc.WaitDataReady(9 * 125), Status::kOk) << "sample " << k;
+    const std::int64_t ready_us = NowUs() - before_us;
+    ASSERT_EQ(adc.Read(s), Status::kOk);
+    EXPECT_EQ(s.timestamp_us, k * 125) << "sample " << k;
+    // Never delivered before it converted; a block's first sample, asked for before it
+    // converted, waits for the block's last (one asked for later is in the FIFO already).
+    const std::uint64_t block_end_us = (k / 8 * 8 + 7) * 125;
+    if (k % 8 == 0 && asked_us < static_cast<std::int64_t>(k * 125)) {
+      EXPECT_GE(ready_us, static_cast<std::int64_t>(block_end_us)) << "sample " << k;
+    }
+    EXPECT_GE(ready_us, static_cast<std::int64_t>(s.timestamp_us)) << "sample " << k;
+  }
+  // The signal is sampled at the conversion instant: the ramp's 1 mV/V per s at k × 125 µs.
+  const double cpm = adc.counts_per_mvv();
+  EXPECT_NEAR(s.counts[0], std::nearbyint(399 * 125e-6 * cpm), 1.0);
+  SimAdcParams bad = Quiet();
+  bad.block_samples = 0;
+  SimAdc zero(src, bad);
+  EXPECT_EQ(zero.Configure(AdcConfig{2, 128, 8000}), Status::kInvalidArgument);
 }
 
 TEST(AdcInterface, NearRailIsOnePercentOfTheHalfSpan) {

@@ -89,9 +89,13 @@ int RdtPort(const test::FtdProcess& ftd) {
   return -1;
 }
 
-TEST(FtdRdt, TenThousandGaplessRecordsAt1kHzEqualTheModbusWrenchOfTheSameSample) {
+/// 10 000 RDT records at rate_hz: gapless, and equal to the Modbus wrench of the same sample,
+/// polled every poll_ms; each Modbus reply's timestamp (inputs 4–5) is its sample's own
+/// conversion time, (sequence − 1) / rate_hz, however the sampling thread batches its reads.
+void GaplessRecordsMatchModbus(const std::string& rate_hz, int poll_ms) {
+  const std::uint32_t period_us = 1000000u / static_cast<std::uint32_t>(std::stoul(rate_hz));
   test::FtdProcess ftd({"--adc", "sim", "--sim-wrench", "20,-10,-150,0.5,-0.3,0.2", "--rate-hz",
-                        "1000", "--modbus-tcp", "127.0.0.1:0", "--rdt", "127.0.0.1:0",
+                        rate_hz, "--modbus-tcp", "127.0.0.1:0", "--rdt", "127.0.0.1:0",
                         "--rdt-counts-per-n", "1000000", "--rdt-counts-per-nm", "1000000",
                         "--rdt-status-mask", "799"});
   ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
@@ -104,6 +108,7 @@ TEST(FtdRdt, TenThousandGaplessRecordsAt1kHzEqualTheModbusWrenchOfTheSameSample)
   std::atomic<bool> done{false};
   // The Modbus side meanwhile: sequence and wrench from one reply (one sample).
   std::map<std::uint32_t, std::array<float, 6>> modbus;
+  std::map<std::uint32_t, std::uint32_t> stamps;  // sequence → timestamp_us
   std::thread poller([&] {
     modbus_t* ctx = modbus_new_tcp("127.0.0.1", ftd.port());
     if (modbus_connect(ctx) != 0) return;
@@ -114,8 +119,9 @@ TEST(FtdRdt, TenThousandGaplessRecordsAt1kHzEqualTheModbusWrenchOfTheSameSample)
         for (int a = 0; a < 6; ++a)
           w[static_cast<std::size_t>(a)] = fw::UnpackFloat32(&r[4 + 2 * a]);
         modbus[fw::UnpackU32(r)] = w;
+        stamps[fw::UnpackU32(r)] = fw::UnpackU32(&r[fw::kInTimestampUs - fw::kInSequence]);
       }
-      std::this_thread::sleep_for(std::chrono::milliseconds(37));
+      std::this_thread::sleep_for(std::chrono::milliseconds(poll_ms));
     }
     modbus_close(ctx);
     modbus_free(ctx);
@@ -150,7 +156,19 @@ TEST(FtdRdt, TenThousandGaplessRecordsAt1kHzEqualTheModbusWrenchOfTheSameSample)
     ++matched;
   }
   EXPECT_GE(matched, 100) << "Modbus reads that fell inside the stream";
+  for (const auto& [seq, t_us] : stamps) {
+    EXPECT_EQ(t_us, (seq - 1) * period_us) << "sequence " << seq;
+  }
   EXPECT_EQ(ftd.Stop(SIGTERM), 0);
+}
+
+TEST(FtdRdt, TenThousandGaplessRecordsAt1kHzEqualTheModbusWrenchOfTheSameSample) {
+  GaplessRecordsMatchModbus("1000", 37);
+}
+
+TEST(FtdRdt, At8kHzInBlocksEveryRecordStaysAndModbusTimesAreConversionTimes) {
+  // The sampling thread reads 8 samples per wake-up here: still one record per sample, in order.
+  GaplessRecordsMatchModbus("8000", 5);
 }
 
 TEST(FtdRdt, BiasStopBufferedAndMalformedRequestsBesideOtherClients) {

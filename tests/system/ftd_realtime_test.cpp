@@ -1,4 +1,4 @@
-// ftd's sampling loop in real time, from outside: log time against the clock, late samples and
+// ftd's sampling loop in real time, from outside: log time = conversion time, late samples and
 // stale replies over Modbus (with a simulated ADC that stalls on chosen samples, under CPU load),
 // and the real-time line against what the kernel shows in /proc (issue 17, item 9).
 #include <gtest/gtest.h>
@@ -88,9 +88,10 @@ class CpuLoad {
   std::vector<pid_t> pids_;
 };
 
-TEST(FtdRealtime, LogTimeIsTheMeasuredTimeAndLateSamplesAreCounted) {
-  // Every 500th sample the simulated ADC holds the sampling thread 20 ms. Before: t advanced by
-  // exactly 1 ms on every row (count × period) while the replies said stale.
+TEST(FtdRealtime, LogTimeIsTheConversionTimeAndSamplesReadLateAreCounted) {
+  // Every 500th sample the simulated ADC holds the sampling thread 20 ms. The converter keeps
+  // converting: the log's t stays the conversion time (one period per row), and the samples read
+  // more than a period after they converted (the held one and those converted meanwhile) are late.
   test::TempDir dir("ftd_rt");
   const std::string log = dir / "log.csv";
   const auto t_spawn = Clock::now();
@@ -106,7 +107,8 @@ TEST(FtdRealtime, LogTimeIsTheMeasuredTimeAndLateSamplesAreCounted) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
     ASSERT_GE(p.seq, 1600u);
-    // Each stall of 20 ms at 1 kHz misses at least 19 deadlines (more if the machine adds some).
+    // Each stall of 20 ms at 1 kHz leaves at least 19 samples read more than 1 ms after they
+    // converted (more if the machine adds delays).
     EXPECT_GE(p.late, 19u * (p.seq / 500)) << "sequence " << p.seq;
   }
   ASSERT_EQ(ftd.Wait(20.0), 0) << ftd.Stderr();
@@ -119,16 +121,18 @@ TEST(FtdRealtime, LogTimeIsTheMeasuredTimeAndLateSamplesAreCounted) {
   const std::vector<double>& t = rec.Column("t");
   const std::vector<double>& status = rec.Column("status");
   ASSERT_GE(rec.rows(), 2000u);
-  // Row k − 1 is sample k (decimation 1, nothing dropped): samples 500, 1000, … were read at
-  // least 20 ms after the previous one, and say so (status bit 9).
-  int stalls = 0;
-  for (std::size_t k = 500; k <= rec.rows(); k += 500) {
-    EXPECT_GE(t[k - 1] - t[k - 2], 0.020) << "sample " << k;
-    EXPECT_NE(static_cast<int>(status[k - 1]) & fw::kStatusLate, 0) << "sample " << k;
-    ++stalls;
+  // Row k is sample k (decimation 1, nothing dropped), converted at k ms: the stalls do not
+  // move it.
+  for (std::size_t k = 1; k < rec.rows(); ++k) {
+    ASSERT_NEAR(t[k] - t[k - 1], 0.001, 1e-7) << "row " << k;
   }
-  // The log's time is the clock's: the span holds every stall and fits in the process's life.
-  EXPECT_GE(t.back() - t.front(), 0.020 * stalls);
+  // Sample 500m − 1 was held 20 ms; it and the samples converted during the stall until 2 ms
+  // before its end were read late, and say so (status bit 9).
+  for (std::size_t k = 499; k + 18 <= rec.rows(); k += 500) {
+    for (std::size_t j = k; j < k + 18; ++j) {
+      EXPECT_NE(static_cast<int>(status[j]) & fw::kStatusLate, 0) << "row " << j;
+    }
+  }
   EXPECT_LE(t.back(), wall_s);
 }
 
