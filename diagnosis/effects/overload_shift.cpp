@@ -171,18 +171,19 @@ std::optional<EffectFit> FitOverloadShift(const Context& cx, const Series& targe
   EffectFit e;
   e.name = "overload_shift";
   e.n_params = cx.nc + 1;
-  ChannelFit f = FitShift(cx, target, onset, 0.0, &e.pred);
+  // Fits first, the one prediction last (memory: never two n × N predictions at once).
+  ChannelFit f = FitShift(cx, target, onset, 0.0, nullptr);
+  double kept_tau = 0.0;
   // A shift that partly recovers: kept by the training BIC (nc + 1 more parameters) and only with
   // its time constant resolved inside its range.
   double log_sigma = 0.0;
   const std::optional<double> tau = RecoveryTau(cx, target, onset, &log_sigma);
   if (tau) {
-    Series pred;
-    ChannelFit g = FitShift(cx, target, onset, *tau, &pred);
+    ChannelFit g = FitShift(cx, target, onset, *tau, nullptr);
     const double log_n = std::log(std::max<double>(2.0, static_cast<double>(cx.n_train)));
     if (g.sse_w + (cx.nc + 1) * log_n < f.sse_w) {
       f = std::move(g);
-      e.pred = std::move(pred);
+      kept_tau = *tau;
       e.n_params = 2 * cx.nc + 2;
       e.variant = "partly recovering";
       e.params["recovery_tau_s"] = *tau;
@@ -190,6 +191,7 @@ std::optional<EffectFit> FitOverloadShift(const Context& cx, const Series& targe
       PutChannelCoef(cx, f, 1, "recovering_shift", &e);
     }
   }
+  FitShift(cx, target, onset, kept_tau, &e.pred);
   e.train_sse_w = f.sse_w;
   const Vec a = PutChannelCoef(cx, f, 0, "shift", &e);
   e.params["onset_s"] = onset;

@@ -192,7 +192,10 @@ std::string PiecesContradict(const Context& cx, const EffectFit& fit) {
     if (value == 0.0 || !lo_j.is_number() || !hi_j.is_number()) continue;
     const double lo = lo_j.get<double>();
     const double hi = hi_j.get<double>();
-    if (lo * hi < 0.0 || hi - lo > std::fabs(value)) {
+    // Pieces of both signs contradict the effect itself. A wide range of one sign is an uncertain
+    // size: the claim stands, its evidence and spread say the pieces disagree (a range rule
+    // dropped true creep on 4-s-hold fixtures, one piece reading 3× the whole record's fraction).
+    if (lo * hi < 0.0) {
       return Fmt("not resolved: pieces disagree (%s = %.4g, per piece %.4g–%.4g)", it.key().c_str(),
                  value, lo, hi);
     }

@@ -31,8 +31,7 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit);
 /// Why a claim is not a finding when its pieces contradict it: for some parameter with a stated
 /// physical range (EffectSpec::ranges: a scale of the physics, not a location such as an onset
 /// time, nor a load-dependent coefficient the pieces' load coverage moves) and a spread, the
-/// pieces' values (of its largest-|value| element) straddle zero, or range over more than the whole
-/// record's |value|. Empty when no parameter does.
+/// pieces' values (of its largest-|value| element) straddle zero. Empty when none does.
 [[nodiscard]] std::string PiecesContradict(const Context& cx, const EffectFit& fit);
 
 }  // namespace ftstack::diag

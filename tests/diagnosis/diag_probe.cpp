@@ -14,7 +14,8 @@ int main(int argc, char** argv) {
   std::vector<testing::FixtureEffect> fe;
   if (std::string(argv[1]) != "none") fe.push_back({argv[1], size});
   if (argc > 4) fe.push_back({argv[4], size});
-  auto fx = testing::MakeFixture(fe, seed);
+  const char* hold = std::getenv("PROBE_HOLD_S");
+  auto fx = testing::MakeFixture(fe, seed, 200.0, 1e-4, hold ? std::atof(hold) : 6.0);
   const auto t0 = std::chrono::steady_clock::now();
   const Report r = Diagnose(fx.data);
   const double ms =
@@ -31,6 +32,9 @@ int main(int argc, char** argv) {
     std::printf("   cand %-24s p=%3d z=%8.1f score=%10.1f hold=%.3g %s\n", c.name.c_str(),
                 c.n_params, c.z, c.score, c.hold_rms_after, c.eligible ? "*" : "");
   }
+  std::printf("  not_claimed %s\n  findings %s\n",
+              j.value("not_claimed", nlohmann::json()).dump().c_str(),
+              j.value("findings", nlohmann::json()).dump().substr(0, 600).c_str());
   std::printf("  mismatch %s\n", j["mismatch"].dump().substr(0, 300).c_str());
   return 0;
 }
