@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "diagnosis/engine/context.hpp"
@@ -170,25 +171,35 @@ int FirstAtLeast(F f, int a, int b, double level) {
   return -1;
 }
 
-/// Measures one edge on its channel of largest relative change: the real load normalised by its
-/// own levels before and after against the normalised reference. Returns false when the edge
-/// cannot be measured (short holds, a small change, a real change unlike the reference's).
-bool MeasureEdge(const Context& cx, const Edge& g, const std::vector<double>& sigma, Transition* t,
-                 int* from, int* to) {
-  const int before = g.s - g.hb;
-  const int after = g.ha - g.e;
-  if (before < 3 || after < 6) return false;
-  int c = 0;
+/// The channels an edge moves clearly (relative to their range: at least 0.05 and half the
+/// largest), the largest first: each settles at its own time (a hand-hung weight loads the cells
+/// unevenly).
+std::vector<int> EdgeChannels(const Context& cx, const Edge& g) {
+  std::vector<std::pair<double, int>> rel;
   double best = 0.0;
   for (int k = 0; k < cx.nc; ++k) {
     if (cx.load_range(k) <= 0) continue;
-    const double rel = std::fabs(cx.load(g.e, k) - cx.load(g.s - 1, k)) / cx.load_range(k);
-    if (rel > best) {
-      best = rel;
-      c = k;
-    }
+    const double r = std::fabs(cx.load(g.e, k) - cx.load(g.s - 1, k)) / cx.load_range(k);
+    rel.emplace_back(r, k);
+    best = std::max(best, r);
   }
-  if (best < 0.05) return false;
+  std::stable_sort(rel.begin(), rel.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<int> out;
+  for (const auto& [r, k] : rel) {
+    if (r >= 0.05 && r >= 0.5 * best) out.push_back(k);
+  }
+  return out;
+}
+
+/// Measures one edge on channel c: the real load normalised by its own levels before and after
+/// against the normalised reference. Returns false when the edge cannot be measured there (short
+/// holds, a real change unlike the reference's).
+bool MeasureEdge(const Context& cx, const Edge& g, int c, const std::vector<double>& sigma,
+                 Transition* t, int* from, int* to) {
+  const int before = g.s - g.hb;
+  const int after = g.ha - g.e;
+  if (before < 3 || after < 6) return false;
   const auto real = [&](int i) {
     return static_cast<double>(cx.resid(i, c)) + cx.load(i, c) + cx.zero(c);
   };
@@ -230,21 +241,35 @@ bool MeasureEdge(const Context& cx, const Edge& g, const std::vector<double>& si
   return true;
 }
 
-/// Reference changes between holds; those whose real load lags are excluded (with one row of
-/// margin each side).
+/// Reference changes between holds, each measured on every channel it moves clearly; the rows where
+/// any of them lags are excluded (with one row of margin each side). The transition reported is the
+/// channel that lags longest (else the one of largest change).
 void FindTransitions(Context* cx, Conditioning* out, const std::vector<std::uint8_t>& moving,
                      const std::vector<double>& sigma) {
   for (const Edge& g : Edges(*cx, moving)) {
-    Transition t;
+    Transition shown;
+    bool measured = false;
     int from = -1;
     int to = -1;
-    if (!MeasureEdge(*cx, g, sigma, &t, &from, &to)) continue;
-    if (t.excluded) {
-      Exclude(cx, from - 1, to + 1);
-      t.excluded_from_s = cx->data->t_s[static_cast<std::size_t>(std::max(0, from - 1))];
-      t.excluded_to_s = cx->data->t_s[static_cast<std::size_t>(std::min(cx->n - 1, to + 1))];
+    for (const int c : EdgeChannels(*cx, g)) {
+      Transition t;
+      int f = -1;
+      int e = -1;
+      if (!MeasureEdge(*cx, g, c, sigma, &t, &f, &e)) continue;
+      if (!measured || (t.excluded && (!shown.excluded || e - f > to - from))) shown = t;
+      measured = true;
+      if (!t.excluded) continue;
+      from = from < 0 ? f : std::min(from, f);
+      to = std::max(to, e);
     }
-    out->transitions.push_back(t);
+    if (!measured) continue;
+    if (from >= 0) {
+      Exclude(cx, from - 1, to + 1);
+      shown.excluded = true;
+      shown.excluded_from_s = cx->data->t_s[static_cast<std::size_t>(std::max(0, from - 1))];
+      shown.excluded_to_s = cx->data->t_s[static_cast<std::size_t>(std::min(cx->n - 1, to + 1))];
+    }
+    out->transitions.push_back(shown);
   }
 }
 
