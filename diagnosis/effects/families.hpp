@@ -101,6 +101,12 @@ std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target
 /// has one (effects/resonance.cpp).
 std::optional<EffectFit> LockedRingingSearch(const Context& cx, const Series& target,
                                              const EffectFit* near, bool uncertainty);
+/// First rows of the stretches between load changes: every load change the conditioning found
+/// (between holds of the reference) and every joined recording's first row; sorted, unique
+/// (effects/ringing_per_change.cpp).
+std::vector<int> LoadChangeStarts(const Context& cx);
+/// zero_drift's variant name for a level per stretch between load changes.
+inline constexpr const char* kZeroStepsAtChanges = "steps at load changes";
 /// resonance's variant name for RingingPerChange.
 inline constexpr const char* kRingingPerChange = "ringing per load change";
 /// resonance, variant kRingingPerChange (effects/ringing_per_change.cpp): a lightly damped mode

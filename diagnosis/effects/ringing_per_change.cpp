@@ -27,19 +27,6 @@ constexpr double kMinPeriods = 3.0;
 /// hand letting go and the hanger's bounce are not this mode's ringing, and would pull ζ up.
 constexpr double kSettlePeriods = 3.0;
 
-/// First rows of the stretches a ringing starts in: every load change the conditioning found
-/// (between holds of the reference) and every joined recording's first row; sorted, unique.
-std::vector<int> RingStarts(const Context& cx) {
-  std::vector<int> s;
-  for (const Transition& tr : cx.conditioning.transitions) s.push_back(tr.first_row);
-  for (std::size_t i = 0; i < cx.restart.size(); ++i) {
-    if (cx.restart[i] != 0) s.push_back(static_cast<int>(i));
-  }
-  std::sort(s.begin(), s.end());
-  s.erase(std::unique(s.begin(), s.end()), s.end());
-  return s;
-}
-
 /// The ringing's search bounds in (log f, log ζ) on this record.
 std::vector<LogBounds> RingBounds(const Context& cx, const std::vector<int>& starts) {
   std::vector<double> len;
@@ -261,9 +248,20 @@ bool SearchNearLine(const Context& cx, const Series& detrended, const std::vecto
 
 }  // namespace
 
+std::vector<int> LoadChangeStarts(const Context& cx) {
+  std::vector<int> s;
+  for (const Transition& tr : cx.conditioning.transitions) s.push_back(tr.first_row);
+  for (std::size_t i = 0; i < cx.restart.size(); ++i) {
+    if (cx.restart[i] != 0) s.push_back(static_cast<int>(i));
+  }
+  std::sort(s.begin(), s.end());
+  s.erase(std::unique(s.begin(), s.end()), s.end());
+  return s;
+}
+
 std::optional<EffectFit> RingingPerChange(const Context& cx, const Series& target,
                                           const EffectFit* near, bool uncertainty) {
-  const std::vector<int> starts = RingStarts(cx);
+  const std::vector<int> starts = LoadChangeStarts(cx);
   if (starts.empty() || cx.data == nullptr || std::ssize(cx.data->t_s) != cx.n) return std::nullopt;
   const std::vector<LogBounds> bounds = RingBounds(cx, starts);
   const bool warm = near != nullptr && near->search_state.size() == 3;

@@ -1,4 +1,6 @@
-// zero_drift: a smooth function of time per bridge (hat splines, knots chosen by BIC).
+// zero_drift: the offset of each bridge moving in time: a smooth function (hat splines, knots
+// chosen by BIC) or, variant "steps at load changes", a level per stretch between load changes
+// (the zero shifts when a weight is hung or removed by hand), whichever has the lower training BIC.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -10,8 +12,12 @@
 
 namespace ftstack::diag::fx {
 
-// Smooth functions of time per channel (hat splines), knots chosen by BIC on training rows.
-std::optional<EffectFit> FitZeroDrift(const Context& cx, const Series& target) {
+namespace {
+
+/// Smooth functions of time per channel (hat splines), knots chosen by BIC on training rows.
+/// *at_top: the BIC was still falling at the finest knot grid the record allows (the knot count is
+/// on its search bound).
+std::optional<EffectFit> FitSmoothDrift(const Context& cx, const Series& target, bool* at_top) {
   const double duration = cx.data->t_s.back() - cx.data->t_s.front();
   // Per channel hat-spline fit with k intervals on every row_step-th training row.
   auto fit_k = [&](int k, int row_step, std::vector<Vec>* beta) {
@@ -40,8 +46,12 @@ std::optional<EffectFit> FitZeroDrift(const Context& cx, const Series& target) {
   std::vector<Vec> best_beta;
   double best_sse = 0.0;
   int worse = 0;
+  int tried = 0;
+  int last_k = 0;
   for (int k : {1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48}) {
     if (duration / k < 3.0 * cx.block_s) break;
+    last_k = k;
+    ++tried;
     std::vector<Vec> beta;
     const double sse_w = fit_k(k, cx.search_stride, &beta);
     const double bic = sse_w + cx.nc * (k + 1) * Penalty(cx);
@@ -72,6 +82,102 @@ std::optional<EffectFit> FitZeroDrift(const Context& cx, const Series& target) {
       best.pred(i, c) = bc(j) * (1.0 - fr) + bc(j + 1) * fr;
     }
   }
+  *at_top = best_k == last_k && tried >= 3;
+  return best;
+}
+
+/// True when at least half the stretches share their reference load and the one before with
+/// another stretch (within 2 % of each channel's load range): only then can a zero that moves at
+/// random at each change be told from an output that depends on the load's history (hysteresis).
+bool LoadStatesRecur(const Context& cx, const std::vector<int>& starts) {
+  const auto state = [&](std::size_t k, int c) {
+    const int a = starts[k];
+    const int b = k + 1 < starts.size() ? starts[k + 1] : cx.n;
+    return cx.load((a + b) / 2, c);
+  };
+  const auto same = [&](std::size_t j, std::size_t k) {
+    for (int c = 0; c < cx.nc; ++c) {
+      const double tol = 0.02 * cx.load_range(c);
+      if (std::fabs(state(j, c) - state(k, c)) > tol) return false;
+      if ((j == 0) != (k == 0)) return false;
+      if (j > 0 && std::fabs(state(j - 1, c) - state(k - 1, c)) > tol) return false;
+    }
+    return true;
+  };
+  std::size_t recurring = 0;
+  for (std::size_t j = 0; j < starts.size(); ++j) {
+    for (std::size_t k = 0; k < starts.size(); ++k) {
+      if (k != j && same(j, k)) {
+        ++recurring;
+        break;
+      }
+    }
+  }
+  return 2 * recurring >= starts.size();
+}
+
+/// A level per channel in each stretch between load changes (fitted on its training rows); nullopt
+/// without load changes, when the load states do not recur (LoadStatesRecur) or with a stretch
+/// holding no training row.
+std::optional<EffectFit> FitHoldLevels(const Context& cx, const Series& target) {
+  std::vector<int> starts = LoadChangeStarts(cx);
+  if (starts.empty() || starts.front() != 0) starts.insert(starts.begin(), 0);
+  if (starts.size() < 2 || !LoadStatesRecur(cx, starts)) return std::nullopt;
+  EffectFit fit;
+  fit.pred.resize(cx.n, cx.nc);
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    const int a = starts[k];
+    const int b = k + 1 < starts.size() ? starts[k + 1] : cx.n;
+    for (int c = 0; c < cx.nc; ++c) {
+      double sum = 0.0;
+      int rows = 0;
+      for (int i = a; i < b; ++i) {
+        if (!cx.train[static_cast<std::size_t>(i)]) continue;
+        sum += target(i, c);
+        ++rows;
+      }
+      if (rows == 0) return std::nullopt;
+      for (int i = a; i < b; ++i) fit.pred(i, c) = sum / rows;
+    }
+  }
+  for (int c = 0; c < cx.nc; ++c) {
+    for (int i = 0; i < cx.n; ++i) {
+      if (!cx.train[static_cast<std::size_t>(i)]) continue;
+      const double r = target(i, c) - fit.pred(i, c);
+      fit.train_sse_w += r * r * cx.weight(c);
+    }
+  }
+  nlohmann::json levels = nlohmann::json::array();
+  for (int c = 0; c < cx.nc; ++c) {
+    nlohmann::json lc = nlohmann::json::array();
+    for (const int a : starts) lc.push_back(fit.pred(a, c));
+    levels.push_back(lc);
+  }
+  nlohmann::json from = nlohmann::json::array();
+  for (const int a : starts) from.push_back(cx.data->t_s[static_cast<std::size_t>(a)]);
+  fit.params["levels_mvv"] = levels;
+  fit.params["level_from_s"] = from;
+  fit.name = "zero_drift";
+  fit.n_params = cx.nc * static_cast<int>(starts.size());
+  fit.params["levels"] = static_cast<int>(starts.size());
+  fit.variant = kZeroStepsAtChanges;
+  return fit;
+}
+
+}  // namespace
+
+std::optional<EffectFit> FitZeroDrift(const Context& cx, const Series& target) {
+  bool smooth_at_top = false;
+  std::optional<EffectFit> smooth = FitSmoothDrift(cx, target, &smooth_at_top);
+  std::optional<EffectFit> steps = FitHoldLevels(cx, target);
+  const auto bic = [&](const std::optional<EffectFit>& f) {
+    return f ? f->train_sse_w + f->n_params * Penalty(cx) : std::numeric_limits<double>::infinity();
+  };
+  if (!smooth && !steps) return std::nullopt;
+  // Steps before a spline whose knot count sits on its bound; else the lower BIC.
+  const bool prefer_steps = steps && (!smooth || smooth_at_top || bic(steps) < bic(smooth));
+  EffectFit best = prefer_steps ? std::move(*steps) : std::move(*smooth);
+  const bool stepped = best.variant == kZeroStepsAtChanges;
   Vec span(cx.nc);
   for (int c = 0; c < cx.nc; ++c)
     span(c) = best.pred.col(c).maxCoeff() - best.pred.col(c).minCoeff();
@@ -84,11 +190,12 @@ std::optional<EffectFit> FitZeroDrift(const Context& cx, const Series& target) {
         Correlation(ColD(target, c).data(), cx.dtemp.data(), static_cast<std::size_t>(cx.n));
     temp_note = Fmt("; temperature explains less (r = %.2f)", rt);
   }
-  best.evidence =
-      Fmt("offset of b%d wanders by %.3g mV/V (%.1f σ) smoothly in time, r = %.2f with a %d-knot "
-          "curve%s",
-          c, span(c), span(c) / cx.sigma(c), RowCorr(cx, target, best.pred, c), best_k + 1,
-          temp_note.c_str());
+  const std::string shape =
+      stepped ? Fmt("in steps at the %d load changes", best.params["levels"].get<int>() - 1)
+              : Fmt("smoothly in time, r = %.2f with a %d-knot curve",
+                    RowCorr(cx, target, best.pred, c), best.params["knots"].get<int>());
+  best.evidence = Fmt("offset of b%d wanders by %.3g mV/V (%.1f σ) %s%s", c, span(c),
+                      span(c) / cx.sigma(c), shape.c_str(), temp_note.c_str());
   return best;
 }
 

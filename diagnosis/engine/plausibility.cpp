@@ -154,14 +154,44 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit) {
   }
 }
 
+namespace {
+
+/// The element of largest |value| of a parameter (per-channel parameters: the channel that carries
+/// it) and that value; (0, 0) when none is a number.
+std::pair<std::size_t, double> LargestElement(const nlohmann::json& v) {
+  std::size_t e = 0;
+  double value = 0.0;
+  const std::size_t dim = v.is_array() ? v.size() : 1;
+  for (std::size_t k = 0; k < dim; ++k) {
+    const nlohmann::json& x = v.is_array() ? v[k] : v;
+    if (x.is_number() && std::fabs(x.get<double>()) > std::fabs(value)) {
+      value = x.get<double>();
+      e = k;
+    }
+  }
+  return {e, value};
+}
+
+}  // namespace
+
 std::string SpreadWords(const EffectFit& fit) {
   std::string out;
   for (auto it = fit.spread.begin(); it != fit.spread.end(); ++it) {
     const auto& s = it.value();
     if (!s.contains("agree") || !s["agree"].is_boolean() || s["agree"].get<bool>()) continue;
-    if (!s["min"].is_number()) continue;
-    out += Fmt("%s%s per piece %.4g–%.4g", out.empty() ? "" : "; ", it.key().c_str(),
-               s["min"].get<double>(), s["max"].get<double>());
+    if (s["min"].is_number()) {
+      out += Fmt("%s%s per piece %.4g–%.4g", out.empty() ? "" : "; ", it.key().c_str(),
+                 s["min"].get<double>(), s["max"].get<double>());
+      continue;
+    }
+    // Per-channel pieces: those of the channel that carries the parameter.
+    if (!s["min"].is_array() || !s["max"].is_array() || !fit.params.contains(it.key())) continue;
+    const std::size_t e = LargestElement(fit.params[it.key()]).first;
+    if (e >= s["min"].size() || e >= s["max"].size() || !s["min"][e].is_number() ||
+        !s["max"][e].is_number())
+      continue;
+    out += Fmt("%s%s on b%zu per piece %.4g–%.4g", out.empty() ? "" : "; ", it.key().c_str(), e,
+               s["min"][e].get<double>(), s["max"][e].get<double>());
   }
   return out;
 }
@@ -176,17 +206,7 @@ std::string PiecesContradict(const Context& cx, const EffectFit& fit) {
     if (!s.contains("min") || !fit.params.contains(it.key())) continue;
     if (std::find(ranged.begin(), ranged.end(), it.key()) == ranged.end()) continue;
     const nlohmann::json& v = fit.params[it.key()];
-    // The element of largest |value| (per-channel parameters: the channel that carries it).
-    std::size_t e = 0;
-    double value = 0.0;
-    const std::size_t dim = v.is_array() ? v.size() : 1;
-    for (std::size_t k = 0; k < dim; ++k) {
-      const nlohmann::json& x = v.is_array() ? v[k] : v;
-      if (x.is_number() && std::fabs(x.get<double>()) > std::fabs(value)) {
-        value = x.get<double>();
-        e = k;
-      }
-    }
+    const auto [e, value] = LargestElement(v);
     const nlohmann::json& lo_j = s["min"].is_array() ? s["min"][e] : s["min"];
     const nlohmann::json& hi_j = s["max"].is_array() ? s["max"][e] : s["max"];
     if (value == 0.0 || !lo_j.is_number() || !hi_j.is_number()) continue;

@@ -246,6 +246,37 @@ TEST(DiagHonesty, FitOnABoundOrOutsideItsRangeIsNotResolved) {
   EXPECT_NE(NotResolved(cx, r).find("above its range"), std::string::npos);
 }
 
+// The pieces rule in closed form: a claim is contradicted when the pieces' values of its largest
+// element straddle zero (here b1's creep fraction −0.01, pieces −0.02…+0.004); b0's pieces
+// straddle zero too but b0 does not carry the effect; pieces of one sign leave the claim standing.
+// The evidence words name the channel whose pieces they quote.
+TEST(DiagHonesty, PiecesStraddlingZeroContradictAClaimAndOneSignDoesNot) {
+  const auto fx = testing::MakeFixture({}, 3, 200.0, kNoise, 4.0);
+  const Context cx = MakeContext(fx.data);
+  EffectFit f;
+  f.name = "creep";
+  f.params["tau_s"] = 12.0;
+  f.params["fraction"] = {0.004, -0.01, 0.001};
+  f.spread["fraction"] = {{"pieces", 4},
+                          {"agree", false},
+                          {"min", {-0.001, -0.02, 0.0005}},
+                          {"max", {0.005, 0.004, 0.002}}};
+  const std::string why = PiecesContradict(cx, f);
+  EXPECT_NE(why.find("fraction = -0.01, per piece -0.02–0.004"), std::string::npos) << why;
+  EXPECT_EQ(SpreadWords(f), "fraction on b1 per piece -0.02–0.004");
+  f.spread["fraction"]["min"] = {-0.001, -0.03, 0.0005};
+  f.spread["fraction"]["max"] = {0.005, -0.002, 0.002};
+  EXPECT_EQ(PiecesContradict(cx, f), "");
+  EXPECT_EQ(SpreadWords(f), "fraction on b1 per piece -0.03–-0.002");
+  // A parameter without a stated range (an onset time is the piece's own) never contradicts.
+  EffectFit o;
+  o.name = "overload_shift";
+  o.params["onset_s"] = 2.0;
+  o.spread["onset_s"] = {{"pieces", 3}, {"agree", false}, {"min", -1.0}, {"max", 3.0}};
+  EXPECT_EQ(PiecesContradict(cx, o), "");
+  EXPECT_EQ(SpreadWords(o), "onset_s per piece -1–3");
+}
+
 // The spread across pieces of the record covers the truth on data the creep model describes, and
 // the pieces agree with the curvature σ; the JSON report carries it next to the σ.
 TEST(DiagHonesty, CreepSpreadAcrossPiecesCoversTheTruth) {
