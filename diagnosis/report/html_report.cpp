@@ -59,12 +59,16 @@ std::string UnitOf(const std::string& key, const std::string& effect) {
   return "";
 }
 
-/// One value or a list of per-channel values.
+/// One value, a list of per-channel values, or per channel a list ("b0: …; b1: …").
 std::string Cell(const nlohmann::json& v) {
   if (v.is_number()) return Num(v.get<double>());
   if (v.is_array()) {
+    const bool nested = !v.empty() && v[0].is_array();
     std::string out;
-    for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + Cell(v[i]);
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (nested) out += (i ? "; b" : "b") + std::to_string(i) + ": ";
+      out += (i && !nested ? ", " : "") + Cell(v[i]);
+    }
     return out;
   }
   return Esc(v.is_string() ? v.get<std::string>() : v.dump());
