@@ -13,38 +13,23 @@
 #include "diagnosis/engine/diagnose.hpp"
 #include "diagnosis/report/html_report.hpp"
 #include "diagnosis/report/json_report.hpp"
+#include "tests/diagnosis/random_sensor.hpp"
 #include "tests/support/chromium.hpp"
 
 namespace ftstack::diag {
 namespace {
 
-/// The frame the step-load generators share: a random sensitivity (nc bridges × 6 wrench
-/// components, entries within ±0.02 mV/V per N or N·m) and the random draws that follow it.
-struct StepRig {
-  explicit StepRig(unsigned seed, int bridges) : rng(seed), nc(bridges), s(bridges, 6) {
-    for (int c = 0; c < nc; ++c) {
-      for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
-    }
-  }
-  double U() { return u(rng); }
-  std::mt19937_64 rng;
-  std::uniform_real_distribution<double> u{-1.0, 1.0};
-  std::normal_distribution<double> g{0.0, 1.0};
-  int nc;
-  Eigen::MatrixXd s;
-};
-
 /// n rows every dt s: a new random load (each component within ±40) every `step_rows` rows;
 /// row(i, t, &load) may change the load of row i (and add what else the row holds), the real
 /// bridge c adds extra(c) to sim = S·load and noise σ = 1e-3 mV/V.
 template <class Row, class Extra>
-DiagData StepLoads(StepRig& rig, double dt, Eigen::Index n, int step_rows, const char* name,
-                   Row row, Extra extra) {
+DiagData StepLoads(testing::RandomSensor& rig, double dt, Eigen::Index n, int step_rows,
+                   const char* name, Row row, Extra extra) {
   DiagData d;
   d.sim_name = "independent generator";
   d.real_name = name;
-  d.sim_mvv.resize(n, rig.nc);
-  d.real_mvv.resize(n, rig.nc);
+  d.sim_mvv.resize(n, rig.s.rows());
+  d.real_mvv.resize(n, rig.s.rows());
   d.wrench.resize(n, 6);
   Eigen::VectorXd w = Eigen::VectorXd::Zero(6);
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -57,7 +42,7 @@ DiagData StepLoads(StepRig& rig, double dt, Eigen::Index n, int step_rows, const
     d.t_s.push_back(t);
     d.wrench.row(i) = load.transpose().cast<float>();
     const Eigen::VectorXd b = rig.s * load;
-    for (int c = 0; c < rig.nc; ++c) {
+    for (int c = 0; c < rig.s.rows(); ++c) {
       d.sim_mvv(i, c) = b(c);
       d.real_mvv(i, c) = b(c) + extra(c) + 1e-3 * rig.g(rig.rng);
     }
@@ -70,8 +55,8 @@ DiagData StepLoads(StepRig& rig, double dt, Eigen::Index n, int step_rows, const
 /// a first-order lag `lag_s` (integrated with 20 Euler substeps per sample), and their apparent
 /// strain adds k_c · (T_gauge − 20 °C). Noise σ = 1e-3 mV/V.
 DiagData LaggingThermometer(double lag_s, double duration_s, unsigned seed) {
-  StepRig rig(seed, 6);
-  std::vector<double> k(static_cast<std::size_t>(rig.nc));
+  testing::RandomSensor rig(seed, 6);
+  std::vector<double> k(static_cast<std::size_t>(rig.s.rows()));
   for (double& v : k) v = 0.004 * (0.5 + 0.5 * std::fabs(rig.U()));  // mV/V per K: ~15 σ over 5 K
   const double dt = 0.01;
   auto thermometer = [](double t) {
@@ -135,14 +120,12 @@ TEST(DiagShapes, LaggingThermometerIsThermalZeroDriftWithTheLag) {
 /// every bridge sees through the sensitivity.
 DiagData PreisachHysteresis(unsigned seed, bool load_path = false, int period = 180,
                             int ramp = 120) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::normal_distribution<double> g(0.0, 1.0);
   const int nc = 8;
-  Eigen::MatrixXd s(nc, 6);
-  for (int c = 0; c < nc; ++c) {
-    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
-  }
+  testing::RandomSensor sensor(seed, nc);
+  auto& rng = sensor.rng;
+  auto& u = sensor.u;
+  auto& g = sensor.g;
+  const Eigen::MatrixXd& s = sensor.s;
   struct Relay {
     double up, down, weight;
   };
@@ -280,14 +263,12 @@ TEST(DiagShapes, HysteresisInTheLoadPathIsNamedHysteresisAlone) {
 DiagData CreepLags(const std::vector<double>& tau_s, const std::vector<double>& fraction,
                    double duration_s, unsigned seed,
                    std::vector<std::vector<double>>* true_fraction) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::normal_distribution<double> g(0.0, 1.0);
   const int nc = 6;
-  Eigen::MatrixXd s(nc, 6);
-  for (int c = 0; c < nc; ++c) {
-    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
-  }
+  testing::RandomSensor sensor(seed, nc);
+  auto& rng = sensor.rng;
+  auto& u = sensor.u;
+  auto& g = sensor.g;
+  const Eigen::MatrixXd& s = sensor.s;
   true_fraction->assign(tau_s.size(), std::vector<double>(nc));
   for (std::size_t k = 0; k < tau_s.size(); ++k) {
     for (int c = 0; c < nc; ++c) (*true_fraction)[k][c] = fraction[k] * (0.85 + 0.15 * u(rng));
@@ -424,8 +405,8 @@ TEST(DiagShapes, OneTimeConstantCreepIsNotGivenTwo) {
 /// σ = 1e-3 mV/V. At 400 Hz the 5th harmonic of 50.4 Hz (252 Hz) lies above Nyquist.
 DiagData MainsWithHarmonics(double f0, const std::vector<double>& amp_mvv, unsigned seed,
                             std::vector<std::vector<double>>* true_amp) {
-  StepRig rig(seed, 6);
-  const auto nc = static_cast<std::size_t>(rig.nc);
+  testing::RandomSensor rig(seed, 6);
+  const auto nc = static_cast<std::size_t>(rig.s.rows());
   true_amp->assign(amp_mvv.size(), std::vector<double>(nc));
   std::vector<std::vector<double>> phase(amp_mvv.size(), std::vector<double>(nc));
   for (std::size_t h = 0; h < amp_mvv.size(); ++h) {
@@ -497,8 +478,8 @@ TEST(DiagShapes, PureMainsLineIsNotGivenHarmonics) {
 /// after which bridge c's zero moves by a_c·(r + (1 − r)·exp(−(t − t_end)/τ)), a_c of either sign,
 /// 8–16 σ. Noise σ = 1e-3 mV/V. `end_s` receives t_end.
 DiagData RecoveringOverloadShift(double tau_s, double kept, unsigned seed, double* end_s) {
-  StepRig rig(seed, 6);
-  std::vector<double> shift(static_cast<std::size_t>(rig.nc));
+  testing::RandomSensor rig(seed, 6);
+  std::vector<double> shift(static_cast<std::size_t>(rig.s.rows()));
   for (double& v : shift) v = (rig.U() < 0 ? -1.0 : 1.0) * (0.008 + 0.008 * std::fabs(rig.U()));
   const double dt = 0.02;
   const double press_s = 120.0;
