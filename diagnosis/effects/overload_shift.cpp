@@ -52,22 +52,21 @@ bool FindOnset(const Context& cx, const Series& target, double* onset, double* t
 
 /// The zero after `onset`: a lasting shift per channel and, with tau_s > 0, a part that recovers
 /// as exp(−(t − onset)/tau_s) (a yielded adhesive or flexure relaxing part of the way back).
-ChannelFit FitShift(const Context& cx, const Series& target, double onset, double tau_s,
-                    Series* pred) {
-  const auto& t = cx.data->t_s;
-  const auto since = [&t, onset](int i) { return t[static_cast<std::size_t>(i)] - onset; };
-  if (tau_s <= 0) {
-    return FitChannels(
-        cx, target, 1, [&](int i, int, double* x) { x[0] = since(i) >= 0 ? 1.0 : 0.0; }, pred);
+/// Features of row i: the step, and with tau_s > 0 the recovery.
+struct ShiftFeatures {
+  const std::vector<double>* t_s;
+  double onset;
+  double tau_s;
+  [[nodiscard]] int Count() const { return tau_s > 0 ? 2 : 1; }
+  void operator()(int i, int, double* x) const {
+    const double s = (*t_s)[static_cast<std::size_t>(i)] - onset;
+    x[0] = s >= 0 ? 1.0 : 0.0;
+    if (tau_s > 0) x[1] = s >= 0 ? std::exp(-s / tau_s) : 0.0;
   }
-  return FitChannels(
-      cx, target, 2,
-      [&](int i, int, double* x) {
-        const double s = since(i);
-        x[0] = s >= 0 ? 1.0 : 0.0;
-        x[1] = s >= 0 ? std::exp(-s / tau_s) : 0.0;
-      },
-      pred);
+};
+
+ChannelFit FitShift(const Context& cx, const Series& target, const ShiftFeatures& feat) {
+  return FitChannels(cx, target, feat.Count(), feat, nullptr);
 }
 
 /// The recovery's time-constant range: 3 samples (and 0.2 s) to a third of the time left after the
@@ -171,19 +170,20 @@ std::optional<EffectFit> FitOverloadShift(const Context& cx, const Series& targe
   EffectFit e;
   e.name = "overload_shift";
   e.n_params = cx.nc + 1;
-  // Fits first, the one prediction last (memory: never two n × N predictions at once).
-  ChannelFit f = FitShift(cx, target, onset, 0.0, nullptr);
-  double kept_tau = 0.0;
+  // Both variants fitted without a prediction; the kept one predicts last, from its coefficients.
+  ShiftFeatures kept{&cx.data->t_s, onset, 0.0};
+  ChannelFit f = FitShift(cx, target, kept);
   // A shift that partly recovers: kept by the training BIC (nc + 1 more parameters) and only with
   // its time constant resolved inside its range.
   double log_sigma = 0.0;
   const std::optional<double> tau = RecoveryTau(cx, target, onset, &log_sigma);
   if (tau) {
-    ChannelFit g = FitShift(cx, target, onset, *tau, nullptr);
+    const ShiftFeatures recovering{&cx.data->t_s, onset, *tau};
+    ChannelFit g = FitShift(cx, target, recovering);
     const double log_n = std::log(std::max<double>(2.0, static_cast<double>(cx.n_train)));
     if (g.sse_w + (cx.nc + 1) * log_n < f.sse_w) {
       f = std::move(g);
-      kept_tau = *tau;
+      kept = recovering;
       e.n_params = 2 * cx.nc + 2;
       e.variant = "partly recovering";
       e.params["recovery_tau_s"] = *tau;
@@ -191,7 +191,7 @@ std::optional<EffectFit> FitOverloadShift(const Context& cx, const Series& targe
       PutChannelCoef(cx, f, 1, "recovering_shift", &e);
     }
   }
-  FitShift(cx, target, onset, kept_tau, &e.pred);
+  PredictChannels(cx, f, kept.Count(), kept, &e.pred);
   e.train_sse_w = f.sse_w;
   const Vec a = PutChannelCoef(cx, f, 0, "shift", &e);
   e.params["onset_s"] = onset;

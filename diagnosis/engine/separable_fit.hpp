@@ -41,6 +41,19 @@ struct ChannelFit {
   double sse_w = 0.0;
 };
 
+/// Column c of a fit's prediction: pred(i, c) = Σ_j f.beta(j, c) · feat(i, c)_j on every row
+/// (x: p doubles of work space).
+template <class F>
+void PredictChannel(const Context& cx, const ChannelFit& f, int p, int c, F& feat, double* x,
+                    Series* pred) {
+  for (int i = 0; i < cx.n; ++i) {
+    feat(i, c, x);
+    double v = 0.0;
+    for (int j = 0; j < p; ++j) v += f.beta(j, c) * x[j];
+    (*pred)(i, c) = static_cast<float>(v);
+  }
+}
+
 /// Per-channel least squares target_c ≈ Σ_j beta_jc · feat(i, c)_j on training rows; fills pred.
 template <class F>
 ChannelFit FitChannels(const Context& cx, const Series& target, int p, F feat, Series* pred,
@@ -75,16 +88,18 @@ ChannelFit FitChannels(const Context& cx, const Series& target, int p, F feat, S
     out.cov[static_cast<std::size_t>(c)] = r.cov_unit;
     out.sse(c) = r.sse;
     out.sse_w += r.sse * cx.weight(c);
-    if (pred != nullptr) {
-      for (int i = 0; i < cx.n; ++i) {
-        feat(i, c, x.data());
-        double v = 0.0;
-        for (int j = 0; j < p; ++j) v += r.beta(j) * x[static_cast<std::size_t>(j)];
-        (*pred)(i, c) = static_cast<float>(v);
-      }
-    }
+    if (pred != nullptr) PredictChannel(cx, out, p, c, feat, x.data(), pred);
   }
   return out;
+}
+
+/// The prediction of a fit FitChannels solved without one (kept only after a choice between
+/// variants): pred(i, c) = Σ_j f.beta(j, c) · feat(i, c)_j on every row, FitChannels' sums.
+template <class F>
+void PredictChannels(const Context& cx, const ChannelFit& f, int p, F feat, Series* pred) {
+  std::vector<double> x(static_cast<std::size_t>(p));
+  pred->setZero(cx.n, cx.nc);
+  for (int c = 0; c < cx.nc; ++c) PredictChannel(cx, f, p, c, feat, x.data(), pred);
 }
 
 /// The prediction of a fit whose features are streamed (ForLaggedLoad, ForRinging), made only once

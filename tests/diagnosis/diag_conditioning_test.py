@@ -12,30 +12,15 @@
 Usage: diag_conditioning_test.py FTDIAG
 """
 
-import json
 import os
-import subprocess
 import sys
 import tempfile
 
 sys.dont_write_bytecode = True
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-SUPPORT = os.path.join(ROOT, "tests", "support")
-PY = sys.executable
-
-
-def run(args):
-    subprocess.run(args, check=True, stdout=subprocess.DEVNULL)
-
-
-def diagnose(ftdiag, real, work):
-    sim = os.path.join(work, os.path.basename(real) + ".sim.csv")
-    out = os.path.join(work, os.path.basename(real) + ".json")
-    run([PY, os.path.join(SUPPORT, "static_sim.py"), real, sim])
-    run([ftdiag, "diagnose", "--sim", sim, "--real", real, "--json", out])
-    with open(out, encoding="utf-8") as f:
-        return json.load(f)
+sys.path.insert(0, os.path.join(ROOT, "tests", "support"))
+from ftdiag_runs import diagnose, generate  # noqa: E402
 
 
 def glitch_finding(report):
@@ -44,12 +29,9 @@ def glitch_finding(report):
 
 
 def check_generator(ftdiag, work, seed, rate_hz, failures):
-    real = os.path.join(work, f"gen_{seed}.csv")
-    run([PY, os.path.join(SUPPORT, "real_class_generator.py"), "--out", real, "--seed", str(seed),
-         "--duration-s", "1200", "--rate-hz", str(rate_hz), "--channels", "3"])
-    with open(real[:-4] + ".json", encoding="utf-8") as f:
-        truth = json.load(f)
-    report = diagnose(ftdiag, real, work)
+    real, truth = generate(work, seed, "--duration-s", "1200", "--rate-hz", str(rate_hz),
+                           "--channels", "3")
+    report = diagnose(ftdiag, real, work)[0]
     dt = 1.0 / truth["rate_hz_actual"]
     want = sorted((g["channel"], g["t_s"]) for g in truth["glitches"])
     finding = glitch_finding(report)
@@ -77,7 +59,7 @@ def check_generator(ftdiag, work, seed, rate_hz, failures):
 
 def check_cie324(ftdiag, work, failures):
     real = os.path.join(ROOT, "tests", "data", "real", "cie324_swing", "ketter133_2024-02-14.csv")
-    report = diagnose(ftdiag, real, work)
+    report = diagnose(ftdiag, real, work)[0]
     finding = glitch_finding(report)
     glitches = finding["glitches"] if finding else []
     per_channel = {}

@@ -12,6 +12,7 @@
 #include "diagnosis/report/html_report.hpp"
 #include "diagnosis/report/json_report.hpp"
 #include "tests/diagnosis/diag_fixture.hpp"
+#include "tests/diagnosis/random_sensor.hpp"
 
 namespace ftstack::diag {
 namespace {
@@ -373,15 +374,13 @@ TEST(DiagConditioning, WrongCodesOnLoadRampsAreFoundAndStepsAreNot) {
   // row), hold 1.5 s, and every third change is an instant step. Wrong codes of ±0.1 mV/V (100 σ
   // of the noise, 3 times the detection threshold) sit at chosen rows, two of them mid-ramp, one
   // right after a step; nothing else may be reported.
-  std::mt19937_64 rng(21);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::normal_distribution<double> g(0.0, 1.0);
   const int nc = 6;
   const Eigen::Index n = 6000;
-  Eigen::MatrixXd s(nc, 6);
-  for (int c = 0; c < nc; ++c) {
-    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
-  }
+  testing::RandomSensor sensor(21, nc);
+  auto& rng = sensor.rng;
+  auto& u = sensor.u;
+  auto& g = sensor.g;
+  const Eigen::MatrixXd& s = sensor.s;
   DiagData d;
   d.sim_name = "ramps";
   d.real_name = "ramps with wrong codes";

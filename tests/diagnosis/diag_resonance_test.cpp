@@ -15,6 +15,7 @@
 #include "diagnosis/engine/diagnose.hpp"
 #include "diagnosis/report/html_report.hpp"
 #include "diagnosis/report/json_report.hpp"
+#include "tests/diagnosis/random_sensor.hpp"
 
 namespace ftstack::diag {
 namespace {
@@ -39,14 +40,12 @@ struct Osc {
 /// `true_p` receives the participations per mode and bridge.
 DiagData Ringing(const std::vector<Mode>& modes, double segment_s, unsigned seed,
                  std::vector<std::array<double, 6>>* true_p) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::normal_distribution<double> g(0.0, 1.0);
   constexpr int nc = 6;
-  Eigen::MatrixXd s(nc, 6);
-  for (int c = 0; c < nc; ++c) {
-    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
-  }
+  testing::RandomSensor sensor(seed, nc);
+  auto& rng = sensor.rng;
+  auto& u = sensor.u;
+  auto& g = sensor.g;
+  const Eigen::MatrixXd& s = sensor.s;
   true_p->assign(modes.size(), {});
   for (std::size_t k = 0; k < modes.size(); ++k) {
     for (int c = 0; c < nc; ++c) {

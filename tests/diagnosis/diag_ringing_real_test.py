@@ -25,38 +25,19 @@ each diagnosis takes is printed, not asserted (performance lives in bench/).
 Usage: diag_ringing_real_test.py FTDIAG
 """
 
-import json
 import os
-
-import numpy as np
-import subprocess
 import sys
 import tempfile
-import time
+
+import numpy as np
 
 sys.dont_write_bytecode = True
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-SUPPORT = os.path.join(ROOT, "tests", "support")
 REAL = os.path.join(ROOT, "tests", "data", "real", "cie324_swing")
-PY = sys.executable
-sys.path.insert(0, SUPPORT)
+sys.path.insert(0, os.path.join(ROOT, "tests", "support"))
+from ftdiag_runs import diagnose, generate  # noqa: E402
 from hold_analysis import analyse  # noqa: E402
-
-
-def run(args):
-    subprocess.run(args, check=True, stdout=subprocess.DEVNULL)
-
-
-def diagnose(ftdiag, real, work):
-    sim = os.path.join(work, os.path.basename(real) + ".sim.csv")
-    out = os.path.join(work, os.path.basename(real) + ".report.json")
-    run([PY, os.path.join(SUPPORT, "static_sim.py"), real, sim])
-    t0 = time.monotonic()
-    run([ftdiag, "diagnose", "--sim", sim, "--real", real, "--json", out])
-    elapsed = time.monotonic() - t0
-    with open(out, encoding="utf-8") as f:
-        return json.load(f), elapsed
 
 
 def per_hold_taus(path):
@@ -135,10 +116,7 @@ def check_zero_shifts(seed, truth, report, failures):
 
 
 def check_generator(ftdiag, work, seed, failures):
-    real = os.path.join(work, f"gen_{seed}.csv")
-    run([PY, os.path.join(SUPPORT, "real_class_generator.py"), "--out", real, "--seed", str(seed)])
-    with open(real[:-4] + ".json", encoding="utf-8") as f:
-        truth = json.load(f)
+    real, truth = generate(work, seed)
     report, elapsed = diagnose(ftdiag, real, work)
     f_true = truth["ringing"]["freq_hz"]
     ring = [e for e in report["effects"] if e["name"] == "resonance"]

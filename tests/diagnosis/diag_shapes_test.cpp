@@ -13,60 +13,67 @@
 #include "diagnosis/engine/diagnose.hpp"
 #include "diagnosis/report/html_report.hpp"
 #include "diagnosis/report/json_report.hpp"
+#include "tests/diagnosis/random_sensor.hpp"
 #include "tests/support/chromium.hpp"
 
 namespace ftstack::diag {
 namespace {
+
+/// n rows every dt s: a new random load (each component within ±40) every `step_rows` rows;
+/// row(i, t, &load) may change the load of row i (and add what else the row holds), the real
+/// bridge c adds extra(c) to sim = S·load and noise σ = 1e-3 mV/V.
+template <class Row, class Extra>
+DiagData StepLoads(testing::RandomSensor& rig, double dt, Eigen::Index n, int step_rows,
+                   const char* name, Row row, Extra extra) {
+  DiagData d;
+  d.sim_name = "independent generator";
+  d.real_name = name;
+  d.sim_mvv.resize(n, rig.s.rows());
+  d.real_mvv.resize(n, rig.s.rows());
+  d.wrench.resize(n, 6);
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(6);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) * dt;
+    if (i % step_rows == 0) {
+      for (int a = 0; a < 6; ++a) w(a) = 40.0 * rig.U();
+    }
+    Eigen::VectorXd load = w;
+    row(i, t, &load, &d);
+    d.t_s.push_back(t);
+    d.wrench.row(i) = load.transpose().cast<float>();
+    const Eigen::VectorXd b = rig.s * load;
+    for (int c = 0; c < rig.s.rows(); ++c) {
+      d.sim_mvv(i, c) = b(c);
+      d.real_mvv(i, c) = b(c) + extra(c) + 1e-3 * rig.g(rig.rng);
+    }
+  }
+  return d;
+}
 
 /// 6 bridges at 100 Hz for `duration_s`: steps of random loads every 8 s through a fixed
 /// sensitivity; the body's thermometer follows a non-monotone profile, the gauges see it through
 /// a first-order lag `lag_s` (integrated with 20 Euler substeps per sample), and their apparent
 /// strain adds k_c · (T_gauge − 20 °C). Noise σ = 1e-3 mV/V.
 DiagData LaggingThermometer(double lag_s, double duration_s, unsigned seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::normal_distribution<double> g(0.0, 1.0);
-  const int nc = 6;
-  Eigen::MatrixXd s(nc, 6);
-  for (int c = 0; c < nc; ++c) {
-    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
-  }
-  std::vector<double> k(nc);
-  for (double& v : k) v = 0.004 * (0.5 + 0.5 * std::fabs(u(rng)));  // mV/V per K: ~15 σ over 5 K
+  testing::RandomSensor rig(seed, 6);
+  std::vector<double> k(static_cast<std::size_t>(rig.s.rows()));
+  for (double& v : k) v = 0.004 * (0.5 + 0.5 * std::fabs(rig.U()));  // mV/V per K: ~15 σ over 5 K
   const double dt = 0.01;
-  const auto n = static_cast<Eigen::Index>(duration_s / dt);
-  DiagData d;
-  d.sim_name = "independent generator";
-  d.real_name = "lagging thermometer";
-  d.sim_mvv.resize(n, nc);
-  d.real_mvv.resize(n, nc);
-  d.wrench.resize(n, 6);
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(6);
   auto thermometer = [](double t) {
     return 20.0 + 4.0 * std::sin(2.0 * M_PI * t / 400.0) + 2.0 * std::sin(2.0 * M_PI * t / 130.0);
   };
   double gauge = thermometer(0.0);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const double t = static_cast<double>(i) * dt;
-    if (i % 800 == 0) {
-      for (int a = 0; a < 6; ++a) w(a) = 40.0 * u(rng);
-    }
+  const auto row = [&](Eigen::Index i, double t, Eigen::VectorXd*, DiagData* d) {
     if (i > 0) {
       for (int sub = 0; sub < 20; ++sub) {
         const double ts = t - dt + (sub + 0.5) * dt / 20.0;
         gauge += (thermometer(ts) - gauge) * (dt / 20.0) / lag_s;
       }
     }
-    d.t_s.push_back(t);
-    d.temp_c.push_back(thermometer(t));
-    d.wrench.row(i) = w.transpose().cast<float>();
-    const Eigen::VectorXd b = s * w;
-    for (int c = 0; c < nc; ++c) {
-      d.sim_mvv(i, c) = b(c);
-      d.real_mvv(i, c) = b(c) + k[static_cast<std::size_t>(c)] * (gauge - 20.0) + 1e-3 * g(rng);
-    }
-  }
-  return d;
+    d->temp_c.push_back(thermometer(t));
+  };
+  return StepLoads(rig, dt, static_cast<Eigen::Index>(duration_s / dt), 800, "lagging thermometer",
+                   row, [&](int c) { return k[static_cast<std::size_t>(c)] * (gauge - 20.0); });
 }
 
 TEST(DiagShapes, LaggingThermometerIsThermalZeroDriftWithTheLag) {
@@ -113,14 +120,12 @@ TEST(DiagShapes, LaggingThermometerIsThermalZeroDriftWithTheLag) {
 /// every bridge sees through the sensitivity.
 DiagData PreisachHysteresis(unsigned seed, bool load_path = false, int period = 180,
                             int ramp = 120) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::normal_distribution<double> g(0.0, 1.0);
   const int nc = 8;
-  Eigen::MatrixXd s(nc, 6);
-  for (int c = 0; c < nc; ++c) {
-    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
-  }
+  testing::RandomSensor sensor(seed, nc);
+  auto& rng = sensor.rng;
+  auto& u = sensor.u;
+  auto& g = sensor.g;
+  const Eigen::MatrixXd& s = sensor.s;
   struct Relay {
     double up, down, weight;
   };
@@ -258,14 +263,12 @@ TEST(DiagShapes, HysteresisInTheLoadPathIsNamedHysteresisAlone) {
 DiagData CreepLags(const std::vector<double>& tau_s, const std::vector<double>& fraction,
                    double duration_s, unsigned seed,
                    std::vector<std::vector<double>>* true_fraction) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::normal_distribution<double> g(0.0, 1.0);
   const int nc = 6;
-  Eigen::MatrixXd s(nc, 6);
-  for (int c = 0; c < nc; ++c) {
-    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
-  }
+  testing::RandomSensor sensor(seed, nc);
+  auto& rng = sensor.rng;
+  auto& u = sensor.u;
+  auto& g = sensor.g;
+  const Eigen::MatrixXd& s = sensor.s;
   true_fraction->assign(tau_s.size(), std::vector<double>(nc));
   for (std::size_t k = 0; k < tau_s.size(); ++k) {
     for (int c = 0; c < nc; ++c) (*true_fraction)[k][c] = fraction[k] * (0.85 + 0.15 * u(rng));
@@ -402,50 +405,28 @@ TEST(DiagShapes, OneTimeConstantCreepIsNotGivenTwo) {
 /// σ = 1e-3 mV/V. At 400 Hz the 5th harmonic of 50.4 Hz (252 Hz) lies above Nyquist.
 DiagData MainsWithHarmonics(double f0, const std::vector<double>& amp_mvv, unsigned seed,
                             std::vector<std::vector<double>>* true_amp) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::normal_distribution<double> g(0.0, 1.0);
-  const int nc = 6;
-  Eigen::MatrixXd s(nc, 6);
-  for (int c = 0; c < nc; ++c) {
-    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
-  }
+  testing::RandomSensor rig(seed, 6);
+  const auto nc = static_cast<std::size_t>(rig.s.rows());
   true_amp->assign(amp_mvv.size(), std::vector<double>(nc));
   std::vector<std::vector<double>> phase(amp_mvv.size(), std::vector<double>(nc));
   for (std::size_t h = 0; h < amp_mvv.size(); ++h) {
-    for (int c = 0; c < nc; ++c) {
-      (*true_amp)[h][c] = amp_mvv[h] * (0.8 + 0.2 * u(rng));
-      phase[h][c] = M_PI * u(rng);
+    for (std::size_t c = 0; c < nc; ++c) {
+      (*true_amp)[h][c] = amp_mvv[h] * (0.8 + 0.2 * rig.U());
+      phase[h][c] = M_PI * rig.U();
     }
   }
-  const double dt = 1.0 / 400.0;
-  const Eigen::Index n = 60000;
-  DiagData d;
-  d.sim_name = "independent generator";
-  d.real_name = "mains with harmonics";
-  d.sim_mvv.resize(n, nc);
-  d.real_mvv.resize(n, nc);
-  d.wrench.resize(n, 6);
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(6);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const double t = static_cast<double>(i) * dt;
-    if (i % 2000 == 0) {
-      for (int a = 0; a < 6; ++a) w(a) = 40.0 * u(rng);
+  double t_row = 0.0;
+  const auto row = [&](Eigen::Index, double t, Eigen::VectorXd*, DiagData*) { t_row = t; };
+  const auto hum = [&](int c) {
+    double sum = 0.0;
+    for (std::size_t h = 0; h < amp_mvv.size(); ++h) {
+      const auto cu = static_cast<std::size_t>(c);
+      sum += (*true_amp)[h][cu] *
+             std::sin(2.0 * M_PI * static_cast<double>(h + 1) * f0 * t_row + phase[h][cu]);
     }
-    d.t_s.push_back(t);
-    d.wrench.row(i) = w.transpose().cast<float>();
-    const Eigen::VectorXd b = s * w;
-    for (int c = 0; c < nc; ++c) {
-      double hum = 0.0;
-      for (std::size_t h = 0; h < amp_mvv.size(); ++h) {
-        hum += (*true_amp)[h][c] *
-               std::sin(2.0 * M_PI * static_cast<double>(h + 1) * f0 * t + phase[h][c]);
-      }
-      d.sim_mvv(i, c) = b(c);
-      d.real_mvv(i, c) = b(c) + hum + 1e-3 * g(rng);
-    }
-  }
-  return d;
+    return sum;
+  };
+  return StepLoads(rig, 1.0 / 400.0, 60000, 2000, "mains with harmonics", row, hum);
 }
 
 TEST(DiagShapes, MainsOffNominalWithHarmonicsIncludingAnAliasedOne) {
@@ -497,47 +478,23 @@ TEST(DiagShapes, PureMainsLineIsNotGivenHarmonics) {
 /// after which bridge c's zero moves by a_c·(r + (1 − r)·exp(−(t − t_end)/τ)), a_c of either sign,
 /// 8–16 σ. Noise σ = 1e-3 mV/V. `end_s` receives t_end.
 DiagData RecoveringOverloadShift(double tau_s, double kept, unsigned seed, double* end_s) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::normal_distribution<double> g(0.0, 1.0);
-  const int nc = 6;
-  Eigen::MatrixXd s(nc, 6);
-  for (int c = 0; c < nc; ++c) {
-    for (int a = 0; a < 6; ++a) s(c, a) = 0.02 * u(rng);
-  }
-  std::vector<double> shift(nc);
-  for (double& v : shift) v = (u(rng) < 0 ? -1.0 : 1.0) * (0.008 + 0.008 * std::fabs(u(rng)));
+  testing::RandomSensor rig(seed, 6);
+  std::vector<double> shift(static_cast<std::size_t>(rig.s.rows()));
+  for (double& v : shift) v = (rig.U() < 0 ? -1.0 : 1.0) * (0.008 + 0.008 * std::fabs(rig.U()));
   const double dt = 0.02;
-  const auto n = static_cast<Eigen::Index>(240.0 / dt);
   const double press_s = 120.0;
   *end_s = press_s + 1.5;
-  DiagData d;
-  d.sim_name = "independent generator";
-  d.real_name = "partly recovering overload shift";
-  d.sim_mvv.resize(n, nc);
-  d.real_mvv.resize(n, nc);
-  d.wrench.resize(n, 6);
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(6);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const double t = static_cast<double>(i) * dt;
-    if (i % 300 == 0) {
-      for (int a = 0; a < 6; ++a) w(a) = 40.0 * u(rng);
-    }
-    Eigen::VectorXd load = w;
+  double after = 0.0;
+  const auto row = [&](Eigen::Index, double t, Eigen::VectorXd* load, DiagData*) {
     if (t >= press_s && t < *end_s) {
-      load.setZero();
-      load(2) = 160.0;
+      load->setZero();
+      (*load)(2) = 160.0;
     }
-    const double after = t >= *end_s ? kept + (1.0 - kept) * std::exp(-(t - *end_s) / tau_s) : 0.0;
-    d.t_s.push_back(t);
-    d.wrench.row(i) = load.transpose().cast<float>();
-    const Eigen::VectorXd b = s * load;
-    for (int c = 0; c < nc; ++c) {
-      d.sim_mvv(i, c) = b(c);
-      d.real_mvv(i, c) = b(c) + shift[static_cast<std::size_t>(c)] * after + 1e-3 * g(rng);
-    }
-  }
-  return d;
+    after = t >= *end_s ? kept + (1.0 - kept) * std::exp(-(t - *end_s) / tau_s) : 0.0;
+  };
+  return StepLoads(rig, dt, static_cast<Eigen::Index>(240.0 / dt), 300,
+                   "partly recovering overload shift", row,
+                   [&](int c) { return shift[static_cast<std::size_t>(c)] * after; });
 }
 
 TEST(DiagShapes, PartlyRecoveringOverloadShiftIsNamedOverloadShift) {
