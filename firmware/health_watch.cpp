@@ -95,12 +95,23 @@ void HealthWatch::Clear() {
   for (RainflowCounter& c : rainflow_) c.Clear();
 }
 
-void HealthWatch::OnTare(std::int32_t temperature_mdegc, bool has_temperature, bool cleared) {
+void HealthWatch::OnTare(std::int32_t temperature_mdegc, bool has_temperature, bool cleared,
+                         const WrenchLsb& load_lsb, TareSource source) {
   ResetReference(temperature_mdegc, has_temperature);
   if (cleared) return;
   tare_sample_ = static_cast<std::uint32_t>(samples_ / rate_);
   report_.tare_temp_mdegc = has_temperature ? temperature_mdegc : 0;
   ++report_.tare_count;
+  if (tares_completed_ < UINT32_MAX) ++tares_completed_;
+  // Newest first: the oldest record falls off the end (only at a tare, never per sample).
+  auto& h = report_.tares;
+  for (std::size_t k = kTareHistory - 1; k > 0; --k) h[k] = h[k - 1];
+  h[0].number = tares_completed_;
+  h[0].source = source;
+  h[0].has_temperature = has_temperature;
+  h[0].time_s = tare_sample_;
+  h[0].temperature_mdegc = has_temperature ? temperature_mdegc : 0;
+  h[0].load_lsb = load_lsb;
 }
 
 void HealthWatch::ResetReference(std::int32_t temperature_mdegc, bool has_temperature) {
