@@ -81,6 +81,12 @@ void BuildHealthHistoryRegisters(const DeviceSample& d, std::uint16_t* regs) {
                 &r[6]);
     PackWrench(t.load_lsb, &r[8]);
   }
+  std::uint16_t* bins = &regs[kInCycleBins - kInHistoryFirst];
+  for (std::size_t a = 0; a < kAxes; ++a) {
+    for (std::size_t k = 0; k < kRainflowBins; ++k) {
+      PackU32(d.health.cycle_bins[a][k], &bins[2 * (a * kRainflowBins + k)]);
+    }
+  }
 }
 
 std::uint16_t ReadHealthHolding(const DeviceSettings& s, std::uint32_t a) {

@@ -41,11 +41,13 @@ enum HealthHistoryRegister : std::uint16_t {
   /// 0 number (uint32, 0: empty), 2 source (uint16, TareSource), 3 reserved, 4 time_s (uint32),
   /// 6 temperature (float32 °C, NaN: none), 8 the load it removed (float32 × 6, N and N·m).
   kInTareHistory = 210,
-  kInHistoryEnd = 290,
+  kInCycleBins = 290,  ///< uint32 × kRainflowBins per axis, Fx … Mz: rainflow full cycles per bin
+  kInHistoryEnd = 386,
 };
 inline constexpr std::uint16_t kTareRecordRegisters = 20;
 static_assert(kInTareHistory == kInHistoryFirst);
-static_assert(kInTareHistory + kTareHistory * kTareRecordRegisters == kInHistoryEnd);
+static_assert(kInTareHistory + kTareHistory * kTareRecordRegisters == kInCycleBins);
+static_assert(kInCycleBins + kAxes * kRainflowBins * 2 == kInHistoryEnd);
 static_assert(kInHistoryEnd == kInHistoryFirst + kInHistoryCount);
 
 /// Holding register addresses of the health block: 50 command, 51 … 59 thresholds.

@@ -68,6 +68,13 @@ struct TareRecord {
 /// Tares the history keeps (the newest first).
 inline constexpr std::size_t kTareHistory = 4;
 
+/// Rainflow range bins per axis, and their upper edges in % of the axis's rated range: bin k
+/// holds full cycles with edge[k − 1] ≤ range < edge[k] (bin 1 from the 2 % turning-point gate,
+/// bin 8 from 100 % up).
+inline constexpr std::size_t kRainflowBins = 8;
+inline constexpr std::array<std::int32_t, kRainflowBins - 1> kRainflowBinEdgesPct = {5,  10, 20, 40,
+                                                                                     60, 80, 100};
+
 /// One finding: its cause and its estimated error per axis (LSB: mN, 10 µN·m).
 struct HealthFinding {
   HealthCause cause = HealthCause::kNone;
@@ -96,6 +103,8 @@ struct HealthReport {
   std::array<TareRecord, kTareHistory> tares{};  ///< the last tares, newest first
   /// Rainflow full cycles of the untared load per axis with a range ≥ 10 % of rated.
   std::array<std::uint32_t, kAxes> cycles{};
+  /// Rainflow full cycles of the untared load per axis and range bin (kRainflowBinEdgesPct).
+  std::array<std::array<std::uint32_t, kRainflowBins>, kAxes> cycle_bins{};
 };
 
 }  // namespace ftstack::fw

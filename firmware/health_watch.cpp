@@ -6,6 +6,8 @@
 #include "firmware/status_bits.hpp"
 
 namespace ftstack::fw {
+
+static_assert(RainflowCounter::kBins == kRainflowBins);
 namespace {
 
 constexpr std::int64_t kZeroClamp = std::int64_t{1} << 20;  ///< |zero point| used, LSB
@@ -55,7 +57,12 @@ bool HealthWatch::Configure(std::uint32_t rate_hz, const WrenchLsb& rated_lsb) {
   capture_stride_ = rate_hz <= 2000 ? 1 : rate_hz / 1000;
   for (std::size_t r = 0; r < kAxes; ++r) {
     // Turning points beyond 2 % of rated (noise makes none); cycles of 10 % of rated and more.
-    rainflow_[r].Configure(rated_lsb[r] / 50, rated_lsb[r] / 10);
+    RainflowCounter::BinEdges edges{};
+    for (std::size_t k = 0; k < edges.size(); ++k) {
+      edges[k] =
+          static_cast<std::int32_t>(std::int64_t{rated_lsb[r]} * kRainflowBinEdgesPct[k] / 100);
+    }
+    rainflow_[r].Configure(rated_lsb[r] / 50, rated_lsb[r] / 10, edges);
   }
   seg_len_ = 2 * rate_hz;
   configured_ = true;
@@ -533,7 +540,10 @@ void HealthWatch::Publish(const HealthInput& in) {
   r.findings = active_;
   r.ring_ref_mhz = ring_ref_mhz_;
   r.tare_age_s = static_cast<std::uint32_t>(samples_ / rate_) - tare_sample_;
-  for (std::size_t a = 0; a < kAxes; ++a) r.cycles[a] = rainflow_[a].cycles();
+  for (std::size_t a = 0; a < kAxes; ++a) {
+    r.cycles[a] = rainflow_[a].cycles();
+    r.cycle_bins[a] = rainflow_[a].bins();
+  }
   r.slots = {};
   std::size_t k = 0;
   for (std::size_t i = 0; i < kHealthCauses && k < kHealthSlots; ++i) {

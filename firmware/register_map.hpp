@@ -59,7 +59,7 @@ inline constexpr std::uint16_t kInMqttCount = 10;
 /// and the rainflow range bins, from the same published sample as 0 … 199 (layout:
 /// health_registers.hpp).
 inline constexpr std::uint16_t kInHistoryFirst = kInMqttFirst + kInMqttCount;
-inline constexpr std::uint16_t kInHistoryCount = 80;
+inline constexpr std::uint16_t kInHistoryCount = 176;
 /// Input addresses 0 … kInputAddressSpan − 1: the sample image, the MQTT block and the history
 /// block (the server's table size).
 inline constexpr std::uint16_t kInputAddressSpan = kInHistoryFirst + kInHistoryCount;

@@ -351,11 +351,11 @@ TEST_F(RegisterMapTest, AddressesOutsideTheMapGiveException02) {
   StartDevice();
   std::array<std::uint16_t, 125> buf{};
   EXPECT_EQ(map_->ReadInput(84, 1, buf.data()), ModbusException::kNone);
-  EXPECT_EQ(map_->ReadInput(199, 1, buf.data()), ModbusException::kNone);  // map v3: 0 … 289
+  EXPECT_EQ(map_->ReadInput(199, 1, buf.data()), ModbusException::kNone);  // map v3: 0 … 385
   EXPECT_EQ(map_->ReadInput(209, 2, buf.data()), ModbusException::kNone);
-  EXPECT_EQ(map_->ReadInput(289, 1, buf.data()), ModbusException::kNone);
-  EXPECT_EQ(map_->ReadInput(289, 2, buf.data()), ModbusException::kIllegalDataAddress);
-  EXPECT_EQ(map_->ReadInput(290, 1, buf.data()), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(map_->ReadInput(385, 1, buf.data()), ModbusException::kNone);
+  EXPECT_EQ(map_->ReadInput(385, 2, buf.data()), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(map_->ReadInput(386, 1, buf.data()), ModbusException::kIllegalDataAddress);
   EXPECT_EQ(map_->ReadHolding(0, 5, buf.data()), ModbusException::kNone);
   EXPECT_EQ(map_->ReadHolding(10, 12, buf.data()), ModbusException::kNone);
   // 5 … 9 are reserved, not a hole: a PLC's block read of 0 … 15 or 0 … 21 works.
@@ -405,7 +405,7 @@ TEST_F(RegisterMapTest, MqttBlockReadsThePublishersCountersAlsoInAReadAcrossBloc
   for (std::size_t i = 0; i < want.size(); ++i) EXPECT_EQ(buf[i], want[i]) << 200 + i;
   for (std::size_t i = 0; i < 10; ++i) EXPECT_EQ(buf[10 + i], alone[i]) << 210 + i;
   for (const auto& [addr, count] :
-       std::vector<std::pair<int, int>>{{289, 2}, {290, 1}, {200, 91}, {0, 291}}) {
+       std::vector<std::pair<int, int>>{{385, 2}, {386, 1}, {200, 187}, {0, 387}}) {
     EXPECT_EQ(map_->ReadInput(static_cast<std::uint16_t>(addr), static_cast<std::uint16_t>(count),
                               buf.data()),
               ModbusException::kIllegalDataAddress)

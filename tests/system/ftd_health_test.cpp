@@ -286,6 +286,15 @@ TEST(FtdHealth, StepsWithoutEffectsRaiseNothing) {
   // Load history: that one cycle on Fz, nothing on the other axes.
   const auto cycles = h.Read("3", 190, 6);
   for (int a = 0; a < 6; ++a) EXPECT_EQ(cycles.at(190 + a), a == 2 ? 1 : 0) << "axis " << a;
+  // Its range bin: 80 N of Fz's rated 400 N is 20 %, bin 4 ([20, 40) %; input 290 + 16 per axis,
+  // 2 per bin); no full cycle in any other bin of any axis.
+  const auto bins = h.Read("3:int", 290, 48);
+  for (int a = 0; a < 6; ++a) {
+    for (int k = 0; k < 8; ++k) {
+      const int addr = 290 + 16 * a + 2 * k;
+      EXPECT_EQ(bins.at(addr), a == 2 && k == 3 ? 1 : 0) << "axis " << a << " bin " << k + 1;
+    }
+  }
 }
 
 TEST(FtdHealth, PoweredUpUnderLoadIsOverloadNotBridgeFault) {
