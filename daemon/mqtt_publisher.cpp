@@ -296,7 +296,8 @@ void MqttPublisher::HandleCommands(const std::vector<Metric>& metrics) {
     } else if (opt_.mqtt_write_protect) {
       result = "refused: write-protected";
     } else {
-      const fw::ModbusException e = map_->WriteHolding(fw::kHoldCommand, &command, 1);
+      const fw::ModbusException e =
+          map_->WriteHolding(fw::kHoldCommand, &command, 1, fw::TareSource::kMqtt);
       result = e == fw::ModbusException::kNone
                    ? "accepted"
                    : "refused: register map exception " + std::to_string(static_cast<int>(e));

@@ -129,7 +129,7 @@ void RdtServer::HandleRequest(const std::uint8_t* buf, long n, std::uint32_t ip,
     case kRdtResetLatch:
     case kRdtSetBias: {
       const std::uint16_t v = cmd == kRdtSetBias ? fw::kCmdTare : fw::kCmdClearPeaks;
-      if (map_ != nullptr) (void)map_->WriteHolding(fw::kHoldCommand, &v, 1);
+      if (map_ != nullptr) (void)map_->WriteHolding(fw::kHoldCommand, &v, 1, fw::TareSource::kRdt);
       break;
     }
     default:

@@ -61,6 +61,9 @@ class WrenchCore {
   void ClearTare();
   [[nodiscard]] bool tare_active() const { return tare_active_; }
   [[nodiscard]] bool tare_pending() const { return tare_remaining_ > 0; }
+  /// The wrench of the active tare (untared − tared: the mean load it removed), sensor frame, LSB;
+  /// zero without one.
+  [[nodiscard]] const WrenchLsb& tare_offset() const { return tare_offset_; }
 
   /// Moving-average length, 1 … kMaxFilterLength; false (and unchanged) otherwise. Restarts the
   /// filter.

@@ -95,6 +95,7 @@ void Device::ApplySettings() {
     active_.tare_generation = s.tare_generation;
     if (s.tare_kind == 1) {
       (void)core_.RequestTare(tare_samples_);  // tare_samples_ is within range by construction
+      tare_source_ = s.tare_source;
     } else if (s.tare_kind == 2) {
       core_.ClearTare();
       health_.OnTare(last_.sample.temperature_mdegc, last_.sample.has_temperature, true);
@@ -120,7 +121,8 @@ void Device::WatchHealth(const PublishedSample& p, std::uint16_t status) {
   const CoreOutput& core = sampler_.core_output();
   const bool pending = core_.tare_pending();
   if (tare_was_pending_ && !pending && core_.tare_active()) {
-    health_.OnTare(p.temperature_mdegc, p.has_temperature, false);
+    health_.OnTare(p.temperature_mdegc, p.has_temperature, false, core_.tare_offset(),
+                   tare_source_);
   }
   tare_was_pending_ = pending;
   HealthInput in;

@@ -55,6 +55,7 @@ struct DeviceSettings {
   FixedToolTransform transform{};
   std::uint32_t tare_generation = 0;            ///< +1 per tare / clear-tare command
   std::uint8_t tare_kind = 0;                   ///< 1 = tare now, 2 = clear tare (the latest wins)
+  TareSource tare_source = TareSource::kNone;   ///< who asked for the latest tare command
   std::uint32_t clear_generation = 0;           ///< +1 per "clear peaks and overload counter"
   std::array<std::int32_t, 3> gravity_umps2{};  ///< gravity in the sensor frame, µm/s²
   bool gravity_comp = false;                    ///< subtract the payload (needs one)
@@ -146,6 +147,7 @@ class Device {
   OverloadMonitor overload_{};
   HealthWatch health_{};
   bool tare_was_pending_ = false;
+  TareSource tare_source_ = TareSource::kNone;  ///< who asked for the tare under way
   Seqlock<DeviceSample> published_{};
   Seqlock<DeviceSettings> settings_{};
   std::uint32_t settings_seen_ = 0;

@@ -1,5 +1,7 @@
 #include "firmware/health_registers.hpp"
 
+#include <limits>
+
 #include "firmware/register_map.hpp"
 
 namespace ftstack::fw {
@@ -63,6 +65,27 @@ void BuildHealthInputRegisters(const DeviceSample& d, std::uint16_t* regs) {
   for (std::size_t r = 0; r < kAxes; ++r) {
     *at(static_cast<std::uint16_t>(kInCycles + r)) =
         static_cast<std::uint16_t>(h.cycles[r] > 0xFFFFu ? 0xFFFFu : h.cycles[r]);
+  }
+}
+
+void BuildHealthHistoryRegisters(const DeviceSample& d, std::uint16_t* regs) {
+  for (std::size_t k = 0; k < kTareHistory; ++k) {
+    const TareRecord& t = d.health.tares[k];
+    std::uint16_t* r = &regs[kInTareHistory - kInHistoryFirst + k * kTareRecordRegisters];
+    if (t.number == 0) continue;  // an empty slot reads 0
+    PackU32(t.number, &r[0]);
+    r[2] = static_cast<std::uint16_t>(t.source);
+    PackU32(t.time_s, &r[4]);
+    PackFloat32(t.has_temperature ? static_cast<float>(t.temperature_mdegc * 1e-3)
+                                  : std::numeric_limits<float>::quiet_NaN(),
+                &r[6]);
+    PackWrench(t.load_lsb, &r[8]);
+  }
+  std::uint16_t* bins = &regs[kInCycleBins - kInHistoryFirst];
+  for (std::size_t a = 0; a < kAxes; ++a) {
+    for (std::size_t k = 0; k < kRainflowBins; ++k) {
+      PackU32(d.health.cycle_bins[a][k], &bins[2 * (a * kRainflowBins + k)]);
+    }
   }
 }
 

@@ -1,9 +1,10 @@
-// The health watch's Modbus registers: input 100 … 199 (state, findings) and holding 50 … 79.
+// The health watch's Modbus registers: input 100 … 199 and 210 … (history), holding 50 … 79.
 #pragma once
 
 #include <cstdint>
 
 #include "firmware/device.hpp"
+#include "firmware/register_map.hpp"
 
 namespace ftstack::fw {
 
@@ -34,6 +35,21 @@ enum HealthInputRegister : std::uint16_t {
   kInHealthEnd = 200,
 };
 
+/// Input register addresses of the history block (map version 3, after the MQTT block).
+enum HealthHistoryRegister : std::uint16_t {
+  /// kTareHistory records of kTareRecordRegisters, newest first; per record at offset:
+  /// 0 number (uint32, 0: empty), 2 source (uint16, TareSource), 3 reserved, 4 time_s (uint32),
+  /// 6 temperature (float32 °C, NaN: none), 8 the load it removed (float32 × 6, N and N·m).
+  kInTareHistory = 210,
+  kInCycleBins = 290,  ///< uint32 × kRainflowBins per axis, Fx … Mz: rainflow full cycles per bin
+  kInHistoryEnd = 386,
+};
+inline constexpr std::uint16_t kTareRecordRegisters = 20;
+static_assert(kInTareHistory == kInHistoryFirst);
+static_assert(kInTareHistory + kTareHistory * kTareRecordRegisters == kInCycleBins);
+static_assert(kInCycleBins + kAxes * kRainflowBins * 2 == kInHistoryEnd);
+static_assert(kInHistoryEnd == kInHistoryFirst + kInHistoryCount);
+
 /// Holding register addresses of the health block: 50 command, 51 … 59 thresholds.
 enum HealthHoldingRegister : std::uint16_t {
   kHoldHealthCommand = 50,  ///< 1 = commission, 2 = clear findings; reads 0
@@ -45,6 +61,8 @@ enum HealthCommand : std::uint16_t { kHealthCmdCommission = 1, kHealthCmdClear =
 
 /// Fills input registers 100 … 199 (regs points at address 100).
 void BuildHealthInputRegisters(const DeviceSample& d, std::uint16_t* regs);
+/// Fills the history block (regs points at address kInHistoryFirst).
+void BuildHealthHistoryRegisters(const DeviceSample& d, std::uint16_t* regs);
 /// The value holding register `a` (50 … 79) reads.
 [[nodiscard]] std::uint16_t ReadHealthHolding(const DeviceSettings& s, std::uint32_t a);
 /// Writes `v` to holding register `a` (50 … 79) of `next`; false (nothing written) when the value

@@ -47,6 +47,34 @@ struct HealthThresholds {
   bool operator==(const HealthThresholds&) const = default;
 };
 
+/// Who asked for a tare (the command reaches the device through one of these).
+enum class TareSource : std::uint8_t {
+  kNone = 0,    ///< an empty history slot
+  kModbus = 1,  ///< holding register 0 = 1 (TCP or RTU)
+  kRdt = 2,     ///< ATI RDT command 0x0042 "set software bias" (ftd --rdt)
+  kMqtt = 3,    ///< the Sparkplug command Device Control/Tare (ftd --mqtt)
+};
+
+/// One completed tare, as the history keeps it.
+struct TareRecord {
+  std::uint32_t number = 0;  ///< 1 for the first tare since start, +1 each; 0: an empty slot
+  TareSource source = TareSource::kNone;
+  bool has_temperature = false;
+  std::uint32_t time_s =
+      0;  ///< when it completed: samples the watch has seen ÷ rate (as tare_age_s)
+  std::int32_t temperature_mdegc = 0;  ///< at its completion (meaningful when has_temperature)
+  WrenchLsb load_lsb{};  ///< the untared wrench it removed (its mean load), sensor frame, LSB
+};
+/// Tares the history keeps (the newest first).
+inline constexpr std::size_t kTareHistory = 4;
+
+/// Rainflow range bins per axis, and their upper edges in % of the axis's rated range: bin k
+/// holds full cycles with edge[k − 1] ≤ range < edge[k] (bin 1 from the 2 % turning-point gate,
+/// bin 8 from 100 % up).
+inline constexpr std::size_t kRainflowBins = 8;
+inline constexpr std::array<std::int32_t, kRainflowBins - 1> kRainflowBinEdgesPct = {5,  10, 20, 40,
+                                                                                     60, 80, 100};
+
 /// One finding: its cause and its estimated error per axis (LSB: mN, 10 µN·m).
 struct HealthFinding {
   HealthCause cause = HealthCause::kNone;
@@ -72,8 +100,11 @@ struct HealthReport {
   std::uint32_t tare_age_s = 0;        ///< since the last tare (or start)
   std::int32_t tare_temp_mdegc = 0;    ///< temperature at the last tare (0 without one)
   std::uint16_t tare_count = 0;        ///< tares since start
+  std::array<TareRecord, kTareHistory> tares{};  ///< the last tares, newest first
   /// Rainflow full cycles of the untared load per axis with a range ≥ 10 % of rated.
   std::array<std::uint32_t, kAxes> cycles{};
+  /// Rainflow full cycles of the untared load per axis and range bin (kRainflowBinEdgesPct).
+  std::array<std::array<std::uint32_t, kRainflowBins>, kAxes> cycle_bins{};
 };
 
 }  // namespace ftstack::fw

@@ -6,6 +6,8 @@
 #include "firmware/status_bits.hpp"
 
 namespace ftstack::fw {
+
+static_assert(RainflowCounter::kBins == kRainflowBins);
 namespace {
 
 constexpr std::int64_t kZeroClamp = std::int64_t{1} << 20;  ///< |zero point| used, LSB
@@ -55,7 +57,12 @@ bool HealthWatch::Configure(std::uint32_t rate_hz, const WrenchLsb& rated_lsb) {
   capture_stride_ = rate_hz <= 2000 ? 1 : rate_hz / 1000;
   for (std::size_t r = 0; r < kAxes; ++r) {
     // Turning points beyond 2 % of rated (noise makes none); cycles of 10 % of rated and more.
-    rainflow_[r].Configure(rated_lsb[r] / 50, rated_lsb[r] / 10);
+    RainflowCounter::BinEdges edges{};
+    for (std::size_t k = 0; k < edges.size(); ++k) {
+      edges[k] =
+          static_cast<std::int32_t>(std::int64_t{rated_lsb[r]} * kRainflowBinEdgesPct[k] / 100);
+    }
+    rainflow_[r].Configure(rated_lsb[r] / 50, rated_lsb[r] / 10, edges);
   }
   seg_len_ = 2 * rate_hz;
   configured_ = true;
@@ -95,12 +102,23 @@ void HealthWatch::Clear() {
   for (RainflowCounter& c : rainflow_) c.Clear();
 }
 
-void HealthWatch::OnTare(std::int32_t temperature_mdegc, bool has_temperature, bool cleared) {
+void HealthWatch::OnTare(std::int32_t temperature_mdegc, bool has_temperature, bool cleared,
+                         const WrenchLsb& load_lsb, TareSource source) {
   ResetReference(temperature_mdegc, has_temperature);
   if (cleared) return;
   tare_sample_ = static_cast<std::uint32_t>(samples_ / rate_);
   report_.tare_temp_mdegc = has_temperature ? temperature_mdegc : 0;
   ++report_.tare_count;
+  if (tares_completed_ < UINT32_MAX) ++tares_completed_;
+  // Newest first: the oldest record falls off the end (only at a tare, never per sample).
+  auto& h = report_.tares;
+  for (std::size_t k = kTareHistory - 1; k > 0; --k) h[k] = h[k - 1];
+  h[0].number = tares_completed_;
+  h[0].source = source;
+  h[0].has_temperature = has_temperature;
+  h[0].time_s = tare_sample_;
+  h[0].temperature_mdegc = has_temperature ? temperature_mdegc : 0;
+  h[0].load_lsb = load_lsb;
 }
 
 void HealthWatch::ResetReference(std::int32_t temperature_mdegc, bool has_temperature) {
@@ -522,7 +540,10 @@ void HealthWatch::Publish(const HealthInput& in) {
   r.findings = active_;
   r.ring_ref_mhz = ring_ref_mhz_;
   r.tare_age_s = static_cast<std::uint32_t>(samples_ / rate_) - tare_sample_;
-  for (std::size_t a = 0; a < kAxes; ++a) r.cycles[a] = rainflow_[a].cycles();
+  for (std::size_t a = 0; a < kAxes; ++a) {
+    r.cycles[a] = rainflow_[a].cycles();
+    r.cycle_bins[a] = rainflow_[a].bins();
+  }
   r.slots = {};
   std::size_t k = 0;
   for (std::size_t i = 0; i < kHealthCauses && k < kHealthSlots; ++i) {

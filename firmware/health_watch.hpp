@@ -44,8 +44,10 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   void Commission();
   /// Clears every finding and the zero history: the reference becomes now.
   void Clear();
-  /// A tare completed or was removed: the zero reference becomes now, at this temperature.
-  void OnTare(std::int32_t temperature_mdegc, bool has_temperature, bool cleared);
+  /// A tare completed or was removed: the zero reference becomes now, at this temperature. A
+  /// completed tare also enters the history with the load it removed and who asked for it.
+  void OnTare(std::int32_t temperature_mdegc, bool has_temperature, bool cleared,
+              const WrenchLsb& load_lsb = {}, TareSource source = TareSource::kNone);
   void Step(const HealthInput& in);
   [[nodiscard]] const HealthReport& report() const { return report_; }
 
@@ -143,6 +145,7 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   std::uint16_t active_ = 0;
   std::array<WrenchLsb, kHealthCauses> error_{};
   std::uint32_t tare_sample_ = 0;
+  std::uint32_t tares_completed_ = 0;
   HealthReport report_{};
 };
 

@@ -45,6 +45,9 @@ void RainflowCounter::Push(std::int32_t p) {
     const std::int64_t x = Range(b, c);
     if (x > Range(a, b) || x > Range(c, d)) break;
     if (x >= count_range_ && cycles_ < UINT32_MAX) ++cycles_;
+    std::size_t bin = 0;
+    while (bin < edges_.size() && x >= edges_[bin]) ++bin;
+    if (bins_[bin] < UINT32_MAX) ++bins_[bin];
     residue_[n_ - 3] = d;
     n_ -= 2;
   }

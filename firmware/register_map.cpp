@@ -132,38 +132,30 @@ bool RegisterMap::Unlocked() {
   return UnlockedLocked(device_.NowUs());
 }
 
-ModbusException RegisterMap::ReadMqttInput(std::uint16_t addr, std::uint16_t count,
-                                           std::uint16_t* out) const {
-  std::array<std::uint16_t, kInMqttCount> image{};
-  if (mqtt_ != nullptr) {
-    const auto at = [](std::uint16_t a) { return static_cast<std::size_t>(a - kInMqttFirst); };
-    image[at(kInMqttConnected)] =
-        static_cast<std::uint16_t>(mqtt_->connected.load(std::memory_order_relaxed));
-    PackU32(mqtt_->published.load(std::memory_order_relaxed), &image[at(kInMqttPublished)]);
-    PackU32(mqtt_->dropped.load(std::memory_order_relaxed), &image[at(kInMqttDropped)]);
-    PackU32(mqtt_->reconnects.load(std::memory_order_relaxed), &image[at(kInMqttReconnects)]);
-  }
-  for (std::uint16_t i = 0; i < count; ++i) out[i] = image[addr - kInMqttFirst + i];
-  return ModbusException::kNone;
+void RegisterMap::ReadMqttInput(std::uint16_t* image) const {
+  if (mqtt_ == nullptr) return;
+  image[kInMqttConnected] =
+      static_cast<std::uint16_t>(mqtt_->connected.load(std::memory_order_relaxed));
+  PackU32(mqtt_->published.load(std::memory_order_relaxed), &image[kInMqttPublished]);
+  PackU32(mqtt_->dropped.load(std::memory_order_relaxed), &image[kInMqttDropped]);
+  PackU32(mqtt_->reconnects.load(std::memory_order_relaxed), &image[kInMqttReconnects]);
 }
 
 ModbusException RegisterMap::ReadInput(std::uint16_t addr, std::uint16_t count,
                                        std::uint16_t* out) {
   const std::uint32_t end = static_cast<std::uint32_t>(addr) + count;
   if (count == 0 || end > kInputAddressSpan) return ModbusException::kIllegalDataAddress;
-  if (addr < kInputRegisterCount) {
-    const auto in_image =
-        static_cast<std::uint16_t>(std::min<std::uint32_t>(end, kInputRegisterCount) - addr);
-    const ModbusException e = ReadSampleInput(addr, in_image, out);
-    if (e != ModbusException::kNone || in_image == count) return e;
-    return ReadMqttInput(kInMqttFirst, static_cast<std::uint16_t>(count - in_image),
-                         out + in_image);
+  std::array<std::uint16_t, kInputAddressSpan> image{};
+  if (addr < kInMqttFirst || end > kInHistoryFirst) {  // one sample for every sample register
+    const ModbusException e = ReadSampleInput(image.data());
+    if (e != ModbusException::kNone) return e;
   }
-  return ReadMqttInput(addr, count, out);
+  if (addr < kInHistoryFirst && end > kInMqttFirst) ReadMqttInput(image.data());
+  for (std::uint16_t i = 0; i < count; ++i) out[i] = image[addr + i];
+  return ModbusException::kNone;
 }
 
-ModbusException RegisterMap::ReadSampleInput(std::uint16_t addr, std::uint16_t count,
-                                             std::uint16_t* out) {
+ModbusException RegisterMap::ReadSampleInput(std::uint16_t* image) {
   DeviceSample d{};
   // The writer may be preempted in the middle of a publication (odd sequence): let it run
   // rather than spinning. Only a writer stuck for 1000 scheduler rounds gives exception 04.
@@ -173,10 +165,11 @@ ModbusException RegisterMap::ReadSampleInput(std::uint16_t addr, std::uint16_t c
     got = device_.ReadLatest(&d);
   }
   if (!got) return ModbusException::kDeviceFailure;
-  std::array<std::uint16_t, kInputRegisterCount> image{};
+  std::array<std::uint16_t, kInputRegisterCount> main{};
   const std::uint64_t last_sample_us = device_.last_sample_us();
-  BuildInputRegisters(d, device_.adc_info(), device_.NowUs(), last_sample_us, &image);
-  for (std::uint16_t i = 0; i < count; ++i) out[i] = image[addr + i];
+  BuildInputRegisters(d, device_.adc_info(), device_.NowUs(), last_sample_us, &main);
+  std::copy(main.begin(), main.end(), image);
+  BuildHealthHistoryRegisters(d, &image[kInHistoryFirst]);
   return ModbusException::kNone;
 }
 
@@ -230,7 +223,7 @@ ModbusException RegisterMap::ReadHolding(std::uint16_t addr, std::uint16_t count
 }
 
 ModbusException RegisterMap::WriteHolding(std::uint16_t addr, const std::uint16_t* values,
-                                          std::uint16_t count) {
+                                          std::uint16_t count, TareSource source) {
   const std::uint32_t end = static_cast<std::uint32_t>(addr) + count;
   if (count == 0) return ModbusException::kIllegalDataAddress;
   for (std::uint32_t a = addr; a < end; ++a) {
@@ -254,6 +247,7 @@ ModbusException RegisterMap::WriteHolding(std::uint16_t addr, const std::uint16_
         if (v == kCmdTare || v == kCmdClearTare) {
           ++next.tare_generation;
           next.tare_kind = static_cast<std::uint8_t>(v);
+          next.tare_source = source;
         } else if (v == kCmdClearPeaks) {
           ++next.clear_generation;
         } else if (v != kCmdNone) {

@@ -12,7 +12,8 @@ namespace ftstack::fw {
 
 inline constexpr std::uint16_t kMapVersion = 3;
 /// Input registers 0 … 199 (the sample's image): 81 … 99 reserved, 100 … 199 the health watch
-/// (health_registers.hpp); the MQTT block 200 … 209 follows (MqttInputRegister).
+/// (health_registers.hpp); the MQTT block 200 … 209 follows (MqttInputRegister), then the history
+/// block 210 … (kInHistoryFirst).
 inline constexpr std::uint16_t kInputRegisterCount = 200;
 /// Input registers 0 … 84, map version 2's image: one read covers it (a Modbus read carries at
 /// most 125 registers; the whole v3 image takes two).
@@ -54,9 +55,14 @@ enum MqttInputRegister : std::uint16_t {
   kInMqttReserved207 = 207,  ///< 207 … 209 reserved, read 0
 };
 inline constexpr std::uint16_t kInMqttCount = 10;
-/// Input addresses 0 … kInputAddressSpan − 1: the sample image followed by the MQTT block (the
-/// server's table size).
-inline constexpr std::uint16_t kInputAddressSpan = kInMqttFirst + kInMqttCount;
+/// The history block of input registers, 210 … (map v3, after the MQTT block): the tare history
+/// and the rainflow range bins, from the same published sample as 0 … 199 (layout:
+/// health_registers.hpp).
+inline constexpr std::uint16_t kInHistoryFirst = kInMqttFirst + kInMqttCount;
+inline constexpr std::uint16_t kInHistoryCount = 176;
+/// Input addresses 0 … kInputAddressSpan − 1: the sample image, the MQTT block and the history
+/// block (the server's table size).
+inline constexpr std::uint16_t kInputAddressSpan = kInHistoryFirst + kInHistoryCount;
 static_assert(kInMqttFirst == kInputRegisterCount, "the MQTT block follows the sample image");
 
 /// Holding register addresses.
@@ -123,8 +129,9 @@ class RegisterMap {
  public:
   explicit RegisterMap(Device& device);
 
-  /// Function 04. 02 when [addr, addr+count) leaves 0 … 209 (a read may span the main and the
-  /// MQTT block); reserved 81 … 99, 190 … 199 and 207 … 209 read 0.
+  /// Function 04. 02 when [addr, addr+count) leaves 0 … kInputAddressSpan − 1 (a read may span
+  /// the blocks; the sample's registers of one reply come from one sample); reserved 81 … 99,
+  /// 196 … 199 and 207 … 209 read 0.
   [[nodiscard]] ModbusException ReadInput(std::uint16_t addr, std::uint16_t count,
                                           std::uint16_t* out);
   /// Function 03. 02 when any address is outside 0 … 79; reserved 5 … 9, 29, 42 … 49 and 60 … 79
@@ -137,8 +144,10 @@ class RegisterMap {
   /// 10–21, 30–41) while locked, a write covering only one half of a float (10–27, 30–41), a
   /// gravity component that is not finite or beyond ±20 m/s², or gravity compensation on (28 = 1)
   /// without a payload. On any exception nothing changes.
+  /// `source` says who wrote (a tare command is recorded with it in the tare history).
   [[nodiscard]] ModbusException WriteHolding(std::uint16_t addr, const std::uint16_t* values,
-                                             std::uint16_t count);
+                                             std::uint16_t count,
+                                             TareSource source = TareSource::kModbus);
 
   /// True while protected writes are allowed (within 10 s of writing kUnlockKey).
   [[nodiscard]] bool Unlocked();
@@ -148,11 +157,11 @@ class RegisterMap {
   void SetMqttCounters(const MqttCounters* counters) { mqtt_ = counters; }
 
  private:
-  /// Input registers 0 … kInputRegisterCount − 1 from the latest published sample.
-  [[nodiscard]] ModbusException ReadSampleInput(std::uint16_t addr, std::uint16_t count,
-                                                std::uint16_t* out);
-  [[nodiscard]] ModbusException ReadMqttInput(std::uint16_t addr, std::uint16_t count,
-                                              std::uint16_t* out) const;
+  /// Input registers 0 … kInputRegisterCount − 1 and the history block of `image` (the whole
+  /// input table) from the latest published sample.
+  [[nodiscard]] ModbusException ReadSampleInput(std::uint16_t* image);
+  /// The MQTT block of `image` (the whole input table).
+  void ReadMqttInput(std::uint16_t* image) const;
 
   [[nodiscard]] bool UnlockedLocked(std::uint64_t now_us) const;
 

@@ -1,8 +1,13 @@
 // The health watch's integer signal blocks against closed forms computed here in double.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdlib>
+#include <map>
 #include <random>
+#include <set>
 #include <vector>
 
 #include "firmware/health_signal.hpp"
@@ -126,12 +131,16 @@ TEST(CreepRemaining, ExponentialApproachFromSegmentMeans) {
   EXPECT_EQ(CreepRemaining(0, 10, 30), 30);
 }
 
-/// ASTM E1049-85 rainflow (three-point rule with the starting point), on turning points in double:
-/// the full cycles (step 4) with a range of at least `min_range`.
-int AstmFullCycles(const std::vector<double>& peaks, double min_range) {
+/// ASTM E1049-85 § 5.4.4 rainflow (three-point rule with the starting point), on turning points
+/// in double: the ranges of the full cycles (step 4) and of the half cycles (step 3: Y contains
+/// the starting point; step 6: at the end, every range left).
+struct AstmCycles {
+  std::vector<double> full, half;
+};
+AstmCycles AstmCount(const std::vector<double>& peaks) {
+  AstmCycles c;
   std::vector<double> s;
   std::size_t start = 0;  // index in s of the starting point S
-  int full = 0;
   for (const double p : peaks) {
     s.push_back(p);
     while (s.size() >= 3) {
@@ -140,30 +149,61 @@ int AstmFullCycles(const std::vector<double>& peaks, double min_range) {
       const double y = std::fabs(s[n - 2] - s[n - 3]);
       if (x < y) break;
       if (n - 3 == start) {  // Y contains S: a half cycle; S moves on
+        c.half.push_back(y);
         s.erase(s.begin() + static_cast<long>(start));
         continue;
       }
-      if (y >= min_range) ++full;
+      c.full.push_back(y);
       s.erase(s.begin() + static_cast<long>(n - 3), s.begin() + static_cast<long>(n - 1));
     }
   }
+  for (std::size_t i = start + 1; i < s.size(); ++i) c.half.push_back(std::fabs(s[i] - s[i - 1]));
+  return c;
+}
+int AstmFullCycles(const std::vector<double>& peaks, double min_range) {
+  int full = 0;
+  for (const double r : AstmCount(peaks).full) full += r >= min_range ? 1 : 0;
   return full;
 }
+/// Full cycles per range bin, binned here: bin k holds ranges with edge[k − 1] ≤ range < edge[k]
+/// (the first from 0, the last unbounded), the edges as fractions of `rated`.
+std::vector<int> AstmBins(const std::vector<double>& ranges, const std::vector<double>& edge_frac,
+                          double rated) {
+  std::vector<int> bins(edge_frac.size() + 1, 0);
+  for (const double r : ranges) {
+    const auto above = std::upper_bound(edge_frac.begin(), edge_frac.end(), r / rated);
+    ++bins[static_cast<std::size_t>(above - edge_frac.begin())];
+  }
+  return bins;
+}
 
-TEST(RainflowCounter, FullCyclesAgreeWithAstmE1049OnRandomHistories) {
+TEST(RainflowCounter, FullCyclesAndRangeBinsAgreeWithAstmE1049OnRandomHistories) {
   std::mt19937 rng(7);
+  std::array<int, RainflowCounter::kBins> filled{};
   std::uniform_real_distribution<double> level(-100000.0, 100000.0);
+  std::uniform_real_distribution<double> step(4500.0, 12000.0);
+  std::bernoulli_distribution near(0.3);
   for (int history = 0; history < 20; ++history) {
-    // Alternating turning points at least 3 gates apart, joined by ramps of 5 samples with
-    // noise below the gate: the counter must find exactly these turning points.
+    // Alternating turning points at least 2.25 gates apart (a third of them a small step from
+    // the last, so that small ranges occur too), joined by ramps of 5 samples with noise below
+    // the gate: the counter must find exactly these turning points.
+    // No level twice: two neighbouring ranges are equal only where two turning points have the
+    // same level, and at such a tie with the starting point the standard's three-point rule
+    // drops the starting point (a half cycle) where the four-point rule keeps it.
     std::vector<double> peaks = {0.0};
+    std::set<long> levels = {0};
     while (peaks.size() < 400) {
-      const double v = level(rng);
       const bool up = peaks.size() % 2 == 1;
-      if ((up && v > peaks.back() + 6000) || (!up && v < peaks.back() - 6000)) peaks.push_back(v);
+      const double v =
+          std::round(near(rng) ? peaks.back() + (up ? 1 : -1) * step(rng) : level(rng));
+      if (((up && v > peaks.back() + 4500) || (!up && v < peaks.back() - 4500)) &&
+          levels.insert(std::lround(v)).second) {
+        peaks.push_back(v);
+      }
     }
+    // Bins as the watch sets them for a rated range of 100 000 LSB (5 … 100 %).
     RainflowCounter c;
-    c.Configure(2000, 20000);
+    c.Configure(2000, 20000, {5000, 10000, 20000, 40000, 60000, 80000, 100000});
     std::uniform_int_distribution<int> noise(-400, 400);
     for (std::size_t i = 1; i < peaks.size(); ++i) {
       for (int k = 0; k < 5; ++k) {
@@ -172,18 +212,59 @@ TEST(RainflowCounter, FullCyclesAgreeWithAstmE1049OnRandomHistories) {
       }
     }
     c.Add(static_cast<std::int32_t>(std::lround(peaks.back())));
-    c.Add(
-        static_cast<std::int32_t>(std::lround(peaks.back() - (peaks.back() > 0 ? 1 : -1) * 3000)));
+    // Back from the last turning point by more than the gate (peaks alternate, the first one
+    // up): it becomes a turning point too.
+    c.Add(static_cast<std::int32_t>(
+        std::lround(peaks.back() + (peaks.size() % 2 == 0 ? -3000 : 3000))));
     std::vector<double> rounded;
     for (const double p : peaks) rounded.push_back(static_cast<double>(std::lround(p)));
     EXPECT_EQ(static_cast<int>(c.cycles()), AstmFullCycles(rounded, 20000)) << history;
     EXPECT_GT(c.cycles(), 50u);
+    const std::vector<int> want =
+        AstmBins(AstmCount(rounded).full, {0.05, 0.1, 0.2, 0.4, 0.6, 0.8, 1.0}, 100000.0);
+    for (std::size_t k = 0; k < RainflowCounter::kBins; ++k) {
+      EXPECT_EQ(static_cast<int>(c.bins()[k]), want[k]) << history << " bin " << k;
+    }
+    // Every bin is exercised over the 20 histories (checked once, below).
+    for (std::size_t k = 0; k < RainflowCounter::kBins; ++k) filled[k] += want[k];
   }
+  for (std::size_t k = 0; k < RainflowCounter::kBins; ++k) EXPECT_GT(filled[k], 0) << "bin " << k;
+}
+
+TEST(RainflowCounter, AstmE1049WorkedExampleFullCyclesInBinsAndHalfCyclesInTheResidue) {
+  // ASTM E1049-85, Fig. 6: -2 1 -3 5 -1 3 -4 4 -2 (units of 1000 LSB). The standard's rainflow
+  // table: range 3: 0.5, 4: 1.5, 6: 0.5, 8: 1.0, 9: 0.5 cycles (one full cycle, range 4; six
+  // half cycles). One bin per unit of range here: edges 2.5, 3.5, … 8.5 units.
+  const std::vector<double> history = {-2, 1, -3, 5, -1, 3, -4, 4, -2};
+  const std::map<int, double> table = {{3, 0.5}, {4, 1.5}, {6, 0.5}, {8, 1.0}, {9, 0.5}};
+  // The independent implementation reproduces the published table.
+  std::map<int, double> astm;
+  const AstmCycles ref = AstmCount(history);
+  for (const double r : ref.full) astm[static_cast<int>(r)] += 1.0;
+  for (const double r : ref.half) astm[static_cast<int>(r)] += 0.5;
+  EXPECT_EQ(astm, table);
+
+  RainflowCounter c;
+  c.Configure(500, 1, {2500, 3500, 4500, 5500, 6500, 7500, 8500});
+  for (const double v : history) c.Add(static_cast<std::int32_t>(v * 1000));
+  c.Add(-1000);  // the load turns back up by more than the gate: -2 is a turning point
+  std::map<int, double> got;
+  for (std::size_t k = 1; k < RainflowCounter::kBins; ++k) {  // bin k: range k + 2 units
+    if (c.bins()[k] != 0) got[static_cast<int>(k) + 2] += c.bins()[k];
+  }
+  EXPECT_EQ(c.bins()[0], 0u);
+  EXPECT_EQ(c.cycles(), 1u);
+  // The residue's neighbouring points are the half cycles the standard counts at the end.
+  ASSERT_EQ(c.residue_size(), 7u);
+  for (std::size_t i = 1; i < c.residue_size(); ++i) {
+    got[std::abs(c.residue(i) - c.residue(i - 1)) / 1000] += 0.5;
+  }
+  EXPECT_EQ(got, table);
 }
 
 TEST(RainflowCounter, NoiseBelowTheGateCountsNothing) {
   RainflowCounter c;
-  c.Configure(2000, 1);
+  c.Configure(2000, 1, {});
   std::mt19937 rng(3);
   std::uniform_int_distribution<int> noise(-999, 999);
   for (int i = 0; i < 100000; ++i) c.Add(50000 + noise(rng));

@@ -351,10 +351,11 @@ TEST_F(RegisterMapTest, AddressesOutsideTheMapGiveException02) {
   StartDevice();
   std::array<std::uint16_t, 125> buf{};
   EXPECT_EQ(map_->ReadInput(84, 1, buf.data()), ModbusException::kNone);
-  EXPECT_EQ(map_->ReadInput(199, 1, buf.data()), ModbusException::kNone);  // map v3: 0 … 209
-  EXPECT_EQ(map_->ReadInput(209, 1, buf.data()), ModbusException::kNone);
-  EXPECT_EQ(map_->ReadInput(209, 2, buf.data()), ModbusException::kIllegalDataAddress);
-  EXPECT_EQ(map_->ReadInput(210, 1, buf.data()), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(map_->ReadInput(199, 1, buf.data()), ModbusException::kNone);  // map v3: 0 … 385
+  EXPECT_EQ(map_->ReadInput(209, 2, buf.data()), ModbusException::kNone);
+  EXPECT_EQ(map_->ReadInput(385, 1, buf.data()), ModbusException::kNone);
+  EXPECT_EQ(map_->ReadInput(385, 2, buf.data()), ModbusException::kIllegalDataAddress);
+  EXPECT_EQ(map_->ReadInput(386, 1, buf.data()), ModbusException::kIllegalDataAddress);
   EXPECT_EQ(map_->ReadHolding(0, 5, buf.data()), ModbusException::kNone);
   EXPECT_EQ(map_->ReadHolding(10, 12, buf.data()), ModbusException::kNone);
   // 5 … 9 are reserved, not a hole: a PLC's block read of 0 … 15 or 0 … 21 works.
@@ -397,8 +398,14 @@ TEST_F(RegisterMapTest, MqttBlockReadsThePublishersCountersAlsoInAReadAcrossBloc
   ASSERT_EQ(map_->ReadInput(190, 20, buf.data()), ModbusException::kNone);
   for (std::size_t i = 0; i < 10; ++i) EXPECT_EQ(buf[i], alone[i]) << 190 + i;
   for (std::size_t i = 0; i < want.size(); ++i) EXPECT_EQ(buf[10 + i], want[i]) << 200 + i;
+  // … and across the MQTT block and the history block (read alone as the reference).
+  ASSERT_EQ(map_->ReadInput(kInHistoryFirst, 10, alone.data()), ModbusException::kNone);
+  buf.fill(0xFFFF);
+  ASSERT_EQ(map_->ReadInput(kInMqttFirst, 20, buf.data()), ModbusException::kNone);
+  for (std::size_t i = 0; i < want.size(); ++i) EXPECT_EQ(buf[i], want[i]) << 200 + i;
+  for (std::size_t i = 0; i < 10; ++i) EXPECT_EQ(buf[10 + i], alone[i]) << 210 + i;
   for (const auto& [addr, count] :
-       std::vector<std::pair<int, int>>{{209, 2}, {210, 1}, {150, 61}, {0, 211}}) {
+       std::vector<std::pair<int, int>>{{385, 2}, {386, 1}, {200, 187}, {0, 387}}) {
     EXPECT_EQ(map_->ReadInput(static_cast<std::uint16_t>(addr), static_cast<std::uint16_t>(count),
                               buf.data()),
               ModbusException::kIllegalDataAddress)

@@ -293,6 +293,23 @@ std::map<std::string, Expected> ReferenceInputValues(
   e["mqtt_dropped"] = {17, 0, "uint32"};
   e["mqtt_reconnects"] = {3, 0, "uint32"};
   for (int a = 207; a <= 209; ++a) e["reserved_" + std::to_string(a)] = {0, 0, "uint16"};
+  // The tare history before any tare: four empty slots, every register 0.
+  for (int k = 1; k <= 4; ++k) {
+    const std::string t = "tare" + std::to_string(k) + "_";
+    e[t + "number"] = {0, 0, "uint32"};
+    e[t + "source"] = {0, 0, "uint16"};
+    e["reserved_" + std::to_string(210 + 20 * (k - 1) + 3)] = {0, 0, "uint16"};
+    e[t + "time_s"] = {0, 0, "uint32"};
+    e[t + "temp_c"] = {0, 0, "float32"};
+    for (std::size_t a = 0; a < 6; ++a) {
+      e[t + axes[a] + (a < 3 ? "_n" : "_nm")] = {0, 0, "float32"};
+    }
+  }
+  // No rainflow cycle yet in any bin.
+  for (std::size_t a = 0; a < 6; ++a) {
+    for (int k = 1; k <= 8; ++k)
+      e["rf_" + std::string(axes[a]) + "_b" + std::to_string(k)] = {0, 0, "uint32"};
+  }
   return e;
 }
 
@@ -355,7 +372,8 @@ class CodeCheck : public maptest::RegisterMapTest {
     }
   }
 
-  /// The input tags tile the code's blocks, 0 … 199 and 200 … 209, in order and without gaps.
+  /// The input tags tile the code's blocks, 0 … 199, 200 … 209 and 210 …, in order and without
+  /// gaps.
   static void CheckInputLayout(const std::vector<Tag>& tags, std::vector<std::string>* d) {
     int next = 0;
     for (const Tag& t : tags) {
@@ -373,7 +391,9 @@ class CodeCheck : public maptest::RegisterMapTest {
   void CheckInputValues(const std::vector<Tag>& tags, std::vector<std::string>* d) {
     std::array<std::uint16_t, kInputAddressSpan> r{};
     if (map_->ReadInput(0, kInputRegisterCount, r.data()) != ModbusException::kNone ||
-        map_->ReadInput(kInMqttFirst, kInMqttCount, &r[kInMqttFirst]) != ModbusException::kNone) {
+        map_->ReadInput(kInMqttFirst, kInMqttCount, &r[kInMqttFirst]) != ModbusException::kNone ||
+        map_->ReadInput(kInHistoryFirst, kInHistoryCount, &r[kInHistoryFirst]) !=
+            ModbusException::kNone) {
       d->push_back("reading the input image failed");
       return;
     }
@@ -491,9 +511,9 @@ TEST(RegisterMapTable, MarkdownAndCsvListTheSameTags) {
   const auto md = ParseMarkdown(ReadText("docs/spec/modbus-map.md"), &errors);
   const auto csv = ParseCsv(ReadText("docs/spec/modbus-map.csv"), &errors);
   EXPECT_TRUE(errors.empty()) << Join(errors);
-  // 47 + 75 + 7 input tags (map v3: health, MQTT), 27 + 38 holding tags (16 + 5 gravity + 6
-  // mount; health)
-  EXPECT_EQ(md.size(), 194u);
+  // 47 + 75 + 7 + 44 + 48 input tags (map v3: health, MQTT, tare history, rainflow bins), 27 +
+  // 38 holding tags (16 + 5 gravity + 6 mount; health)
+  EXPECT_EQ(md.size(), 286u);
   const auto diffs = CompareTables(md, csv);
   EXPECT_TRUE(diffs.empty()) << Join(diffs);
 }

@@ -267,6 +267,33 @@ TEST(FtdHealth, ZeroDriftFlaggedWithItsSize) {
   std::printf("\n");
 }
 
+TEST(FtdHealth, ZeroShiftAfterAnOverloadFlaggedWithItsSize) {
+  // The simulator's overload_shift: 1.6 × rated Fz (640 N) around 20 s (up from 19.5 s, held
+  // 20–20.3 s, gone at 20.6 s) and from 20 s on a lasting shift of 0.01 mV/V on the largest
+  // channel of Fz's sensitivity column, the others in proportion to that column.
+  Health h({"--sim-span-s", "60", "--sim-effect", "overload_shift:onset_s=20,shift=0.01"});
+  ASSERT_GT(h.port(), 0) << h.Stderr();
+  const Flag f = h.WaitFor(fw::HealthCause::kOverloadShift, 50.0);
+  ASSERT_TRUE(f.found) << h.Stderr();
+  // Stated: within 12 s of the overload's end (the slow filter settling from the step, 2 s of
+  // stability, a 1 s zero point, a poll of 2 s).
+  EXPECT_GE(f.sim_s, 20.6);
+  EXPECT_LE(f.sim_s, 32.6);
+  EXPECT_EQ(f.retare, 1);
+  EXPECT_EQ(f.reason, static_cast<int>(fw::HealthCause::kOverloadShift));
+  EXPECT_GE(h.Read("3:int", 58, 1).at(58), 1);  // the overload the device saw
+  // Truth: the shift pattern through the calibration matrix.
+  const Eigen::VectorXd col = sim::MakeDefaultSensor()->Sensitivity().col(2);
+  const double m = col.cwiseAbs().maxCoeff();
+  std::array<double, 6> mvv{};
+  for (std::size_t c = 0; c < 6; ++c) mvv[c] = 0.01 * col(static_cast<Eigen::Index>(c)) / m;
+  const auto truth = OnAxes(mvv);
+  ExpectWithinFactor2(f.error, truth, 2.5e-3, 1e-3);
+  std::printf("overload shift: flagged at %.1f s; error", f.sim_s);
+  for (std::size_t a = 0; a < 6; ++a) std::printf(" %.4g/%.4g", f.error[a], truth[a]);
+  std::printf("\n");
+}
+
 TEST(FtdHealth, StepsWithoutEffectsRaiseNothing) {
   test::TempDir dir;
   // Levels 160, 40, 120, 0, 60 N: the turning points 0 160 40 120 0 close one full rainflow cycle
@@ -286,6 +313,15 @@ TEST(FtdHealth, StepsWithoutEffectsRaiseNothing) {
   // Load history: that one cycle on Fz, nothing on the other axes.
   const auto cycles = h.Read("3", 190, 6);
   for (int a = 0; a < 6; ++a) EXPECT_EQ(cycles.at(190 + a), a == 2 ? 1 : 0) << "axis " << a;
+  // Its range bin: 80 N of Fz's rated 400 N is 20 %, bin 4 ([20, 40) %; input 290 + 16 per axis,
+  // 2 per bin); no full cycle in any other bin of any axis.
+  const auto bins = h.Read("3:int", 290, 48);
+  for (int a = 0; a < 6; ++a) {
+    for (int k = 0; k < 8; ++k) {
+      const int addr = 290 + 16 * a + 2 * k;
+      EXPECT_EQ(bins.at(addr), a == 2 && k == 3 ? 1 : 0) << "axis " << a << " bin " << k + 1;
+    }
+  }
 }
 
 TEST(FtdHealth, PoweredUpUnderLoadIsOverloadNotBridgeFault) {

@@ -56,6 +56,18 @@ class FtdProcess {
   FtdProcess& operator=(const FtdProcess&) = delete;
 
   [[nodiscard]] int port() const { return port_; }
+  /// The port of a "serving WHAT on HOST:PORT" line on stderr (e.g. "RDT"), waiting up to 5 s;
+  /// -1 when none appears.
+  [[nodiscard]] int ServedPort(const std::string& what) const {
+    const std::regex re("serving " + what + " on [^:]+:([0-9]+)");
+    for (int i = 0; i < 500; ++i) {
+      std::smatch m;
+      const std::string err = Stderr();
+      if (std::regex_search(err, m, re)) return std::stoi(m[1]);
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return -1;
+  }
   [[nodiscard]] pid_t pid() const { return pid_; }
   [[nodiscard]] bool alive() const { return pid_ > 0 && !reaped_ && kill(pid_, 0) == 0; }
 

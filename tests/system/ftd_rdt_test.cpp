@@ -12,7 +12,6 @@
 #include <arpa/inet.h>
 #include <atomic>
 #include <map>
-#include <regex>
 #include <thread>
 
 #include "firmware/register_map.hpp"
@@ -78,16 +77,7 @@ class RdtClient {
   sockaddr_in to_{};
 };
 
-int RdtPort(const test::FtdProcess& ftd) {
-  const std::regex re("serving RDT on [^:]+:([0-9]+)");
-  for (int i = 0; i < 500; ++i) {
-    std::smatch m;
-    const std::string err = ftd.Stderr();
-    if (std::regex_search(err, m, re)) return std::stoi(m[1]);
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return -1;
-}
+int RdtPort(const test::FtdProcess& ftd) { return ftd.ServedPort("RDT"); }
 
 /// 10 000 RDT records at rate_hz: gapless, and equal to the Modbus wrench of the same sample,
 /// polled every poll_ms; each Modbus reply's timestamp (inputs 4–5) is its sample's own
