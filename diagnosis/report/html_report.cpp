@@ -569,7 +569,17 @@ void WriteJson(const std::string& path, const nlohmann::json& j) {
 std::string SummaryText(const Report& report) {
   char buf[160];
   std::string s = "verdict: " + report.verdict;
-  for (std::size_t i = 1; i < report.effects.size(); ++i) s += " + " + report.effects[i].fit.name;
+  // The verdict is the first identified claim: the claims are listed apart when it is not the
+  // first (an unidentified claim ranks above it, or none is identified).
+  const bool verdict_first =
+      !report.effects.empty() && report.effects[0].fit.name == report.verdict;
+  std::string claims;
+  for (std::size_t i = verdict_first ? 1 : 0; i < report.effects.size(); ++i) {
+    const ClaimedEffect& e = report.effects[i];
+    claims += (verdict_first || i > 0 ? " + " : "") + e.fit.name;
+    if (!verdict_first && !e.confounded_with.empty()) claims += " (not identified)";
+  }
+  s += verdict_first || claims.empty() ? claims : "; claimed: " + claims;
   std::snprintf(buf, sizeof buf, "  (held-out RMS %.4g -> %.4g mV/V)\n", report.hold_rms_before,
                 report.hold_rms_after);
   s += buf;

@@ -360,6 +360,39 @@ TEST(DiagReportHtml, NotClaimedPartnersAreSaidInWords) {
   EXPECT_EQ(ToJson(r)["not_claimed"][0], r.dropped[0]);
 }
 
+TEST(DiagReportText, SummaryNamesTheVerdictAndEveryClaimOnce) {
+  // The summary's first line: the verdict, then the other claims; when the verdict is not the
+  // first claim (an unidentified one ranks above it, or none is identified) every claim is listed
+  // after it with its identification, never the verdict twice.
+  Report r;
+  r.hold_rms_before = 2.0;
+  r.hold_rms_after = 1.0;
+  const auto first_line = [&r] {
+    const std::string s = SummaryText(r);
+    return s.substr(0, s.find('\n'));
+  };
+  ClaimedEffect drift;
+  drift.fit.name = "zero_drift";
+  ClaimedEffect shift;
+  shift.fit.name = "overload_shift";
+  r.verdict = "zero_drift";
+  r.effects = {drift, shift};
+  EXPECT_EQ(first_line(), "verdict: zero_drift + overload_shift  (held-out RMS 2 -> 1 mV/V)");
+  r.effects[0].confounded_with = {"hysteresis"};
+  r.verdict = "overload_shift";
+  EXPECT_EQ(first_line(),
+            "verdict: overload_shift; claimed: zero_drift (not identified) + overload_shift  "
+            "(held-out RMS 2 -> 1 mV/V)");
+  r.effects[1].confounded_with = {"zero_offset"};
+  r.verdict = "undetermined";
+  EXPECT_EQ(first_line(),
+            "verdict: undetermined; claimed: zero_drift (not identified) + overload_shift (not "
+            "identified)  (held-out RMS 2 -> 1 mV/V)");
+  r.verdict = "none";
+  r.effects.clear();
+  EXPECT_EQ(first_line(), "verdict: none  (held-out RMS 2 -> 1 mV/V)");
+}
+
 TEST(DiagFixtureSubtle, WithoutTemperatureThermalDriftIsNotClaimed) {
   // The same thermal drift, but the real file carries no temp_C: the tool must fall back to time.
   auto fx = testing::MakeFixture({{"thermal_zero_drift", 6}}, 3, 200.0, kNoise, 4.0);
