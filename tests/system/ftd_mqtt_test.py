@@ -29,7 +29,8 @@ def ftd_args(port, *extra, scheme="mqtt", rate_hz=20, keepalive_s=5):
 
 
 def mbpoll(port, table, first, count):
-    """Input registers read by mbpoll (0-based addresses; '3:int' = uint32 high word first)."""
+    """Input registers read by mbpoll (0-based addresses; '3:int' = uint32 high word first,
+    '3:float' = float32 high word first)."""
     out = subprocess.run(["mbpoll", "-m", "tcp", "-p", str(port), "-a", "1", "-t", table, "-B",
                           "-0", "-r", str(first), "-c", str(count), "-1", "127.0.0.1"],
                          capture_output=True, text=True, timeout=10, check=True).stdout
@@ -37,7 +38,8 @@ def mbpoll(port, table, first, count):
     for line in out.splitlines():
         if line.startswith("["):
             addr, value = line.split(":", 1)
-            values[int(addr.strip("[]"))] = int(value.strip())
+            text = value.strip()
+            values[int(addr.strip("[]"))] = float(text) if "float" in table else int(text)
     return values
 
 
@@ -205,11 +207,13 @@ class MqttTest(unittest.TestCase):
             lambda m: m.kind == "DDATA" and "Device Control/Commands" in m.metrics, 5, "ack")
 
     def test_commands_and_write_protect(self):
-        """Tare and clear peaks, acknowledged in the next DDATA; anything else and everything under
+        """Tare and clear peaks, acknowledged in the next DDATA; the tare enters the tare history
+        (input 210-229) as source 3 with the load it removed; anything else and everything under
         --mqtt-write-protect is refused and changes nothing."""
         self.broker = Broker(self.tmp.path)
         self.host = SparkplugHost(self.broker.port)
-        self.start(ftd_args(self.broker.port))
+        modbus = free_port()
+        self.start(ftd_args(self.broker.port, "--modbus-tcp", f"127.0.0.1:{modbus}"))
         self.host.wait_kind("DBIRTH")
         ack = self.command("Device Control/Tare")
         self.assertEqual(ack.value("Device Control/Commands"), 1)
@@ -221,6 +225,16 @@ class MqttTest(unittest.TestCase):
         for k, a in enumerate(AXES):
             self.assertLess(abs(later.value(f"Wrench/{a}")), 0.02 * max(abs(APPLIED[k]), 1.0), a)
         self.assertIsNotNone(tared)
+        # The newest tare of the history: number 1, asked over MQTT (3), at the constant
+        # --sim-wrench's 20 °C, and the load it removed is the applied one.
+        self.assertEqual(mbpoll(modbus, "3:int", 210, 1)[210], 1)
+        self.assertEqual(mbpoll(modbus, "3", 212, 1)[212], 3)
+        self.assertAlmostEqual(mbpoll(modbus, "3:float", 216, 1)[216], 20.0, delta=0.01)
+        removed = mbpoll(modbus, "3:float", 218, 6)
+        for k, a in enumerate(AXES):
+            self.assertAlmostEqual(removed[218 + 2 * k], APPLIED[k],
+                                   delta=0.02 * max(abs(APPLIED[k]), 1.0), msg=a)
+        self.assertEqual(mbpoll(modbus, "3:int", 230, 1)[230], 0)  # no second tare
         ack = self.command("Device Control/Clear Peaks")
         self.assertEqual(ack.value("Device Control/Commands"), 2)
         self.assertEqual(ack.value("Device Control/Last Result"), "accepted")
