@@ -97,14 +97,17 @@ EffectFit SmoothDriftFit(const Context& cx, const SmoothDrift& s) {
   return fit;
 }
 
+/// One past the last row of stretch k (stretches start at `starts`, the last ends at row n).
+int StretchEnd(const std::vector<int>& starts, std::size_t k, int n) {
+  return k + 1 < starts.size() ? starts[k + 1] : n;
+}
+
 /// True when at least half the stretches share their reference load and the one before with
 /// another stretch (within 2 % of each channel's load range): only then can a zero that moves at
 /// random at each change be told from an output that depends on the load's history (hysteresis).
 bool LoadStatesRecur(const Context& cx, const std::vector<int>& starts) {
   const auto state = [&](std::size_t k, int c) {
-    const int a = starts[k];
-    const int b = k + 1 < starts.size() ? starts[k + 1] : cx.n;
-    return cx.load((a + b) / 2, c);
+    return cx.load((starts[k] + StretchEnd(starts, k, cx.n)) / 2, c);
   };
   const auto same = [&](std::size_t j, std::size_t k) {
     for (int c = 0; c < cx.nc; ++c) {
@@ -148,7 +151,7 @@ std::optional<HoldLevels> FitHoldLevels(const Context& cx, const Series& target)
     for (int c = 0; c < cx.nc; ++c) {
       double sum = 0.0;
       int rows = 0;
-      for (int i = starts[k]; i < (k + 1 < starts.size() ? starts[k + 1] : cx.n); ++i) {
+      for (int i = starts[k]; i < StretchEnd(starts, k, cx.n); ++i) {
         if (!cx.train[static_cast<std::size_t>(i)]) continue;
         sum += target(i, c);
         ++rows;
@@ -160,7 +163,7 @@ std::optional<HoldLevels> FitHoldLevels(const Context& cx, const Series& target)
   for (int c = 0; c < cx.nc; ++c) {
     for (std::size_t k = 0; k < starts.size(); ++k) {
       const float level = h.level_mvv(static_cast<Eigen::Index>(k), c);
-      for (int i = starts[k]; i < (k + 1 < starts.size() ? starts[k + 1] : cx.n); ++i) {
+      for (int i = starts[k]; i < StretchEnd(starts, k, cx.n); ++i) {
         if (!cx.train[static_cast<std::size_t>(i)]) continue;
         const double r = target(i, c) - level;
         h.sse_w += r * r * cx.weight(c);
@@ -177,8 +180,7 @@ EffectFit HoldLevelsFit(const Context& cx, const HoldLevels& h) {
   for (std::size_t k = 0; k < h.starts.size(); ++k) {
     for (int c = 0; c < cx.nc; ++c) {
       const float level = h.level_mvv(static_cast<Eigen::Index>(k), c);
-      for (int i = h.starts[k]; i < (k + 1 < h.starts.size() ? h.starts[k + 1] : cx.n); ++i)
-        fit.pred(i, c) = level;
+      for (int i = h.starts[k]; i < StretchEnd(h.starts, k, cx.n); ++i) fit.pred(i, c) = level;
     }
   }
   nlohmann::json levels = nlohmann::json::array();
