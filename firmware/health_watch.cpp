@@ -100,6 +100,7 @@ void HealthWatch::Clear() {
   ResetReference(0, false);  // the next sample's temperature becomes the reference
   ring_measured_ = 0;
   for (RainflowCounter& c : rainflow_) c.Clear();
+  cycles_changed_ = true;
 }
 
 void HealthWatch::OnTare(std::int32_t temperature_mdegc, bool has_temperature, bool cleared,
@@ -167,7 +168,9 @@ void HealthWatch::Step(const HealthInput& in) {
   // Also while the wrench is not valid (a bridge at a rail): an overload is what matters here.
   if ((in.status & kStatusOverload) != 0) overload_seen_ = true;
   if (in.untared_valid) {
-    for (std::size_t r = 0; r < kAxes; ++r) rainflow_[r].Add(in.untared[r]);
+    for (std::size_t r = 0; r < kAxes; ++r) {
+      if (rainflow_[r].Add(in.untared[r])) cycles_changed_ = true;
+    }
   }
   if (!in.valid) {
     ResetFilters();
@@ -540,9 +543,13 @@ void HealthWatch::Publish(const HealthInput& in) {
   r.findings = active_;
   r.ring_ref_mhz = ring_ref_mhz_;
   r.tare_age_s = static_cast<std::uint32_t>(samples_ / rate_) - tare_sample_;
-  for (std::size_t a = 0; a < kAxes; ++a) {
-    r.cycles[a] = rainflow_[a].cycles();
-    r.cycle_bins[a] = rainflow_[a].bins();
+  // The counts change only when a cycle closes: copy them then, not every sample.
+  if (cycles_changed_) {
+    cycles_changed_ = false;
+    for (std::size_t a = 0; a < kAxes; ++a) {
+      r.cycles[a] = rainflow_[a].cycles();
+      r.cycle_bins[a] = rainflow_[a].bins();
+    }
   }
   r.slots = {};
   std::size_t k = 0;

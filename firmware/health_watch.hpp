@@ -140,6 +140,7 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
 
   // Load history: rainflow cycles of the untared load per axis.
   std::array<RainflowCounter, kAxes> rainflow_{};
+  bool cycles_changed_ = true;  ///< a count changed since the report last copied them
 
   // Findings.
   std::uint16_t active_ = 0;

@@ -10,30 +10,32 @@ namespace {
 
 }  // namespace
 
-void RainflowCounter::Add(std::int32_t v) {
+bool RainflowCounter::Add(std::int32_t v) {
   if (!started_) {
     started_ = true;
     extreme_ = v;
-    Push(v);
-    return;
+    return Push(v);
   }
   if (dir_ == 0) {
     if (Range(v, residue_[n_ - 1]) > gate_) {
       dir_ = v > residue_[n_ - 1] ? 1 : -1;
       extreme_ = v;
     }
-    return;
+    return false;
   }
   if ((dir_ > 0 && v > extreme_) || (dir_ < 0 && v < extreme_)) {
     extreme_ = v;
   } else if (Range(v, extreme_) > gate_) {
-    Push(extreme_);  // the extreme was a turning point
+    const bool closed = Push(extreme_);  // the extreme was a turning point
     dir_ = -dir_;
     extreme_ = v;
+    return closed;
   }
+  return false;
 }
 
-void RainflowCounter::Push(std::int32_t p) {
+bool RainflowCounter::Push(std::int32_t p) {
+  bool closed = false;
   if (n_ == kResidue) {  // forget the oldest point
     for (std::size_t i = 1; i < n_; ++i) residue_[i - 1] = residue_[i];
     --n_;
@@ -48,9 +50,11 @@ void RainflowCounter::Push(std::int32_t p) {
     std::size_t bin = 0;
     while (bin < edges_.size() && x >= edges_[bin]) ++bin;
     if (bins_[bin] < UINT32_MAX) ++bins_[bin];
+    closed = true;
     residue_[n_ - 3] = d;
     n_ -= 2;
   }
+  return closed;
 }
 
 }  // namespace ftstack::fw

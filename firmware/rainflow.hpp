@@ -34,7 +34,8 @@ class RainflowCounter {
     cycles_ = 0;
     bins_ = {};
   }
-  void Add(std::int32_t v);
+  /// Adds one sample; true when a full cycle closed (the counts changed).
+  bool Add(std::int32_t v);
   [[nodiscard]] std::uint32_t cycles() const { return cycles_; }
   /// Full cycles per range bin (each saturates at 2³² − 1).
   [[nodiscard]] const Bins& bins() const { return bins_; }
@@ -43,7 +44,7 @@ class RainflowCounter {
   [[nodiscard]] std::int32_t residue(std::size_t i) const { return residue_[i]; }
 
  private:
-  void Push(std::int32_t turning_point);
+  bool Push(std::int32_t turning_point);
 
   std::array<std::int32_t, kResidue> residue_{};
   std::size_t n_ = 0;

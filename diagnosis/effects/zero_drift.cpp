@@ -14,10 +14,16 @@ namespace ftstack::diag::fx {
 
 namespace {
 
+/// The smooth variant's fit: k hat-spline intervals, per channel coefficients, training SSE.
+struct SmoothDrift {
+  int k = 0;
+  std::vector<Vec> beta;
+  double sse_w = 0.0;
+  bool at_top = false;  ///< the BIC still fell at the finest knot grid the record allows
+};
+
 /// Smooth functions of time per channel (hat splines), knots chosen by BIC on training rows.
-/// *at_top: the BIC was still falling at the finest knot grid the record allows (the knot count is
-/// on its search bound).
-std::optional<EffectFit> FitSmoothDrift(const Context& cx, const Series& target, bool* at_top) {
+std::optional<SmoothDrift> FitSmoothDrift(const Context& cx, const Series& target) {
   const double duration = cx.data->t_s.back() - cx.data->t_s.front();
   // Per channel hat-spline fit with k intervals on every row_step-th training row.
   auto fit_k = [&](int k, int row_step, std::vector<Vec>* beta) {
@@ -43,8 +49,6 @@ std::optional<EffectFit> FitSmoothDrift(const Context& cx, const Series& target,
   };
   double best_bic = std::numeric_limits<double>::infinity();
   int best_k = 0;
-  std::vector<Vec> best_beta;
-  double best_sse = 0.0;
   int worse = 0;
   int tried = 0;
   int last_k = 0;
@@ -63,27 +67,39 @@ std::optional<EffectFit> FitSmoothDrift(const Context& cx, const Series& target,
       break;
     }
   }
-  if (best_k > 0) best_sse = fit_k(best_k, 1, &best_beta);
   if (best_k == 0) return std::nullopt;
-  EffectFit best;
-  best.name = "zero_drift";
-  best.n_params = cx.nc * (best_k + 1);
-  best.train_sse_w = best_sse;
-  best.params["knots"] = best_k + 1;
-  best.variant = Fmt("hat spline, %d knots", best_k + 1);
-  best.pred.resize(cx.n, cx.nc);
-  const HatBasis hb = MakeHat(cx, best_k);
+  SmoothDrift best;
+  best.k = best_k;
+  best.sse_w = fit_k(best_k, 1, &best.beta);
+  best.at_top = best_k == last_k && tried >= 3;
+  return best;
+}
+
+/// The smooth variant as an effect: its prediction on every row.
+EffectFit SmoothDriftFit(const Context& cx, const SmoothDrift& s) {
+  EffectFit fit;
+  fit.name = "zero_drift";
+  fit.n_params = cx.nc * (s.k + 1);
+  fit.train_sse_w = s.sse_w;
+  fit.params["knots"] = s.k + 1;
+  fit.variant = Fmt("hat spline, %d knots", s.k + 1);
+  fit.pred.resize(cx.n, cx.nc);
+  const HatBasis hb = MakeHat(cx, s.k);
   for (int i = 0; i < cx.n; ++i) {
     int j = 0;
     double fr = 0.0;
     hb.At(cx.data->t_s[static_cast<std::size_t>(i)], &j, &fr);
     for (int c = 0; c < cx.nc; ++c) {
-      const Vec& bc = best_beta[static_cast<std::size_t>(c)];
-      best.pred(i, c) = bc(j) * (1.0 - fr) + bc(j + 1) * fr;
+      const Vec& bc = s.beta[static_cast<std::size_t>(c)];
+      fit.pred(i, c) = bc(j) * (1.0 - fr) + bc(j + 1) * fr;
     }
   }
-  *at_top = best_k == last_k && tried >= 3;
-  return best;
+  return fit;
+}
+
+/// One past the last row of stretch k (stretches start at `starts`, the last ends at row n).
+int StretchEnd(const std::vector<int>& starts, std::size_t k, int n) {
+  return k + 1 < starts.size() ? starts[k + 1] : n;
 }
 
 /// True when at least half the stretches share their reference load and the one before with
@@ -91,9 +107,7 @@ std::optional<EffectFit> FitSmoothDrift(const Context& cx, const Series& target,
 /// random at each change be told from an output that depends on the load's history (hysteresis).
 bool LoadStatesRecur(const Context& cx, const std::vector<int>& starts) {
   const auto state = [&](std::size_t k, int c) {
-    const int a = starts[k];
-    const int b = k + 1 < starts.size() ? starts[k + 1] : cx.n;
-    return cx.load((a + b) / 2, c);
+    return cx.load((starts[k] + StretchEnd(starts, k, cx.n)) / 2, c);
   };
   const auto same = [&](std::size_t j, std::size_t k) {
     for (int c = 0; c < cx.nc; ++c) {
@@ -116,50 +130,73 @@ bool LoadStatesRecur(const Context& cx, const std::vector<int>& starts) {
   return 2 * recurring >= starts.size();
 }
 
+/// The "steps at load changes" variant's fit: a level per stretch and channel, training SSE.
+struct HoldLevels {
+  std::vector<int> starts;    ///< first row of each stretch
+  Eigen::MatrixXf level_mvv;  ///< stretches × channels (in the prediction's precision)
+  double sse_w = 0.0;
+};
+
 /// A level per channel in each stretch between load changes (fitted on its training rows); nullopt
 /// without load changes, when the load states do not recur (LoadStatesRecur) or with a stretch
 /// holding no training row.
-std::optional<EffectFit> FitHoldLevels(const Context& cx, const Series& target) {
-  std::vector<int> starts = LoadChangeStarts(cx);
+std::optional<HoldLevels> FitHoldLevels(const Context& cx, const Series& target) {
+  HoldLevels h;
+  h.starts = LoadChangeStarts(cx);
+  std::vector<int>& starts = h.starts;
   if (starts.empty() || starts.front() != 0) starts.insert(starts.begin(), 0);
   if (starts.size() < 2 || !LoadStatesRecur(cx, starts)) return std::nullopt;
-  EffectFit fit;
-  fit.pred.resize(cx.n, cx.nc);
+  h.level_mvv.resize(static_cast<Eigen::Index>(starts.size()), cx.nc);
   for (std::size_t k = 0; k < starts.size(); ++k) {
-    const int a = starts[k];
-    const int b = k + 1 < starts.size() ? starts[k + 1] : cx.n;
     for (int c = 0; c < cx.nc; ++c) {
       double sum = 0.0;
       int rows = 0;
-      for (int i = a; i < b; ++i) {
+      for (int i = starts[k]; i < StretchEnd(starts, k, cx.n); ++i) {
         if (!cx.train[static_cast<std::size_t>(i)]) continue;
         sum += target(i, c);
         ++rows;
       }
       if (rows == 0) return std::nullopt;
-      for (int i = a; i < b; ++i) fit.pred(i, c) = sum / rows;
+      h.level_mvv(static_cast<Eigen::Index>(k), c) = static_cast<float>(sum / rows);
     }
   }
   for (int c = 0; c < cx.nc; ++c) {
-    for (int i = 0; i < cx.n; ++i) {
-      if (!cx.train[static_cast<std::size_t>(i)]) continue;
-      const double r = target(i, c) - fit.pred(i, c);
-      fit.train_sse_w += r * r * cx.weight(c);
+    for (std::size_t k = 0; k < starts.size(); ++k) {
+      const float level = h.level_mvv(static_cast<Eigen::Index>(k), c);
+      for (int i = starts[k]; i < StretchEnd(starts, k, cx.n); ++i) {
+        if (!cx.train[static_cast<std::size_t>(i)]) continue;
+        const double r = target(i, c) - level;
+        h.sse_w += r * r * cx.weight(c);
+      }
+    }
+  }
+  return h;
+}
+
+/// The "steps at load changes" variant as an effect: its levels, their start times, the prediction.
+EffectFit HoldLevelsFit(const Context& cx, const HoldLevels& h) {
+  EffectFit fit;
+  fit.pred.resize(cx.n, cx.nc);
+  for (std::size_t k = 0; k < h.starts.size(); ++k) {
+    for (int c = 0; c < cx.nc; ++c) {
+      const float level = h.level_mvv(static_cast<Eigen::Index>(k), c);
+      for (int i = h.starts[k]; i < StretchEnd(h.starts, k, cx.n); ++i) fit.pred(i, c) = level;
     }
   }
   nlohmann::json levels = nlohmann::json::array();
   for (int c = 0; c < cx.nc; ++c) {
     nlohmann::json lc = nlohmann::json::array();
-    for (const int a : starts) lc.push_back(fit.pred(a, c));
+    for (Eigen::Index k = 0; k < h.level_mvv.rows(); ++k) lc.push_back(h.level_mvv(k, c));
     levels.push_back(lc);
   }
   nlohmann::json from = nlohmann::json::array();
-  for (const int a : starts) from.push_back(cx.data->t_s[static_cast<std::size_t>(a)]);
+  for (const int a : h.starts) from.push_back(cx.data->t_s[static_cast<std::size_t>(a)]);
   fit.params["levels_mvv"] = levels;
   fit.params["level_from_s"] = from;
   fit.name = "zero_drift";
-  fit.n_params = cx.nc * static_cast<int>(starts.size());
-  fit.params["levels"] = static_cast<int>(starts.size());
+  fit.n_params = cx.nc * static_cast<int>(h.starts.size());
+  fit.train_sse_w = h.sse_w;
+  fit.params["levels"] = static_cast<int>(h.starts.size());
   fit.variant = kZeroStepsAtChanges;
   return fit;
 }
@@ -167,16 +204,17 @@ std::optional<EffectFit> FitHoldLevels(const Context& cx, const Series& target) 
 }  // namespace
 
 std::optional<EffectFit> FitZeroDrift(const Context& cx, const Series& target) {
-  bool smooth_at_top = false;
-  std::optional<EffectFit> smooth = FitSmoothDrift(cx, target, &smooth_at_top);
-  std::optional<EffectFit> steps = FitHoldLevels(cx, target);
-  const auto bic = [&](const std::optional<EffectFit>& f) {
-    return f ? f->train_sse_w + f->n_params * Penalty(cx) : std::numeric_limits<double>::infinity();
-  };
+  // Both variants' levels and training SSE first; the prediction only for the one kept.
+  const std::optional<SmoothDrift> smooth = FitSmoothDrift(cx, target);
+  const std::optional<HoldLevels> steps = FitHoldLevels(cx, target);
   if (!smooth && !steps) return std::nullopt;
+  const auto bic = [&](double sse_w, int n_params) { return sse_w + n_params * Penalty(cx); };
   // Steps before a spline whose knot count sits on its bound; else the lower BIC.
-  const bool prefer_steps = steps && (!smooth || smooth_at_top || bic(steps) < bic(smooth));
-  EffectFit best = prefer_steps ? std::move(*steps) : std::move(*smooth);
+  const bool prefer_steps =
+      steps && (!smooth || smooth->at_top ||
+                bic(steps->sse_w, cx.nc * static_cast<int>(steps->starts.size())) <
+                    bic(smooth->sse_w, cx.nc * (smooth->k + 1)));
+  EffectFit best = prefer_steps ? HoldLevelsFit(cx, *steps) : SmoothDriftFit(cx, *smooth);
   const bool stepped = best.variant == kZeroStepsAtChanges;
   Vec span(cx.nc);
   for (int c = 0; c < cx.nc; ++c)

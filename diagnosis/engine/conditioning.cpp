@@ -242,12 +242,14 @@ bool MeasureEdge(const Context& cx, const Edge& g, int c, const std::vector<doub
 }
 
 /// Reference changes between holds, each measured on every channel it moves clearly; the rows where
-/// any of them lags are excluded (with one row of margin each side). The transition reported is the
-/// channel that lags longest (else the one of largest change).
+/// any of them lags are excluded (the union of their windows, with one row of margin each side).
+/// The transition reported is the lagging channel whose own window (rows off the reference) is
+/// longest, else the one of largest change.
 void FindTransitions(Context* cx, Conditioning* out, const std::vector<std::uint8_t>& moving,
                      const std::vector<double>& sigma) {
   for (const Edge& g : Edges(*cx, moving)) {
     Transition shown;
+    int shown_rows = -1;  // the shown channel's own window, in rows (last − first)
     bool measured = false;
     int from = -1;
     int to = -1;
@@ -256,7 +258,10 @@ void FindTransitions(Context* cx, Conditioning* out, const std::vector<std::uint
       int f = -1;
       int e = -1;
       if (!MeasureEdge(*cx, g, c, sigma, &t, &f, &e)) continue;
-      if (!measured || (t.excluded && (!shown.excluded || e - f > to - from))) shown = t;
+      if (!measured || (t.excluded && (!shown.excluded || e - f > shown_rows))) {
+        shown = t;
+        shown_rows = e - f;
+      }
       measured = true;
       if (!t.excluded) continue;
       from = from < 0 ? f : std::min(from, f);

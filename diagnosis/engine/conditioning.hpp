@@ -22,8 +22,10 @@ struct Glitch {
 /// One change of the reference load between two holds, and the rows where the real load had not
 /// reached it (application, bounce): those rows are kept out of every fit and every hold-out score.
 struct Transition {
-  int first_row = 0;           ///< first row of the reference's change
-  int channel = 0;             ///< channel with the largest change (relative to its range)
+  int first_row = 0;  ///< first row of the reference's change
+  /// The lagging channel whose real load is off the reference over the most rows (its own
+  /// window), else (none lags) the channel with the largest change relative to its range.
+  int channel = 0;
   double t_s = 0.0;            ///< time of the reference's change
   double step_mvv = 0.0;       ///< the reference's change on `channel`, mV/V
   double application_s = 0.0;  ///< the real load's 10–90 % rise time / 0.8 (a linear ramp's length)

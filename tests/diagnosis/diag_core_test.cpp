@@ -455,5 +455,46 @@ TEST(DiagConditioning, WrongCodesOnLoadRampsAreFoundAndStepsAreNot) {
   EXPECT_EQ(r.verdict, "none");
 }
 
+TEST(DiagConditioning, TransitionIsShownOnTheChannelWithTheLongestOwnWindow) {
+  // One reference ramp on three channels (0 → 1 mV/V at 100 Hz: 0.05, 0.15, …, 0.95 on rows
+  // 100–109, 1 from row 110), each with its own real load u(100 + k), all lagging (10–90 % rise
+  // ≥ 10 rows against the reference's 8). By hand, the rows where |u − v| > 0.1:
+  //   b0: u = (k + ½)/20, rows 102–117 (15 rows apart), rise rows 102–118;
+  //   b1: u = v up to 0.75 (k ≤ 7), then 0.75 + 0.008 (k − 7): rows 109–125 (16 apart);
+  //   b2: u = (k + ½)/22, rows 102–119 (17 apart), rise rows 102–120 (18 rows).
+  // b2 lags over the most rows of its own; the union window (102–125, 23 apart) is what is
+  // excluded, with one row of margin: 1.01–1.26 s.
+  const int n = 400;
+  DiagData d;
+  d.sim_name = "one ramp";
+  d.real_name = "three lags";
+  d.sim_mvv.resize(n, 3);
+  d.real_mvv.resize(n, 3);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 1e-4);
+  for (int i = 0; i < n; ++i) {
+    const int k = i - 100;
+    const double v = k < 0 ? 0.0 : (k < 10 ? (k + 0.5) / 10.0 : 1.0);
+    const double u[3] = {k < 0 ? 0.0 : std::min(1.0, (k + 0.5) / 20.0),
+                         k <= 7 ? v : std::min(1.0, 0.75 + 0.008 * (k - 7)),
+                         k < 0 ? 0.0 : std::min(1.0, (k + 0.5) / 22.0)};
+    d.t_s.push_back(0.01 * i);
+    for (int c = 0; c < 3; ++c) {
+      d.sim_mvv(i, c) = v;
+      d.real_mvv(i, c) = u[c] + noise(rng);
+    }
+  }
+  const Context cx = MakeContext(d);
+  const auto& tr = cx.conditioning.transitions;
+  ASSERT_EQ(tr.size(), 1u);
+  EXPECT_EQ(tr[0].first_row, 100);
+  EXPECT_EQ(tr[0].channel, 2);
+  EXPECT_TRUE(tr[0].excluded);
+  EXPECT_NEAR(tr[0].step_mvv, 1.0, 1e-12);
+  EXPECT_NEAR(tr[0].application_s, 18 * 0.01 / 0.8, 1e-9);
+  EXPECT_NEAR(tr[0].excluded_from_s, 1.01, 1e-9);
+  EXPECT_NEAR(tr[0].excluded_to_s, 1.26, 1e-9);
+}
+
 }  // namespace
 }  // namespace ftstack::diag

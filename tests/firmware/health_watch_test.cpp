@@ -426,6 +426,42 @@ TEST(HealthWatch, Ne107StateFollowsStatusBits) {
   EXPECT_EQ(w.report().state, Ne107State::kFailure);
 }
 
+TEST(HealthWatch, RainflowCountsReachTheReportWhenACycleClosesAndAfterAClear) {
+  // Fz (rated 400 000 LSB, turning-point gate 2 %) visits 0, 100 000, 40 000, 120 000 and back to
+  // 0, 50 samples each. By the four-point rule (worked by hand) the points 0 100k 40k 120k close
+  // one full cycle 100k–40k (range 60 000 = 15 % of rated: counted, bin [10, 20) %) at the first
+  // sample back at 0, which confirms 120 000 as a turning point; nothing closes before it.
+  HealthWatch w;
+  ASSERT_TRUE(w.Configure(1000, kRated));
+  const std::array<std::int32_t, 5> levels = {0, 100000, 40000, 120000, 0};
+  const auto step = [&](std::int32_t fz) {
+    HealthInput in;
+    in.valid = true;
+    in.tared[2] = fz;
+    in.untared = in.tared;
+    in.untared_valid = true;
+    w.Step(in);
+  };
+  for (std::size_t k = 0; k + 1 < levels.size(); ++k) {
+    for (int i = 0; i < 50; ++i) step(levels[k]);
+  }
+  EXPECT_EQ(w.report().cycles[2], 0u);
+  step(0);
+  for (std::size_t a = 0; a < kAxes; ++a) {
+    EXPECT_EQ(w.report().cycles[a], a == 2 ? 1u : 0u) << "axis " << a;
+    for (std::size_t b = 0; b < kRainflowBins; ++b) {
+      EXPECT_EQ(w.report().cycle_bins[a][b], a == 2 && b == 2 ? 1u : 0u) << a << " bin " << b;
+    }
+  }
+  for (int i = 0; i < 100; ++i) step(0);  // samples closing nothing keep the counts
+  EXPECT_EQ(w.report().cycles[2], 1u);
+  EXPECT_EQ(w.report().cycle_bins[2][2], 1u);
+  w.Clear();
+  step(0);
+  EXPECT_EQ(w.report().cycles[2], 0u);
+  EXPECT_EQ(w.report().cycle_bins[2][2], 0u);
+}
+
 TEST(HealthWatch, RefusesWithoutRatedRange) {
   HealthWatch w;
   EXPECT_FALSE(w.Configure(1000, {1, 1, 0, 1, 1, 1}));

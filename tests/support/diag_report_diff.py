@@ -103,12 +103,16 @@ class Differ:
             sub = f"{path}.{key}" if path else key
             if self.ignore and self.ignore.search(sub):
                 continue
-            if key not in new:
-                self.rows.append(Row(sub, "removed", short(old[key]), "", leaves(old[key])))
-            elif key not in old:
-                self.rows.append(Row(sub, "added", "", short(new[key]), leaves(new[key])))
-            else:
-                self.walk(sub, old[key], new[key])
+            self.walk_member(sub, old, new, key)
+
+    def walk_member(self, sub, old, new, key):
+        """One key of two mappings (a dict's, or a list's items by their key): removed, added or walked."""
+        if key not in new:
+            self.rows.append(Row(sub, "removed", short(old[key]), "", leaves(old[key])))
+        elif key not in old:
+            self.rows.append(Row(sub, "added", "", short(new[key]), leaves(new[key])))
+        else:
+            self.walk(sub, old[key], new[key])
 
     def walk_list(self, path, old, new):
         if old and new and all(is_number(v) for v in old + new) and len(old) == len(new):
@@ -118,12 +122,7 @@ class Differ:
         old_map, new_map = dict(zip(old_keys, old)), dict(zip(new_keys, new))
         for key in old_keys + [k for k in new_keys if k not in old_map]:
             sub = f"{path}[{key}]"
-            if key not in new_map:
-                self.rows.append(Row(sub, "removed", short(old_map[key]), "", leaves(old_map[key])))
-            elif key not in old_map:
-                self.rows.append(Row(sub, "added", "", short(new_map[key]), leaves(new_map[key])))
-            else:
-                self.walk(sub, old_map[key], new_map[key])
+            self.walk_member(sub, old_map, new_map, key)
         if [k for k in old_keys if k in new_map] != [k for k in new_keys if k in old_map]:
             self.rows.append(Row(path, "order", " ".join(old_keys), " ".join(new_keys)))
 
