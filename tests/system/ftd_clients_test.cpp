@@ -110,8 +110,14 @@ TEST(FtdClients, ReadmeMbpollExamplesWork) {
   EXPECT_EQ(h[0], 64);
   ASSERT_EQ(modbus_read_registers(c, fw::kHoldTransform, 6, h), 6);
   EXPECT_FLOAT_EQ(fw::UnpackFloat32(&h[4]), 0.1f);
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // tare over 0.1 s
-  ASSERT_EQ(modbus_read_input_registers(c, fw::kInStatus, 1, h), 1);
+  // The tare completes after 0.1 s of samples: polled (a loaded machine may take longer than a
+  // fixed sleep to sample them), with a deadline far above it.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  do {
+    ASSERT_EQ(modbus_read_input_registers(c, fw::kInStatus, 1, h), 1);
+    if ((h[0] & fw::kStatusTareActive) != 0) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  } while (std::chrono::steady_clock::now() < deadline);
   EXPECT_NE(h[0] & fw::kStatusTareActive, 0);
   modbus_close(c);
   modbus_free(c);

@@ -522,7 +522,7 @@ TEST(FtdModbus, EveryReplyComesFromOneSample) {
   const Expected e = DeriveExpected();
   const double tol = kSigmas * e.sigma_si[2] + e.fixed_error_si[2] + 300 * 6e-8;
   ASSERT_LT(tol, 0.3);  // half a sample step: the test can tell neighbouring samples apart
-  std::atomic<int> bad{0}, checked{0};
+  std::atomic<int> bad{0};
   {
     Client c(ftd.port());
     ASSERT_TRUE(c.WaitSamples(200));  // past start-up, when the sampler may catch up in a burst
@@ -539,8 +539,11 @@ TEST(FtdModbus, EveryReplyComesFromOneSample) {
     std::uint32_t first = 0;
     std::uint32_t prev_seq = 0;
     std::uint32_t prev_ts = 0;
-    // One second of samples (1000 sequence numbers), read as fast as the server answers.
-    for (std::uint32_t seq = 0; first == 0 || seq - first < 1000;) {
+    // At least one second of samples (1000 sequence numbers) and at least 1000 replies, read as
+    // fast as the server answers (on a quiet machine several per sample period; a loaded one
+    // reads longer instead of checking fewer replies).
+    int replies = 0;
+    for (std::uint32_t seq = 0; first == 0 || seq - first < 1000 || replies < 1000;) {
       if (c.Input(0, 18, r.data()) != 18) {
         ++bad;
         continue;
@@ -561,14 +564,13 @@ TEST(FtdModbus, EveryReplyComesFromOneSample) {
       prev_seq = seq;
       prev_ts = ts;
       if (!same) ++bad;
-      ++checked;
+      ++replies;
     }
   };
   std::thread r1(reader), r2(reader);
   r1.join();
   r2.join();
   EXPECT_EQ(bad.load(), 0);
-  EXPECT_GT(checked.load(), 2000);  // several reads per sample period
   EXPECT_EQ(ftd.Stop(), 0);
   std::remove(path);
 }
