@@ -109,8 +109,10 @@ struct Asked {
 
 TEST(FtdTareHistory, LastFourTaresReadBackWithTheLoadTimeTemperatureAndSourceApplied) {
   test::TempDir dir;
+  // Speed 3: a tare asked 2 s into a hold has 6 s of simulated time (2 s of wall clock, many
+  // mbpoll round trips on a loaded machine) to complete before the hold ends.
   test::FtdProcess ftd({"--modbus-tcp", "127.0.0.1:0", "--print-hz", "0", "--rate-hz", "1000",
-                        "--sim-speed", "5", "--sim-profile", Profile(dir), "--sim-span-s", "60",
+                        "--sim-speed", "3", "--sim-profile", Profile(dir), "--sim-span-s", "60",
                         "--rdt", "127.0.0.1:0"});
   ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
   const int rdt = RdtPort(ftd);
