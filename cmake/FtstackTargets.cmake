@@ -8,9 +8,11 @@
 #   ftstack_measurement  host types: wrench, units, recording format, -> nothing of ours
 #                        effect vocabulary, shared numerics
 #   ftstack_cal_file     what a board loads: calibration file, slots  -> hal_if, fw
-#   ftstack_cal_fit      fitting, fit reports, ATI import             -> hal_if, fw, meas, calfile
+#   ftstack_cal_fit      fitting, fit reports, offline apply          -> hal_if, fw, meas, calfile, calfit
+#   ftstack_cal_ati        (calfit) the ATI calibration-file import; ftstack_cal_fit links it
 #   ftstack_sim*         physics simulator, rigs, recordings          -> hal_if, hal, meas, calfile, sim
-#   ftstack_daemon       ftd's daemon (board and host)                -> hal_if, hal, fw, meas, calfile
+#   ftstack_daemon       ftd's daemon (board and host)                -> hal_if, hal, fw, meas, calfile, daemon
+#   ftstack_rdt            (daemon) its RDT server; ftstack_daemon links it
 #   ftstack_daemon_sim   ftd's simulated backend (host only)          -> the daemon's + sim, daemon
 #   ftstack_diagnosis_filters  the diagnosis's closed-form filters    -> nothing of ours
 #   ftstack_diagnosis    sim-vs-real diagnosis engine and effects     -> meas, diag_filters
@@ -112,9 +114,9 @@ function(_ftstack_layer_of target out)
     set(${out} "sim" PARENT_SCOPE)
   elseif(target STREQUAL "ftstack_cal_file")
     set(${out} "calfile" PARENT_SCOPE)
-  elseif(target STREQUAL "ftstack_cal_fit")
+  elseif(target STREQUAL "ftstack_cal_fit" OR target STREQUAL "ftstack_cal_ati")
     set(${out} "calfit" PARENT_SCOPE)
-  elseif(target STREQUAL "ftstack_daemon")
+  elseif(target STREQUAL "ftstack_daemon" OR target STREQUAL "ftstack_rdt")
     set(${out} "daemon" PARENT_SCOPE)
   elseif(target STREQUAL "ftstack_daemon_sim")
     set(${out} "daemon_sim" PARENT_SCOPE)
@@ -139,9 +141,9 @@ function(ftstack_check_layers)
   set(allowed_fw "hal_if;fw")
   set(allowed_meas "")
   set(allowed_calfile "hal_if;fw")
-  set(allowed_calfit "hal_if;fw;meas;calfile")
+  set(allowed_calfit "hal_if;fw;meas;calfile;calfit")
   set(allowed_sim "hal_if;hal;meas;calfile;sim")
-  set(allowed_daemon "hal_if;hal;fw;meas;calfile")
+  set(allowed_daemon "hal_if;hal;fw;meas;calfile;daemon")
   set(allowed_daemon_sim "hal_if;hal;fw;meas;calfile;sim;daemon")
   set(allowed_diag_filters "")
   set(allowed_diag "meas;diag_filters")
