@@ -28,7 +28,8 @@ struct FtdOptions {
   std::vector<std::string> sim_effects;
   std::string sim_profile;
   double sim_span_s = 600.0;
-  double sim_speed = 1.0;  ///< paced simulated ADC: simulated seconds per wall-clock second
+  double sim_speed = 1.0;       ///< paced simulated ADC: simulated seconds per wall-clock second
+  bool sim_temperature = true;  ///< false: the simulated ADC reports no temperature
   unsigned rate_hz = 1000;
   std::string cal;    ///< calibration file for slot 0 ("" = built-in)
   std::string cal_b;  ///< calibration file for slot 1 ("" = none)

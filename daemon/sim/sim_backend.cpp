@@ -116,6 +116,7 @@ class SimulatedBackend final : public AdcBackend {
     params.seed = opt.seed;
     params.realtime = opt.paced;
     params.speed = opt.sim_speed;
+    params.temperature = opt.sim_temperature;
     params.stall_every = opt.sim_stall_every;
     params.stall_us = static_cast<std::uint32_t>(opt.sim_stall_ms * 1000.0);
     // One wake-up of the sampling thread per millisecond of samples at most (a converter FIFO's

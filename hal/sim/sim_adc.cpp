@@ -117,7 +117,7 @@ Status SimAdc::DoRead(AdcSample& out) {
   if (fault_ == SimFault::kOpenBridge && fault_channel_ < n) {
     out.counts[fault_channel_] = info_.max_counts;
   }
-  if (std::isfinite(temperature_c)) {
+  if (params_.temperature && std::isfinite(temperature_c)) {
     out.has_temperature = true;
     out.temperature_mdegc = static_cast<std::int32_t>(std::lround(temperature_c * 1000.0));
   }

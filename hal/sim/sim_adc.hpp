@@ -52,6 +52,9 @@ struct SimAdcParams {
   /// With realtime: conversions per data-ready (1 … kMaxBlockSamples), like a converter's FIFO
   /// with a watermark. The caller wakes once per block and reads the block without waiting.
   std::uint16_t block_samples = 1;
+  /// False: a converter without a temperature input (an HX711): its samples carry no temperature,
+  /// whatever the source gives.
+  bool temperature = true;
 };
 
 /// Largest block of SimAdcParams::block_samples.

@@ -60,6 +60,19 @@ TEST(SimAdc, QuantisesRatiometricallyAndClipsAtTheRails) {
   EXPECT_EQ(s.temperature_mdegc, 25500);
 }
 
+TEST(SimAdc, AConverterWithoutATemperatureInputReportsNone) {
+  RampSource src(2);  // the source gives 25.5 °C
+  SimAdcParams p = Quiet();
+  p.temperature = false;
+  SimAdc adc(src, p);
+  ASSERT_EQ(adc.Configure(AdcConfig{2, 128, 1000}), Status::kOk);
+  ASSERT_EQ(adc.WaitDataReady(1000), Status::kOk);
+  AdcSample s{};
+  ASSERT_EQ(adc.Read(s), Status::kOk);
+  EXPECT_FALSE(s.has_temperature);
+  EXPECT_EQ(s.temperature_mdegc, 0);
+}
+
 TEST(SimAdc, GainScalesFullScale) {
   RampSource src(1);
   src.value[0] = 10.0;

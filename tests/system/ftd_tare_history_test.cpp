@@ -1,7 +1,8 @@
 // The tare history end to end: ftd's simulated sensor holds five different loads at five
 // temperatures (a --sim-profile), a tare is asked for in each hold — over Modbus with mbpoll, and
 // once over RDT (UDP) —, and the history (input 210–289) read back with mbpoll must hold the last
-// four: number, who asked, when, the temperature and the load the profile applied, per axis.
+// four: number, who asked, when, the temperature and the load the profile applied, per axis. A
+// tare on a converter without a temperature input records none (NaN), not the simulator's.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
@@ -178,6 +179,48 @@ TEST(FtdTareHistory, LastFourTaresReadBackWithTheLoadTimeTemperatureAndSourceApp
   std::printf("tares at simulated time");
   for (const Asked& a : asked) std::printf(" [%.2f, %.2f] s", a.from_s, a.to_s);
   std::printf("\n");
+}
+
+TEST(FtdTareHistory, ATareWithoutATemperatureRecordsNoneNotAGuess) {
+  // --sim-no-temperature: the simulated converter has no temperature input (as an HX711) while the
+  // simulator's body sits at 20 °C. A tare over Modbus must then record the documented "none" —
+  // NaN in its history slot (216–217), 0 as tare_temp_c (187–188), NaN as temperature_c (30–31) —
+  // and not the simulator's 20 °C, which the same run with a temperature must read.
+  const std::array<double, 6> load = {10, -5, 120, 0.5, -0.2, 0.1};
+  const test::SimNoise noise = test::DeriveSimNoise();
+  for (const bool none : {true, false}) {
+    std::vector<std::string> args = {"--modbus-tcp", "127.0.0.1:0",           "--print-hz", "0",
+                                     "--sim-wrench", "10,-5,120,0.5,-0.2,0.1"};
+    if (none) args.emplace_back("--sim-no-temperature");
+    test::FtdProcess ftd(args);
+    ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
+    Mbpoll m(ftd.port());
+    const double temp_now = m.Read("3:float", 30, 1).at(30);
+    ASSERT_TRUE(m.Tare());
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (m.Read("3", 189, 1).at(189) < 1 && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ASSERT_EQ(m.Read("3", 189, 1).at(189), 1) << "the tare did not complete; none = " << none;
+    EXPECT_EQ(m.Read("3:int", 210, 1).at(210), 1) << none;  // tare number 1
+    EXPECT_EQ(m.Read("3", 212, 1).at(212), 1) << none;      // asked over Modbus
+    const auto f = m.Read("3:float", 216, 7);
+    const double tare_temp = m.Read("3:float", 187, 1).at(187);
+    if (none) {
+      EXPECT_TRUE(std::isnan(temp_now)) << temp_now;
+      EXPECT_TRUE(std::isnan(f.at(216))) << "the tare recorded " << f.at(216) << " °C";
+      EXPECT_EQ(tare_temp, 0.0);
+    } else {
+      EXPECT_NEAR(temp_now, 20.0, 0.01);
+      EXPECT_NEAR(f.at(216), 20.0, 0.01);
+      EXPECT_NEAR(tare_temp, 20.0, 0.01);
+    }
+    // The load it removed, as in the test above at 20 °C: noise of the 0.1 s mean and arithmetic.
+    for (std::size_t a = 0; a < 6; ++a) {
+      const double tol = 5 * noise.sigma[a] / 10 + noise.fixed_error[a] + std::fabs(load[a]) * 1e-6;
+      EXPECT_NEAR(f.at(218 + 2 * static_cast<int>(a)), load[a], tol) << "axis " << a << " " << none;
+    }
+  }
 }
 
 }  // namespace

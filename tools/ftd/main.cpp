@@ -109,6 +109,8 @@ void AddOptions(CLI::App& app, Args& a) {
       ->check(CLI::Range(1.0, 86400.0));
   app.add_option("--sim-speed", opt.sim_speed, "simulated seconds per wall-clock second (paced)")
       ->check(CLI::Range(0.01, 1000.0));
+  app.add_flag("--sim-no-temperature{false}", opt.sim_temperature,
+               "the simulated ADC reports no temperature (a converter without one, as an HX711)");
   app.get_option("--sim-wrench")->excludes(app.get_option("--replay"));
   app.get_option("--sim-effect")->excludes(app.get_option("--replay"));
 }
