@@ -51,8 +51,9 @@ nlohmann::json ConditioningJson(const Report& r) {
           {"transitions",
            {{"handling",
              "rows where the real load had not reached the reference (its normalised value more "
-             "than 0.1 from the reference's) are excluded from every fit and hold-out score when "
-             "the real 10-90 % rise is >= 2 rows slower than the reference's"},
+             "than 0.1 from the reference's), widened over the ramp's foot and a decaying "
+             "bounce, are excluded from every fit and hold-out score when the real 10-90 % rise "
+             "is >= 2 rows slower than the reference's"},
             {"count", k.transitions.size()},
             {"excluded", lagging},
             {"list", transitions}}},

@@ -496,5 +496,43 @@ TEST(DiagConditioning, TransitionIsShownOnTheChannelWithTheLongestOwnWindow) {
   EXPECT_NEAR(tr[0].excluded_to_s, 1.26, 1e-9);
 }
 
+TEST(DiagConditioning, ARampsFootAndTheBounceAreExcludedAndTheRingingIsNot) {
+  // A hand-hung weight at 10 Hz: the reference steps 0 → 1 mV/V at row 300 (30 s); the real load
+  // is a raised cosine over 29.4–30.9 s, then a bounce of 8 % of the step at 2.5 Hz decaying with
+  // 0.3 s, under a swing of 0.4 % at 0.8 Hz decaying with 100 s; noise 1e-4 mV/V. By hand:
+  // - the foot: the ramp is 1.1 % off at 29.5 s (row 295; 0 at 29.4 s), 100 σ of the noise;
+  // - the bounce: its amplitude 0.08 e^(−Δ/0.3) is below the swing's 0.004 only for Δ > 0.9 s,
+  //   i.e. after 31.8 s; the swing lasts the whole hold and is a finding, not a transition.
+  const int n = 1200;
+  DiagData d;
+  d.sim_name = "step";
+  d.real_name = "ramp, bounce and swing";
+  d.sim_mvv.resize(n, 1);
+  d.real_mvv.resize(n, 1);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 1e-4);
+  const double pi = 3.141592653589793;
+  for (int i = 0; i < n; ++i) {
+    const double t = 0.1 * i;
+    const double x = std::clamp((t - 29.4) / 1.5, 0.0, 1.0);
+    double u = 0.5 * (1.0 - std::cos(pi * x));
+    if (t > 30.9) {
+      const double after = t - 30.9;
+      u += 0.08 * std::exp(-after / 0.3) * std::sin(2 * pi * 2.5 * after) +
+           0.004 * std::exp(-after / 100.0) * std::sin(2 * pi * 0.8 * after);
+    }
+    d.t_s.push_back(t);
+    d.sim_mvv(i, 0) = i >= 300 ? 1.0 : 0.0;
+    d.real_mvv(i, 0) = u + noise(rng);
+  }
+  const Context cx = MakeContext(d);
+  const auto& tr = cx.conditioning.transitions;
+  ASSERT_EQ(tr.size(), 1u);
+  EXPECT_TRUE(tr[0].excluded);
+  EXPECT_LE(tr[0].excluded_from_s, 29.5 + 1e-9);
+  EXPECT_GE(tr[0].excluded_to_s, 31.8);
+  EXPECT_LE(tr[0].excluded_to_s, 33.9);
+}
+
 }  // namespace
 }  // namespace ftstack::diag

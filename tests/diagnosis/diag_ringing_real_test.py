@@ -10,7 +10,8 @@ References ftdiag shares no code with:
 
 Asserted on every generator seed: `resonance` claimed within 5 % of the true frequency, any creep
 claimed has its tau inside the per-hold fits' range (widened by 50 %: a hold fits one exponential
-to two) and every fraction below 2 %, the held-out RMS lowered, no claim "not resolved" and no
+to two) and every fraction below 2 %, the held-out RMS lowered by at least 30 % (issue 26's bar
+for a real recording of the class), no claim "not resolved" and no
 fit claimed at a search bound. Where `zero_drift` is claimed as "steps at load changes", its level
 per stretch is compared with the generator's true zero (the sum of the zero shifts it applied up to
 that stretch): both projected off [1, reference load] across the stretches (the user's static line
@@ -127,8 +128,8 @@ def check_generator(ftdiag, work, seed, failures):
           f"{f_true:.4f}), held-out {100 * gain:.1f} % lower, {elapsed:.1f} s")
     if f_got is None or abs(f_got / f_true - 1.0) > 0.05:
         failures.append(f"seed {seed}: resonance {f_got} not within 5 % of {f_true:.4f} Hz")
-    if gain <= 0.0:
-        failures.append(f"seed {seed}: held-out RMS not lowered")
+    if gain < 0.30:
+        failures.append(f"seed {seed}: held-out RMS lowered by {100 * gain:.1f} %, not 30 %")
     check_common(f"seed {seed}", report, per_hold_taus(real), failures)
     check_zero_shifts(seed, truth, report, failures)
 
