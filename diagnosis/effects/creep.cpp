@@ -9,9 +9,28 @@
 #include <vector>
 
 #include "diagnosis/effects/families.hpp"
+#include "diagnosis/engine/plausibility.hpp"
 #include "diagnosis/engine/signal.hpp"
 
 namespace ftstack::diag::fx {
+
+/// The shortest creep time constant the data can show: 3 samples, 0.2 s, and 3 times the typical
+/// (median) application time of the load changes that lagged their reference. Faster than that, a
+/// creep runs its course while the hand, hanger and bounce are still settling the load, and a fit
+/// would read it from how the load arrived, not from how it creeps.
+double CreepTauFloor(const Context& cx) {
+  std::vector<double> app;
+  for (const Transition& t : cx.conditioning.transitions) {
+    if (t.excluded) app.push_back(t.application_s);
+  }
+  double floor_s = std::max(3.0 * cx.dt, 0.2);
+  if (!app.empty()) {
+    const auto mid = app.begin() + static_cast<std::ptrdiff_t>(app.size() / 2);
+    std::nth_element(app.begin(), mid, app.end());
+    floor_s = std::max(floor_s, 3.0 * *mid);
+  }
+  return floor_s;
+}
 
 namespace {
 
@@ -144,7 +163,7 @@ std::optional<EffectFit> CreepSearch(const Context& cx, const Series& target, co
     return SearchSse(cx, target, lp, true);
   };
   std::vector<double> grid;
-  const double lo = std::log(std::max(3.0 * cx.dt, 0.2));
+  const double lo = std::log(CreepTauFloor(cx));
   const double hi = std::log(std::max(duration, 1.0));
   for (int j = 0; j <= 12; ++j) grid.push_back(lo + (hi - lo) * j / 12.0);
   // τ is searched with the plain model; the variant with a gain term reuses it. Near a fit: 5
@@ -370,7 +389,7 @@ bool FitCreepTwo(const Context& cx, const Series& target, double log_tau1, doubl
                  EffectFit* best, std::vector<double>* tau, std::vector<double>* tau_sigma,
                  ChannelFit* best_f, bool* best_gamma, const double* start, bool uncertainty) {
   const double duration = cx.data->t_s.back() - cx.data->t_s.front();
-  const double lo = std::log(std::max(3.0 * cx.dt, 0.2));
+  const double lo = std::log(CreepTauFloor(cx));
   // A second time constant longer than a third of the record cannot be told from a drift or an
   // offset over the record (seen with zero_offset + creep): the pair search stops there.
   const double hi = std::log(std::max(duration / 3.0, 1.0));
@@ -383,6 +402,8 @@ bool FitCreepTwo(const Context& cx, const Series& target, double log_tau1, doubl
   // Two exponentials closer than a factor 3 in τ are not resolved by the data (their fractions
   // trade against each other, often with opposite signs: seen on ftsim's creep with drift).
   if (l2 - l1 < std::log(3.0)) return false;
+  // A fast time constant on the floor is not resolved: the one-τ model is what the data supports.
+  if (l1 - lo < kOnBound) return false;
   // Both variants' fits over every row in one streamed pass of the two lags.
   const double t12[2] = {std::exp(l1), std::exp(l2)};
   ChannelSums sums[2] = {ChannelSums(cx, 2), ChannelSums(cx, 3)};
@@ -449,15 +470,15 @@ namespace ftstack::diag {
 
 namespace {
 
-/// Creep's physical ranges: time constants from 3 samples (and 0.2 s: the search's lower bound) to
-/// a third of the record (a slower one is a drift the record cannot tell from creep), fractions of
-/// the load up to 5 % (a load cell creeping more is broken, or the fit is absorbing another
-/// mismatch).
+/// Creep's physical ranges: time constants from fx::CreepTauFloor (3 samples, 0.2 s, 3 application
+/// times of the load: the search's lower bound) to a third of the record (a slower one is a drift
+/// the record cannot tell from creep), fractions of the load up to 5 % (a load cell creeping more
+/// is broken, or the fit is absorbing another mismatch).
 std::vector<ParamRange> CreepRanges(const Context& cx) {
   const auto& t = cx.data->t_s;
-  const double lo = std::max(3.0 * cx.dt, 0.2);
+  const double lo = fx::CreepTauFloor(cx);
   const double hi = std::max((t.back() - t.front()) / 3.0, 1.0);
-  const char* lo_what = "3 samples or 0.2 s";
+  const char* lo_what = "3 samples, 0.2 s or 3 application times of the load";
   const char* hi_what = "a third of the record";
   return {{"tau_s", lo, hi, lo_what, hi_what},
           {"tau1_s", lo, hi, lo_what, hi_what},

@@ -48,6 +48,10 @@ namespace ftstack::diag {
 
 namespace ftstack::diag::fx {
 
+/// The shortest creep time constant the data can show (3 samples, 0.2 s, 3 typical application
+/// times of lagging load changes): the search's lower bound and the range's.
+double CreepTauFloor(const Context& cx);
+
 std::optional<EffectFit> FitZeroOffset(const Context& cx, const Series& target);
 std::optional<EffectFit> FitZeroDrift(const Context& cx, const Series& target);
 std::optional<EffectFit> FitThermalZeroPlain(const Context& cx, const Series& target);

@@ -17,9 +17,6 @@ using fx::Fmt;
 
 namespace {
 
-/// Closeness to a bound that counts as "on" it: 2 % in log (positive ranges) or of the range.
-constexpr double kOnBound = 0.02;
-
 /// Why one scalar value is not resolved against range r, or "".
 std::string ScalarWords(const ParamRange& r, double v) {
   if (!std::isfinite(v)) return Fmt("%s is not finite", r.key);

@@ -9,6 +9,9 @@
 
 namespace ftstack::diag {
 
+/// Closeness to a bound that counts as "on" it: 2 % in log (positive ranges) or of the range.
+inline constexpr double kOnBound = 0.02;
+
 /// Why `fit` is not resolved ("tau_s = 0.30 s at its lower bound (3 samples)"), or "" when every
 /// ranged parameter of its plug-in lies inside its range, more than 2 % (in log) from each bound.
 [[nodiscard]] std::string NotResolved(const Context& cx, const EffectFit& fit);

@@ -149,7 +149,7 @@ def main():
     ftdiag = sys.argv[1]
     failures = []
     with tempfile.TemporaryDirectory() as work:
-        for seed in (101, 102, 103, 104):
+        for seed in (101, 102, 103, 104, 110):
             check_generator(ftdiag, work, seed, failures)
         for file in ("ketter133_2024-02-14.csv", "seesl_2024-01-22.csv"):
             check_real(ftdiag, work, file, failures)
