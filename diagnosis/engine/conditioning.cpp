@@ -194,11 +194,11 @@ std::vector<int> EdgeChannels(const Context& cx, const Edge& g) {
 
 /// Widens a lagging channel's window [from, to] to where its load has really changed and settled.
 /// Before (when the window starts by the reference's change `s`): back to row `a` while the real
-/// load is off its level before the change by more than 4 robust σ of that level (a smooth ramp's
-/// foot lies inside the band). After: on to `last` while the activity (robust σ of first
-/// differences over a second) is over twice that a second and two seconds later: a hanger's
-/// bounce dies within it, while a swinging weight's ringing, creep and noise do not decay that
-/// fast and stay in.
+/// load is off its level before the change by more than kTransitionFootSigmas robust σ of that
+/// level (a smooth ramp's foot lies inside the band). After: on to `last` while the activity
+/// (robust σ of first differences over a second) is over kBounceDecayFactor times that a second
+/// and two seconds later: a hanger's bounce dies within it, while a swinging weight's ringing,
+/// creep and noise do not decay that fast and stay in.
 template <class U>
 void SettleWindow(U u, int a, int s, int last, double rate_hz, int* from, int* to) {
   std::vector<double> pre;
@@ -207,15 +207,23 @@ void SettleWindow(U u, int a, int s, int last, double rate_hz, int* from, int* t
     std::vector<double> dev;
     const double level = Median(&pre);
     for (int i = a; i < s; ++i) dev.push_back(std::fabs(u(i) - level));
-    const double spread = 1.4826 * Median(&dev);
-    while (*from > a && std::fabs(u(*from - 1) - level) > 4.0 * spread) --*from;
+    const double spread = Median(&dev) / 0.6745;  // robust σ: median absolute deviation
+    while (*from > a && std::fabs(u(*from - 1) - level) > kTransitionFootSigmas * spread) --*from;
   }
   const int w = std::max(6, static_cast<int>(std::lround(rate_hz)));
-  const auto activity = [&](int i) { return DetrendedDiffSigma(u, i, i + w); };
-  // A robust σ over a window speaks for its middle rows.
-  for (int i = std::max(s, *to + 1 - w / 2); i + 3 * w <= last; ++i) {
-    if (activity(i) <= 2.0 * std::max(activity(i + w), activity(i + 2 * w))) break;
-    *to = std::max(*to, i + w / 2);
+  const int first = std::max(s, *to + 1 - w / 2);
+  if (first + 3 * w > last) return;
+  // activity(k): the robust σ of first differences over rows first + k … first + k + w − 1, which
+  // speaks for its middle rows; each is computed once, and only as far as the bounce lasts.
+  std::vector<double> memo(static_cast<std::size_t>(last - first - w + 1), -1.0);
+  const auto activity = [&](int k) {
+    double& m = memo[static_cast<std::size_t>(k)];
+    if (m < 0) m = DetrendedDiffSigma(u, first + k, first + k + w);
+    return m;
+  };
+  for (int k = 0; first + k + 3 * w <= last; ++k) {
+    if (activity(k) <= kBounceDecayFactor * std::max(activity(k + w), activity(k + 2 * w))) break;
+    *to = std::max(*to, first + k + w / 2);
   }
 }
 
@@ -252,7 +260,6 @@ bool MeasureEdge(const Context& cx, const Edge& g, int c, const std::vector<doub
     if (*from < 0) *from = i;
     *to = i;
   }
-  if (*from >= 0) SettleWindow(u, a, g.s, g.e + after / 2, cx.rate_hz, from, to);
   const int u10 = FirstAtLeast(u, a, b, 0.1);
   const int u90 = u10 < 0 ? -1 : FirstAtLeast(u, u10, b, 0.9);
   const int v10 = FirstAtLeast(v, a, b, 0.1);
@@ -266,6 +273,7 @@ bool MeasureEdge(const Context& cx, const Edge& g, int c, const std::vector<doub
   // Lagging: the real load rises clearly slower than the reference (a skew keeps the shape).
   t->excluded =
       *from >= 0 && (u90 - u10) - (v90 - v10) >= 2 && (u90 - u10) > (v90 - v10) + (v90 - v10) / 2;
+  if (t->excluded) SettleWindow(u, a, g.s, g.e + after / 2, cx.rate_hz, from, to);
   return true;
 }
 

@@ -67,6 +67,12 @@ inline constexpr double kQuietClass = 1.5;
 /// A transition's rows are those where the normalised real load is further than this from the
 /// normalised reference (bounce and ringing of a few % stay in).
 inline constexpr double kTransitionBand = 0.1;
+/// A lagging change's window reaches back over rows further than this many robust σ (of the level
+/// before the change) from that level: a smooth ramp's foot, already well out of the noise.
+inline constexpr double kTransitionFootSigmas = 4.0;
+/// ... and on while the activity over a second is more than this factor above that one and two
+/// seconds later: a bounce that dies within seconds (a swing that lasts minutes never is).
+inline constexpr double kBounceDecayFactor = 2.0;
 
 /// Finds glitches and transitions in the context's residual and load, replaces glitch samples of
 /// the residual by the line through their neighbours, marks glitch and lagging-transition rows in

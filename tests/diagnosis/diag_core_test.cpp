@@ -1,7 +1,9 @@
 // ftdiag core: numerical blocks against closed forms, and diagnoses of closed-form fixtures.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "diagnosis/engine/diagnose.hpp"
@@ -455,6 +457,27 @@ TEST(DiagConditioning, WrongCodesOnLoadRampsAreFoundAndStepsAreNot) {
   EXPECT_EQ(r.verdict, "none");
 }
 
+/// A recording of n rows, dt_s apart, on nc channels: reference ref(i, c) and real load
+/// real(i, c), the latter with white noise of 1e-4 mV/V (seeded).
+template <class Ref, class Real>
+DiagData NoisyRecording(int n, int nc, double dt_s, unsigned seed, Ref ref, Real real) {
+  DiagData d;
+  d.sim_name = "reference";
+  d.real_name = "real load with noise";
+  d.sim_mvv.resize(n, nc);
+  d.real_mvv.resize(n, nc);
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1e-4);
+  for (int i = 0; i < n; ++i) {
+    d.t_s.push_back(dt_s * i);
+    for (int c = 0; c < nc; ++c) {
+      d.sim_mvv(i, c) = ref(i, c);
+      d.real_mvv(i, c) = real(i, c) + noise(rng);
+    }
+  }
+  return d;
+}
+
 TEST(DiagConditioning, TransitionIsShownOnTheChannelWithTheLongestOwnWindow) {
   // One reference ramp on three channels (0 → 1 mV/V at 100 Hz: 0.05, 0.15, …, 0.95 on rows
   // 100–109, 1 from row 110), each with its own real load u(100 + k), all lagging (10–90 % rise
@@ -464,26 +487,19 @@ TEST(DiagConditioning, TransitionIsShownOnTheChannelWithTheLongestOwnWindow) {
   //   b2: u = (k + ½)/22, rows 102–119 (17 apart), rise rows 102–120 (18 rows).
   // b2 lags over the most rows of its own; the union window (102–125, 23 apart) is what is
   // excluded, with one row of margin: 1.01–1.26 s.
-  const int n = 400;
-  DiagData d;
-  d.sim_name = "one ramp";
-  d.real_name = "three lags";
-  d.sim_mvv.resize(n, 3);
-  d.real_mvv.resize(n, 3);
-  std::mt19937 rng(5);
-  std::normal_distribution<double> noise(0.0, 1e-4);
-  for (int i = 0; i < n; ++i) {
+  const auto ref = [](int i, int) {
     const int k = i - 100;
-    const double v = k < 0 ? 0.0 : (k < 10 ? (k + 0.5) / 10.0 : 1.0);
-    const double u[3] = {k < 0 ? 0.0 : std::min(1.0, (k + 0.5) / 20.0),
-                         k <= 7 ? v : std::min(1.0, 0.75 + 0.008 * (k - 7)),
-                         k < 0 ? 0.0 : std::min(1.0, (k + 0.5) / 22.0)};
-    d.t_s.push_back(0.01 * i);
-    for (int c = 0; c < 3; ++c) {
-      d.sim_mvv(i, c) = v;
-      d.real_mvv(i, c) = u[c] + noise(rng);
+    return k < 0 ? 0.0 : (k < 10 ? (k + 0.5) / 10.0 : 1.0);
+  };
+  const auto real = [&](int i, int c) {
+    const int k = i - 100;
+    switch (c) {
+      case 0: return k < 0 ? 0.0 : std::min(1.0, (k + 0.5) / 20.0);
+      case 1: return k <= 7 ? ref(i, c) : std::min(1.0, 0.75 + 0.008 * (k - 7));
+      default: return k < 0 ? 0.0 : std::min(1.0, (k + 0.5) / 22.0);
     }
-  }
+  };
+  const DiagData d = NoisyRecording(400, 3, 0.01, 5, ref, real);
   const Context cx = MakeContext(d);
   const auto& tr = cx.conditioning.transitions;
   ASSERT_EQ(tr.size(), 1u);
@@ -503,16 +519,9 @@ TEST(DiagConditioning, ARampsFootAndTheBounceAreExcludedAndTheRingingIsNot) {
   // - the foot: the ramp is 1.1 % off at 29.5 s (row 295; 0 at 29.4 s), 100 σ of the noise;
   // - the bounce: its amplitude 0.08 e^(−Δ/0.3) is below the swing's 0.004 only for Δ > 0.9 s,
   //   i.e. after 31.8 s; the swing lasts the whole hold and is a finding, not a transition.
-  const int n = 1200;
-  DiagData d;
-  d.sim_name = "step";
-  d.real_name = "ramp, bounce and swing";
-  d.sim_mvv.resize(n, 1);
-  d.real_mvv.resize(n, 1);
-  std::mt19937 rng(7);
-  std::normal_distribution<double> noise(0.0, 1e-4);
-  const double pi = 3.141592653589793;
-  for (int i = 0; i < n; ++i) {
+  const double pi = std::numbers::pi;
+  const auto ref = [](int i, int) { return i >= 300 ? 1.0 : 0.0; };
+  const auto real = [&](int i, int) {
     const double t = 0.1 * i;
     const double x = std::clamp((t - 29.4) / 1.5, 0.0, 1.0);
     double u = 0.5 * (1.0 - std::cos(pi * x));
@@ -521,10 +530,9 @@ TEST(DiagConditioning, ARampsFootAndTheBounceAreExcludedAndTheRingingIsNot) {
       u += 0.08 * std::exp(-after / 0.3) * std::sin(2 * pi * 2.5 * after) +
            0.004 * std::exp(-after / 100.0) * std::sin(2 * pi * 0.8 * after);
     }
-    d.t_s.push_back(t);
-    d.sim_mvv(i, 0) = i >= 300 ? 1.0 : 0.0;
-    d.real_mvv(i, 0) = u + noise(rng);
-  }
+    return u;
+  };
+  const DiagData d = NoisyRecording(1200, 1, 0.1, 7, ref, real);
   const Context cx = MakeContext(d);
   const auto& tr = cx.conditioning.transitions;
   ASSERT_EQ(tr.size(), 1u);
