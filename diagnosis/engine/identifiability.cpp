@@ -1,6 +1,7 @@
 #include "diagnosis/engine/identifiability.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -127,6 +128,32 @@ std::string BeyondWords(double z_rest, double z_alone) {
       z_rest, z_alone);
 }
 
+/// The confounding sentence of one offset per load hold where the effect lies within it and only
+/// the load states (LoadStateGroups) could tell them apart: the design's limit when the states
+/// cannot reach z_claim even for an exact effect, else the effect's z beyond them.
+std::string StateWords(int holds, int states, double z_states, double z_rest, double z_claim,
+                       double z_alone) {
+  const std::string head =
+      Fmt("one offset per load hold (%.0f holds: a function of the load's history, tested as one "
+          "offset per load state, a load and the load before it: %.0f states)",
+          holds, states);
+  if (z_states <= z_claim) {
+    return head + Fmt(" explains it as well: too few holds repeat a load state for a zero that "
+                      "moved to show (even an exact effect would improve the held-out rows "
+                      "beyond the states by z = %.1f at most; alone z = %.1f)",
+                      z_states, z_alone);
+  }
+  return head + BeyondWords(z_rest, z_alone);
+}
+
+/// The confounding sentences of `effect` joined into one for a person (empty without any).
+std::string ConfoundingSentence(const std::string& effect, const std::vector<std::string>& words) {
+  std::string all;
+  for (std::size_t i = 0; i < words.size(); ++i) all += (i == 0 ? "" : "; ") + words[i];
+  if (all.empty()) return all;
+  return "The data cannot separate " + effect + " from another explanation: " + all + ".";
+}
+
 /// Wrench of every row quantised to 0.5 % of each axis's range.
 std::vector<std::array<long long, 6>> LoadKeys(const DiagData& d, int n) {
   std::array<double, 6> step{};
@@ -179,6 +206,65 @@ std::vector<int> HoldGroups(const Context& cx, int* groups) {
     return {};
   }
   return g;
+}
+
+/// One group per load state: a hold's quantised load together with the previous hold's (none at
+/// a segment's start), from the hold groups `hold` of HoldGroups (each opens at its hold's first
+/// row). *states receives the number of states.
+std::vector<int> LoadStateGroups(const Context& cx, const std::vector<int>& hold, int holds,
+                                 int* states) {
+  const auto keys = LoadKeys(*cx.data, cx.n);
+  std::vector<int> first(static_cast<std::size_t>(holds), -1);
+  for (int i = 0; i < cx.n; ++i) {
+    int& f = first[static_cast<std::size_t>(hold[static_cast<std::size_t>(i)])];
+    if (f < 0) f = i;
+  }
+  // Load, a flag for "a previous hold in this segment", the previous hold's load.
+  using State = std::array<long long, 13>;
+  std::map<State, int> seen;
+  std::vector<int> state_of(static_cast<std::size_t>(holds), 0);
+  for (int h = 0; h < holds; ++h) {
+    const int a = first[static_cast<std::size_t>(h)];
+    if (a < 0) continue;
+    State s{};
+    const auto& load = keys[static_cast<std::size_t>(a)];
+    std::copy(load.begin(), load.end(), s.begin());
+    const bool restart = !cx.restart.empty() && cx.restart[static_cast<std::size_t>(a)] != 0;
+    const int prev = h > 0 ? first[static_cast<std::size_t>(h - 1)] : -1;
+    if (prev >= 0 && !restart) {
+      s[6] = 1;
+      const auto& before = keys[static_cast<std::size_t>(prev)];
+      std::copy(before.begin(), before.end(), s.begin() + 7);
+    }
+    state_of[static_cast<std::size_t>(h)] =
+        seen.emplace(s, static_cast<int>(seen.size())).first->second;
+  }
+  *states = static_cast<int>(seen.size());
+  std::vector<int> g(static_cast<std::size_t>(cx.n));
+  for (int i = 0; i < cx.n; ++i) {
+    g[static_cast<std::size_t>(i)] =
+        state_of[static_cast<std::size_t>(hold[static_cast<std::size_t>(i)])];
+  }
+  return g;
+}
+
+/// Noise-weighted power (Σ d²/σ²) on the held-out rows of the part d of `pred` that one offset
+/// per group, fitted on the training rows, leaves. Were `pred` exactly true, its gain beyond those
+/// offsets would be this power with z ≈ √power / 2: the most the design lets the data show.
+double PowerBeyondOffsets(const Context& cx, const Series& pred, const std::vector<int>& group,
+                          int groups) {
+  const Series off = GroupOffsets(cx, pred, group, groups);
+  double power = 0.0;
+  for (int c = 0; c < cx.nc; ++c) {
+    double pp = 0.0;
+    for (int i = 0; i < cx.n; ++i) {
+      if (!cx.held_out(static_cast<std::size_t>(i))) continue;
+      const double d = static_cast<double>(pred(i, c)) - off(i, c);
+      pp += d * d;
+    }
+    power += pp * cx.weight(c);
+  }
+  return power;
 }
 
 }  // namespace
@@ -257,6 +343,11 @@ namespace {
 using BeyondFn =
     std::function<bool(const std::function<Series(const Series&)>&, int n_params, double* z_rest)>;
 
+/// Whether one confounder alone, penalised for its `n_params` like the ranking, scores below the
+/// effect (CheckConfounders' shortcut); *s_alone gets the confounder alone's held-out sums.
+using SimplerFn =
+    std::function<bool(const std::function<Series(const Series&)>&, int n_params, Sums* s_alone)>;
+
 /// The drift in time (the kDriftInTime effect) as a confounder of a temperature-driven effect where
 /// the temperature is monotone in time: its sentence, and its name in out->with, when it confounds.
 std::string DriftInTimeConfounds(const Context& cx, const Series& target, const BeyondFn& beyond,
@@ -278,6 +369,37 @@ std::string DriftInTimeConfounds(const Context& cx, const Series& target, const 
       rho, z_rest);
 }
 
+/// Where the effect lies within one offset per hold (were it exact, it could not beat them by
+/// z_claim) the data cannot decide between the two as fitted. The holds' offsets are then tested
+/// in the form the design can refute, a function of the load's history: one offset per load state
+/// (the hold's load and the load before it). A zero that moved shows as holds reached the same way
+/// whose levels differ by more than the noise allows. An effect with fewer parameters than the
+/// holds' offsets is identified by the penalised comparison (`simpler`) as everywhere; with as
+/// many it is the same model and that comparison scatter. True when identified; else *words gets
+/// the confounding sentence.
+bool StatesIdentify(const Context& cx, const EffectFit& fit, double z_claim,
+                    const std::vector<int>& hold, int holds, const SimplerFn& simpler,
+                    const BeyondFn& beyond, double z_alone, std::string* words) {
+  const auto hold_offsets = [&](const Series& y) { return GroupOffsets(cx, y, hold, holds); };
+  Sums s_holds;
+  if (fit.n_params < holds * cx.nc && simpler(hold_offsets, holds * cx.nc, &s_holds)) return true;
+  int states = 0;
+  const std::vector<int> sg = LoadStateGroups(cx, hold, holds, &states);
+  const double z_states = std::sqrt(PowerBeyondOffsets(cx, fit.pred, sg, states)) / 2.0;
+  const auto state_offsets = [&](const Series& y) { return GroupOffsets(cx, y, sg, states); };
+  double z_rest = 0.0;
+  const bool identified = z_states > z_claim && beyond(state_offsets, states * cx.nc, &z_rest);
+  if (DebugOn()) {
+    std::fprintf(stderr,
+                 "confounder hold_offsets (%d holds, %d load states) for %s: design z %.1f beyond "
+                 "states; z_rest %.1f -> %s\n",
+                 holds, states, fit.name.c_str(), z_states, z_rest,
+                 identified ? "identified" : "confounded");
+  }
+  if (!identified) *words = StateWords(holds, states, z_states, z_rest, z_claim, z_alone);
+  return identified;
+}
+
 }  // namespace
 
 Confounding CheckConfounders(const Context& cx, const Series& target, const EffectFit& fit,
@@ -294,23 +416,26 @@ Confounding CheckConfounders(const Context& cx, const Series& target, const Effe
   Improvement(cx, target, fit.pred, &delta_alone, &z_alone);
   // Joint model by backfitting: the confounder fitted to what the effect leaves, the effect
   // refitted to what the confounder leaves. Identified when the joint model beats the confounder
-  // alone on the held-out rows (z > z_claim and a tenth of the effect's own improvement).
+  // alone on the held-out rows (z > z_claim), or when the confounder alone, penalised for its
+  // parameters as the ranking does (Δχ² − p·ln n_hold), scores below the effect (`simpler`): a
+  // simpler explanation is not confounded by a far richer one.
   const double log_hold = std::log(std::max<double>(2.0, static_cast<double>(cx.n_hold)));
   const double score_effect = delta_alone - fit.n_params * log_hold;
   const double base_sse = Score(cx, target, nullptr).hold_sse;
-  // Identified when the joint model beats the confounder alone (below), or when the confounder
-  // alone, penalised for its parameters as the ranking does (Δχ² − p·ln n_hold), scores clearly
-  // below the effect: a simpler explanation is not confounded by a far richer one.
   // Memory: the confounder alone is scored here and formed again in JointBeyond, not held.
-  const BeyondFn beyond = [&](const std::function<Series(const Series&)>& confounder,
-                              int confounder_params, double* z_rest) {
-    const Sums s_alone = [&] {
+  const SimplerFn simpler = [&](const std::function<Series(const Series&)>& confounder,
+                                int confounder_params, Sums* s_alone) {
+    *s_alone = [&] {
       const Series alone = confounder(target);
       return Score(cx, target, &alone);
     }();
-    const double score_conf = base_sse - s_alone.hold_sse - confounder_params * log_hold;
+    return base_sse - s_alone->hold_sse - confounder_params * log_hold < score_effect;
+  };
+  const BeyondFn beyond = [&](const std::function<Series(const Series&)>& confounder,
+                              int confounder_params, double* z_rest) {
+    Sums s_alone;
     *z_rest = 0.0;
-    if (score_conf < score_effect) return true;
+    if (simpler(confounder, confounder_params, &s_alone)) return true;
     double delta = 0.0;
     *z_rest = JointBeyond(cx, target, fit, *spec, confounder, s_alone, &delta);
     return *z_rest > z_claim && delta > 0.0;
@@ -323,6 +448,15 @@ Confounding CheckConfounders(const Context& cx, const Series& target, const Effe
     if (g.empty()) continue;
     double z_rest = 0.0;
     const auto offsets = [&](const Series& y) { return GroupOffsets(cx, y, g, groups); };
+    if (std::string(name) == "hold_offsets" &&
+        std::sqrt(PowerBeyondOffsets(cx, fit.pred, g, groups)) / 2.0 <= z_claim) {
+      std::string sentence;
+      if (StatesIdentify(cx, fit, z_claim, g, groups, simpler, beyond, z_alone, &sentence))
+        continue;
+      out.with.push_back(name);
+      words.push_back(std::move(sentence));
+      continue;
+    }
     const bool identified = beyond(offsets, groups * cx.nc, &z_rest);
     if (DebugOn()) {
       std::fprintf(stderr, "confounder %s (%d groups) for %s: z_rest %.1f -> %s\n", name, groups,
@@ -345,13 +479,7 @@ Confounding CheckConfounders(const Context& cx, const Series& target, const Effe
     std::string sentence = DriftInTimeConfounds(cx, target, beyond, &out);
     if (!sentence.empty()) words.push_back(std::move(sentence));
   }
-  for (std::size_t i = 0; i < words.size(); ++i) {
-    out.words += (i == 0 ? "" : "; ") + words[i];
-  }
-  if (!out.words.empty()) {
-    out.words =
-        "The data cannot separate " + fit.name + " from another explanation: " + out.words + ".";
-  }
+  out.words = ConfoundingSentence(fit.name, words);
   return out;
 }
 

@@ -27,7 +27,12 @@ struct Confounding {
 ///    0.5 % of each axis's range; only where loads are held, ≤ rows/20 distinct loads);
 ///  - hold_offsets: one offset per channel and load hold (a run of ≥ 0.25 s at one load, with the
 ///    movement into it): any function of the load's history (a misfit of a history-dependent
-///    effect);
+///    effect). Where the effect lies within those offsets (were it exact, its held-out gain
+///    beyond them would not reach z_claim: e.g. a level per stretch between load changes), they
+///    are tested as the function of the load's history they stand for: one offset per load state
+///    (a hold's load and the previous hold's), which holds reached the same way at different
+///    levels refute; an effect with fewer parameters than the holds' offsets is still identified
+///    by the penalised comparison;
 ///  - load_polynomial: a quadratic polynomial of the reference wrench per channel (28 terms): a
 ///    smooth function of the load, ramps included (not for a kLoadHistory effect);
 ///  - the drift in time (the kDriftInTime effect, reported by its name), for temperature-driven
