@@ -226,15 +226,38 @@ HatBasis MakeHat(const Context& cx, int k) {
 
 namespace {
 
+/// x with every run of excluded rows (cx.excluded: glitches, transitions the real load lagged)
+/// replaced by the line between the kept rows either side (held flat at the record's ends).
+void BridgeExcluded(const Context& cx, Vec* x) {
+  if (cx.excluded.empty()) return;
+  const int n = cx.n;
+  int i = 0;
+  while (i < n) {
+    if (cx.excluded[static_cast<std::size_t>(i)] == 0) {
+      ++i;
+      continue;
+    }
+    int j = i;
+    while (j < n && cx.excluded[static_cast<std::size_t>(j)] != 0) ++j;
+    if (i == 0 && j == n) return;  // nothing kept to bridge from
+    const double a = i > 0 ? (*x)(i - 1) : (*x)(j);
+    const double b = j < n ? (*x)(j) : a;
+    for (int k = i; k < j; ++k) (*x)(k) = a + (b - a) * (k - i + 1) / (j - i + 1);
+    i = j;
+  }
+}
+
 /// r's Welch spectra (mean or, with `median`, median periodograms) whitened and summed over
-/// channels (empty when r is too short for a spectrum).
-void WhitenedSpectrum(const Context& cx, const Series& r, std::vector<double>* freq,
+/// channels, with `bridged` its excluded rows bridged (BridgeExcluded); empty when r is too short
+/// for a spectrum.
+void WhitenedSpectrum(const Context& cx, const Series& r, bool bridged, std::vector<double>* freq,
                       std::vector<double>* total, bool median = false) {
   const auto rows = static_cast<std::size_t>(cx.n);
   const std::size_t seg = WelchSegment(rows);
   if (rows < seg || seg < 32) return;
   for (int c = 0; c < cx.nc; ++c) {
-    const Vec col = ColD(r, c);
+    Vec col = ColD(r, c);
+    if (bridged) BridgeExcluded(cx, &col);
     const Spectrum s = median ? numerics::WelchMedian(col.data(), rows, cx.rate_hz, seg)
                               : Welch(col.data(), rows, cx.rate_hz, seg);
     if (total->empty()) {
@@ -257,13 +280,32 @@ double MedianOutside(const std::vector<double>& v, std::size_t lo, std::size_t h
   return std::max(w[w.size() / 2], 1e-300);
 }
 
-}  // namespace
+/// The lines (level / floor, Hz) of a and b (one residual as is and bridged), a line not within
+/// half a Welch bin of a more prominent one, most prominent first.
+std::vector<std::pair<double, double>> MergeLines(const Context& cx,
+                                                  std::vector<std::pair<double, double>> a,
+                                                  const std::vector<std::pair<double, double>>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  std::sort(a.rbegin(), a.rend());
+  const double half_bin_hz =
+      0.5 * cx.rate_hz / static_cast<double>(WelchSegment(static_cast<std::size_t>(cx.n)));
+  std::vector<std::pair<double, double>> out;
+  for (const auto& line : a) {
+    if (std::none_of(out.begin(), out.end(), [&](const auto& o) {
+          return std::fabs(o.second - line.second) < half_bin_hz;
+        }))
+      out.push_back(line);
+  }
+  return out;
+}
 
-std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Series& r) {
+/// SpectralLines of r as is or bridged.
+std::vector<std::pair<double, double>> MeanSpectrumLines(const Context& cx, const Series& r,
+                                                         bool bridged) {
   std::vector<double> total;
   std::vector<double> freq;
   std::vector<std::pair<double, double>> peaks;
-  WhitenedSpectrum(cx, r, &freq, &total);
+  WhitenedSpectrum(cx, r, bridged, &freq, &total);
   if (total.size() < 4) return peaks;
   const double floor = MedianOutside(total, 1, total.size(), 0, 0);
   for (std::size_t k = 3; k + 1 < total.size(); ++k) {
@@ -275,12 +317,13 @@ std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Se
   return peaks;
 }
 
-std::vector<std::pair<double, double>> LocalLines(const Context& cx, const Series& r,
-                                                  double min_ratio) {
+/// LocalLines of r as is or bridged.
+std::vector<std::pair<double, double>> MedianSpectrumLines(const Context& cx, const Series& r,
+                                                           double min_ratio, bool bridged) {
   std::vector<double> total;
   std::vector<double> freq;
   std::vector<std::pair<double, double>> peaks;
-  WhitenedSpectrum(cx, r, &freq, &total, true);
+  WhitenedSpectrum(cx, r, bridged, &freq, &total, true);
   constexpr std::size_t kSide = 16;  // bins each side of the local floor
   for (std::size_t k = 3; k + 1 < total.size(); ++k) {
     if (total[k] <= total[k - 1] || total[k] < total[k + 1]) continue;
@@ -297,6 +340,21 @@ std::vector<std::pair<double, double>> LocalLines(const Context& cx, const Serie
   }
   std::sort(peaks.rbegin(), peaks.rend());
   return peaks;
+}
+
+}  // namespace
+
+std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Series& r) {
+  auto lines = MeanSpectrumLines(cx, r, false);
+  if (cx.excluded.empty()) return lines;
+  return MergeLines(cx, std::move(lines), MeanSpectrumLines(cx, r, true));
+}
+
+std::vector<std::pair<double, double>> LocalLines(const Context& cx, const Series& r,
+                                                  double min_ratio) {
+  auto lines = MedianSpectrumLines(cx, r, min_ratio, false);
+  if (cx.excluded.empty()) return lines;
+  return MergeLines(cx, std::move(lines), MedianSpectrumLines(cx, r, min_ratio, true));
 }
 
 /// Restart flags of the context's segments for the filters (nullptr for one recording).

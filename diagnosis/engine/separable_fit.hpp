@@ -272,6 +272,10 @@ struct HatBasis {
 
 HatBasis MakeHat(const Context& cx, int k);
 
+/// Both line searches read r twice where rows are excluded (cx.excluded: glitches, lagging load
+/// transitions), as is and with those rows bridged by straight lines, and merge the lines: a
+/// ringing that dies within a transition shows only in the first, one that lasts through the holds
+/// under the steps' broadband misfit (a change in most Welch segments) only in the second.
 /// Lines of r's Welch spectra, whitened and summed over channels: local maxima (from the 4th bin)
 /// over 4 × the median level, strongest first, as (level / median level, frequency in Hz).
 std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Series& r);
