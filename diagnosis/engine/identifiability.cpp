@@ -400,6 +400,20 @@ bool StatesIdentify(const Context& cx, const EffectFit& fit, double z_claim,
   return identified;
 }
 
+/// The offset-shaped confounders, each one offset per group of rows. A per-hold offset is itself a
+/// function of the load's history, so it cannot confound an effect of that kind, and it can be
+/// refuted by the load states (StatesIdentify) where the effect lies within it.
+struct OffsetConfounder {
+  const char* name;
+  bool is_load_history;
+  bool refutable_by_load_states;
+};
+constexpr OffsetConfounder kOffsetConfounders[] = {
+    {"segment_offsets", false, false},
+    {"load_function", false, false},
+    {"hold_offsets", true, true},
+};
+
 }  // namespace
 
 Confounding CheckConfounders(const Context& cx, const Series& target, const EffectFit& fit,
@@ -441,14 +455,15 @@ Confounding CheckConfounders(const Context& cx, const Series& target, const Effe
     return *z_rest > z_claim && delta > 0.0;
   };
   std::vector<std::string> words;
-  for (const char* name : {"segment_offsets", "load_function", "hold_offsets"}) {
-    if (history && std::string(name) == "hold_offsets") continue;  // the effect is one
+  for (const OffsetConfounder& confounder : kOffsetConfounders) {
+    const char* name = confounder.name;
+    if (history && confounder.is_load_history) continue;  // the effect is one
     int groups = 0;
     const std::vector<int> g = ConfounderGroups(cx, name, &groups);
     if (g.empty()) continue;
     double z_rest = 0.0;
     const auto offsets = [&](const Series& y) { return GroupOffsets(cx, y, g, groups); };
-    if (std::string(name) == "hold_offsets" &&
+    if (confounder.refutable_by_load_states &&
         std::sqrt(PowerBeyondOffsets(cx, fit.pred, g, groups)) / 2.0 <= z_claim) {
       std::string sentence;
       if (StatesIdentify(cx, fit, z_claim, g, groups, simpler, beyond, z_alone, &sentence))

@@ -272,17 +272,19 @@ struct HatBasis {
 
 HatBasis MakeHat(const Context& cx, int k);
 
-/// Both line searches read r twice where rows are excluded (cx.excluded: glitches, lagging load
-/// transitions), as is and with those rows bridged by straight lines, and merge the lines: a
-/// ringing that dies within a transition shows only in the first, one that lasts through the holds
-/// under the steps' broadband misfit (a change in most Welch segments) only in the second.
-/// Lines of r's Welch spectra, whitened and summed over channels: local maxima (from the 4th bin)
-/// over 4 × the median level, strongest first, as (level / median level, frequency in Hz).
+/// The residual's spectral lines, two ways. Both read r twice where rows are excluded
+/// (cx.excluded: glitches, lagging load transitions), as is and with those rows bridged by
+/// straight lines, and merge the lines: a ringing that dies within a transition shows only in the
+/// first, one that lasts through the holds under the steps' broadband misfit only in the second.
+///  - SpectralLines: lines of r's Welch spectra, whitened and summed over channels: local maxima
+///    (from the 4th bin) over 4 × the median level, strongest first, as (level / median level,
+///    frequency in Hz).
+///  - LocalLines: lines of r's median-periodogram spectra (WelchMedian: load steps in a few
+///    segments do not lift it), whitened and summed over channels, that stand out of their
+///    neighbourhood (over `min_ratio` × the median of the 16 bins each side, so a red spectrum's
+///    slope does not hide them), most prominent first, as (level / local median, frequency in Hz
+///    interpolated between bins).
 std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Series& r);
-/// Lines of r's median-periodogram spectra (WelchMedian: load steps in a few segments do not lift
-/// it), whitened and summed over channels, that stand out of their neighbourhood (over 8 × the
-/// median of the 16 bins each side — `min_ratio` × — a red spectrum's slope does not hide them),
-/// most prominent first, as (level / local median, frequency in Hz interpolated between bins).
 std::vector<std::pair<double, double>> LocalLines(const Context& cx, const Series& r,
                                                   double min_ratio = 8.0);
 
