@@ -92,17 +92,43 @@ def start_ftd(tmp, broker, i, mqtt):
     return subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=err), err
 
 
-def late_samples(procs):
-    """Each ftd's late-sample counter (input registers 74-75) over Modbus TCP, function 04."""
-    total = 0
-    for p, err in procs:
+def modbus_port(err, deadline_s=30.0):
+    """The port an ftd printed on stderr; under a fleet's start-up load the line may come late."""
+    t_end = time.time() + deadline_s
+    while True:
         err.flush()
         m = re.search(r"serving Modbus TCP on [\d.]+:(\d+)", open(err.name).read())
-        with socket.create_connection(("127.0.0.1", int(m.group(1))), timeout=2) as c:
-            c.sendall(struct.pack(">HHHBBHH", 1, 0, 6, 1, 4, 74, 2))
-            reply = b""
-            while len(reply) < 13:
-                reply += c.recv(13 - len(reply))
+        if m:
+            return int(m.group(1))
+        if time.time() > t_end:
+            raise RuntimeError(f"{err.name}: no 'serving Modbus TCP' line after {deadline_s:g} s")
+        time.sleep(0.1)
+
+
+def late_samples(procs):
+    """Each ftd's late-sample counter (input registers 74-75) over Modbus TCP, function 04.
+
+    With 2N processes sharing a few cores an ftd's server thread can wait seconds for a core, so
+    the read allows 20 s and tries three times before it gives up on that ftd."""
+    total = 0
+    for p, err in procs:
+        port = modbus_port(err)
+        for attempt in range(3):
+            try:
+                with socket.create_connection(("127.0.0.1", port), timeout=20) as c:
+                    c.sendall(struct.pack(">HHHBBHH", 1, 0, 6, 1, 4, 74, 2))
+                    reply = b""
+                    while len(reply) < 13:
+                        chunk = c.recv(13 - len(reply))
+                        if not chunk:
+                            raise ConnectionError("closed before a whole reply")
+                        reply += chunk
+                break
+            except (OSError, ConnectionError) as e:
+                if attempt == 2:
+                    raise RuntimeError(f"ftd pid {p.pid} (port {port}): late-sample read: {e}")
+        if reply[7] != 4:
+            raise RuntimeError(f"ftd pid {p.pid}: Modbus exception {reply[7]:#x} reading 74-75")
         total += struct.unpack(">I", reply[9:13])[0]
     return total
 
