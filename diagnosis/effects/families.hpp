@@ -48,8 +48,8 @@ namespace ftstack::diag {
 
 namespace ftstack::diag::fx {
 
-/// The shortest creep time constant the data can show (3 samples, 0.2 s, 3 typical application
-/// times of lagging load changes): the search's lower bound and the range's.
+/// The shortest creep time constant the data can show (3 samples, 0.2 s, 3 times the typical
+/// excluded window of a lagging load change): the search's lower bound and the range's.
 double CreepTauFloor(const Context& cx);
 
 std::optional<EffectFit> FitZeroOffset(const Context& cx, const Series& target);

@@ -196,8 +196,8 @@ std::vector<int> EdgeChannels(const Context& cx, const Edge& g) {
 /// Before (when the window starts by the reference's change `s`): back to row `a` while the real
 /// load is off its level before the change by more than kTransitionFootSigmas robust σ of that
 /// level (a smooth ramp's foot lies inside the band). After: on to `last` while the activity
-/// (robust σ of first differences over a second) is over kBounceDecayFactor times that a second
-/// and two seconds later: a hanger's bounce dies within it, while a swinging weight's ringing,
+/// (robust σ of first differences over a second) is over kBounceDecayFactor times the level it
+/// settles to 3–5 s later: a hanger's bounce dies within it, while a swinging weight's ringing,
 /// creep and noise do not decay that fast and stay in.
 template <class U>
 void SettleWindow(U u, int a, int s, int last, double rate_hz, int* from, int* to) {
@@ -221,8 +221,18 @@ void SettleWindow(U u, int a, int s, int last, double rate_hz, int* from, int* t
     if (m < 0) m = DetrendedDiffSigma(u, first + k, first + k + w);
     return m;
   };
+  // The level it settles to: the median activity 3, 4 and 5 s on (those that fit before `last`),
+  // where a bounce has died and a swing, creep and noise have barely changed. Not the next second:
+  // the ramp's tail in the first window and a bounce still alive in the next keep their ratio low.
+  const auto settled = [&](int k) {
+    std::vector<double> later;
+    for (int j = 3; j <= kSettleSeconds && first + k + (j + 1) * w <= last; ++j)
+      later.push_back(activity(k + j * w));
+    if (later.empty()) later.push_back(std::max(activity(k + w), activity(k + 2 * w)));
+    return Median(&later);
+  };
   for (int k = 0; first + k + 3 * w <= last; ++k) {
-    if (activity(k) <= kBounceDecayFactor * std::max(activity(k + w), activity(k + 2 * w))) break;
+    if (activity(k) <= kBounceDecayFactor * settled(k)) break;
     *to = std::max(*to, first + k + w / 2);
   }
 }

@@ -70,9 +70,11 @@ inline constexpr double kTransitionBand = 0.1;
 /// A lagging change's window reaches back over rows further than this many robust σ (of the level
 /// before the change) from that level: a smooth ramp's foot, already well out of the noise.
 inline constexpr double kTransitionFootSigmas = 4.0;
-/// ... and on while the activity over a second is more than this factor above that one and two
-/// seconds later: a bounce that dies within seconds (a swing that lasts minutes never is).
+/// ... and on while the activity over a second is more than this factor above the level it settles
+/// to 3 to kSettleSeconds seconds later: a bounce that dies within seconds (a swing that lasts
+/// minutes never is).
 inline constexpr double kBounceDecayFactor = 2.0;
+inline constexpr int kSettleSeconds = 5;
 
 /// Finds glitches and transitions in the context's residual and load, replaces glitch samples of
 /// the residual by the line through their neighbours, marks glitch and lagging-transition rows in

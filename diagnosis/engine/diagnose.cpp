@@ -472,14 +472,19 @@ Report DiagnoseWith(Context context, const DiagnoseOptions& options) {
   } else {
     claimed.push_back(std::move(singles.front().fit));
   }
+  // The growth stage starts from the significant singles' fits (their predictions released).
+  const std::vector<EffectFit> near =
+      have_pair ? SignificantFits(singles) : std::vector<EffectFit>();
   singles.clear();  // memory: the kept single predictions are not used again
   singles.shrink_to_fit();
   t0 = std::chrono::steady_clock::now();
   RefineClaims(cx, &claimed);
   DebugTime("claims", "refinements", t0);
-  const std::vector<Confounding> partner_conf =
+  std::vector<Confounding> partner_conf =
       DropUnidentifiedPartner(cx, options.z_claim, &claimed, &r.dropped);
   DebugTime("claims", "partner identifiability", t0);
+  if (claimed.size() == 2 && GrowThird(cx, options, near, &claimed)) partner_conf.clear();
+  DebugTime("stage", "third", t0);
   SpreadClaims(&r.cx, &claimed);
   DropContradictedClaims(r.cx, &claimed, &r.dropped);
   DebugTime("claims", "spreads across pieces", t0);

@@ -455,15 +455,14 @@ Confounding CheckConfounders(const Context& cx, const Series& target, const Effe
     return *z_rest > z_claim && delta > 0.0;
   };
   std::vector<std::string> words;
-  for (const OffsetConfounder& confounder : kOffsetConfounders) {
-    const char* name = confounder.name;
-    if (history && confounder.is_load_history) continue;  // the effect is one
+  for (const auto& [name, is_load_history, refutable_by_load_states] : kOffsetConfounders) {
+    if (history && is_load_history) continue;  // the effect is one
     int groups = 0;
     const std::vector<int> g = ConfounderGroups(cx, name, &groups);
     if (g.empty()) continue;
     double z_rest = 0.0;
     const auto offsets = [&](const Series& y) { return GroupOffsets(cx, y, g, groups); };
-    if (confounder.refutable_by_load_states &&
+    if (refutable_by_load_states &&
         std::sqrt(PowerBeyondOffsets(cx, fit.pred, g, groups)) / 2.0 <= z_claim) {
       std::string sentence;
       if (StatesIdentify(cx, fit, z_claim, g, groups, simpler, beyond, z_alone, &sentence))

@@ -1,6 +1,7 @@
 #include "diagnosis/engine/ranking.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <mutex>
@@ -9,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "diagnosis/engine/identifiability.hpp"
 #include "diagnosis/engine/parallel.hpp"
 #include "diagnosis/engine/plausibility.hpp"
 
@@ -209,8 +211,8 @@ std::optional<PairResult> TryPair(const Context& cx, const DiagnoseOptions& opti
                  "pair %s + %s: score %.1f (best single %.1f) z_inc %.1f inc %.1f excess %.1f\n",
                  p.fa.name.c_str(), p.fb.name.c_str(), p.score, best_score, z_inc, inc, excess);
   }
-  p.won = z_inc > options.z_claim && inc > 0.002 * excess && NotResolved(cx, p.fa).empty() &&
-          NotResolved(cx, p.fb).empty();
+  p.won = z_inc > options.z_claim && inc > kVisibleShare * excess &&
+          NotResolved(cx, p.fa).empty() && NotResolved(cx, p.fb).empty();
   return p;
 }
 
@@ -352,6 +354,178 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Sco
     if (x != 0) singles[x].fit.pred = Series();
   }
   return have_pair;
+}
+
+std::vector<EffectFit> SignificantFits(std::vector<Scored>& singles) {
+  std::vector<EffectFit> out;
+  for (Scored& q : singles) {
+    if (!q.significant) continue;
+    q.fit.pred = Series();
+    out.push_back(std::move(q.fit));
+  }
+  return out;
+}
+
+namespace {
+
+/// Backfits three effects twice, each refitted near its current fit to what the other two leave;
+/// the first pass skips the parameters' uncertainties. False when a refit fails.
+bool FitTriple(const Context& cx, std::array<EffectFit, 3>* fits) {
+  std::array<const EffectSpec*, 3> spec{};
+  for (std::size_t k = 0; k < 3; ++k) spec[k] = FindEffect((*fits)[k].name);
+  for (int it = 0; it < 2; ++it) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      Series rest = cx.resid;
+      for (std::size_t o = 0; o < 3; ++o) {
+        if (o != k) rest -= (*fits)[o].pred;
+      }
+      auto f = FitNear(*spec[k], cx, rest, &(*fits)[k], it == 1);
+      if (!f) return false;
+      (*fits)[k] = std::move(*f);
+    }
+  }
+  return true;
+}
+
+/// A candidate for the third claim: its fit to what the pair leaves (with its prediction) and its
+/// single fit.
+struct ThirdCandidate {
+  Scored on_rest;
+  const EffectFit* single = nullptr;
+};
+
+/// Every candidate refitted near its single fit to what the pair leaves (`rest`; the full grid
+/// where the optimum leaves the local window), as the partners are: those significant there,
+/// resolved or not (beside the refitted pair they may resolve, and are claimed only if they do),
+/// that already carry the visible share of the excess a claim needs (the backfits are what costs:
+/// they run only for these), at most kGrowthTries, best first. Only those keep their predictions
+/// (memory: n × N each).
+std::vector<ThirdCandidate> ScanThirds(const Context& cx, const DiagnoseOptions& options,
+                                       const std::vector<const EffectFit*>& todo,
+                                       const Series& rest, double rest_hold_sse, double excess) {
+  std::vector<std::optional<Scored>> tried(todo.size());
+  std::mutex mu;
+  ParallelFor(todo.size(), ResolveThreads(options.threads), [&](std::size_t k) {
+    const EffectSpec* spec = FindEffect(todo[k]->name);
+    const auto t0 = std::chrono::steady_clock::now();
+    auto f = spec != nullptr ? FitNear(*spec, cx, rest, todo[k], false) : std::nullopt;
+    DebugTime("third", todo[k]->name.c_str(), t0);
+    std::optional<Scored> q;
+    if (f) q = ScoreFit(cx, rest, std::move(*f), rest_hold_sse, options.z_claim);
+    if (q && (!q->significant || q->delta <= kVisibleShare * excess)) q.reset();
+    const std::lock_guard<std::mutex> lock(mu);
+    tried[k] = std::move(q);
+    std::vector<Scored*> kept;
+    for (auto& t : tried) {
+      if (t && t->HasPrediction()) kept.push_back(&*t);
+    }
+    if (kept.size() > kGrowthTries) {
+      (*std::min_element(kept.begin(), kept.end(), [](const Scored* u, const Scored* v) {
+        return u->score < v->score;
+      }))->fit.pred = Series();
+    }
+  });
+  std::vector<ThirdCandidate> out;
+  for (std::size_t k = 0; k < todo.size(); ++k) {
+    if (tried[k] && tried[k]->HasPrediction()) out.push_back({std::move(*tried[k]), todo[k]});
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const auto& a, const auto& b) { return a.on_rest.score > b.on_rest.score; });
+  return out;
+}
+
+/// The candidate backfitted with the pair from two starts, as backfitting finds the optimum
+/// nearest its start: as fitted to what the pair leaves, and as fitted alone (refitted near its
+/// single fit), the pair then refitted first. A time spline that took a creep's slow part leaves
+/// the creep only its fast part in the first; from the second, the pair's drift can find its steps
+/// again. The start of lower penalised held-out cost among those that qualify (significant over
+/// the pair, a visible share, a gain above its parameters' penalty, all three resolved), if any.
+std::optional<std::array<EffectFit, 3>> BackfitThird(const Context& cx, double z_claim,
+                                                     const std::vector<EffectFit>& pair,
+                                                     const Series& rest, double excess,
+                                                     ThirdCandidate* candidate) {
+  const double rest_hold_sse = Score(cx, rest, nullptr).hold_sse;
+  const double penalty = HoldPenalty(cx);
+  const int pair_params = pair[0].n_params + pair[1].n_params;
+  std::vector<EffectFit> starts;
+  starts.push_back(std::move(candidate->on_rest.fit));
+  const EffectSpec& spec = *FindEffect(candidate->single->name);
+  if (auto alone = FitNear(spec, cx, cx.resid, candidate->single, false)) {
+    starts.push_back(std::move(*alone));
+  }
+  std::optional<std::array<EffectFit, 3>> best;
+  double best_cost = 0.0;
+  for (EffectFit& start : starts) {
+    std::array<EffectFit, 3> fits{pair[0], pair[1], std::move(start)};
+    start = EffectFit();
+    if (!FitTriple(cx, &fits)) continue;
+    Series model = fits[0].pred + fits[1].pred;
+    model += fits[2].pred;
+    const Sums s = Score(cx, cx.resid, &model);
+    const double inc = rest_hold_sse - s.hold_sse;
+    // What the three add over the pair on the held-out rows: model − (resid − rest).
+    double dd = 0.0;
+    for (int c = 0; c < cx.nc; ++c) {
+      for (int i = 0; i < cx.n; ++i) {
+        if (!cx.held_out(static_cast<std::size_t>(i))) continue;
+        const double d = static_cast<double>(model(i, c)) - cx.resid(i, c) + rest(i, c);
+        dd += d * d * cx.weight(c);
+      }
+    }
+    model = Series();
+    const double z_inc = dd > 0 ? inc / (2.0 * std::sqrt(dd)) : 0.0;
+    const bool resolved = NotResolved(cx, fits[0]).empty() && NotResolved(cx, fits[1]).empty() &&
+                          NotResolved(cx, fits[2]).empty();
+    const int params = fits[0].n_params + fits[1].n_params + fits[2].n_params;
+    const double gain = inc - (params - pair_params) * penalty;
+    const double cost = s.hold_sse + params * penalty;
+    if (DebugOn()) {
+      std::fprintf(stderr,
+                   "triple + %s: z_inc %.1f inc %.1f (excess %.1f) gain %.1f resolved %d "
+                   "cost %.1f\n",
+                   fits[2].name.c_str(), z_inc, inc, excess, gain, resolved ? 1 : 0, cost);
+    }
+    if (z_inc > z_claim && inc > kVisibleShare * excess && gain > 0 && resolved &&
+        (!best || cost < best_cost)) {
+      best = std::move(fits);
+      best_cost = cost;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+bool GrowThird(const Context& cx, const DiagnoseOptions& options,
+               const std::vector<EffectFit>& near, std::vector<EffectFit>* claimed) {
+  if (claimed->size() != 2) return false;
+  Series rest = cx.resid - (*claimed)[0].pred;
+  rest -= (*claimed)[1].pred;
+  std::vector<const EffectFit*> todo;
+  for (const EffectFit& f : near) {
+    if (f.name != (*claimed)[0].name && f.name != (*claimed)[1].name) todo.push_back(&f);
+  }
+  const double excess =
+      Score(cx, cx.resid, nullptr).hold_sse - static_cast<double>(cx.n_hold) * cx.nc;
+  std::vector<ThirdCandidate> thirds =
+      ScanThirds(cx, options, todo, rest, Score(cx, rest, nullptr).hold_sse, excess);
+  for (ThirdCandidate& candidate : thirds) {
+    auto best = BackfitThird(cx, options.z_claim, *claimed, rest, excess, &candidate);
+    if (!best) continue;
+    // Identified beside the refitted pair, or not claimed: an offset per hold, a function of the
+    // load or a drift in time that explains it as well leaves the pair as it was.
+    Series others = cx.resid - (*best)[0].pred;
+    others -= (*best)[1].pred;
+    const Confounding conf = CheckConfounders(cx, others, (*best)[2], options.z_claim);
+    if (DebugOn()) {
+      std::fprintf(stderr, "third %s beside the pair: confounded with %zu\n",
+                   (*best)[2].name.c_str(), conf.with.size());
+    }
+    if (!conf.with.empty()) continue;
+    claimed->assign(std::make_move_iterator(best->begin()), std::make_move_iterator(best->end()));
+    return true;
+  }
+  return false;
 }
 
 }  // namespace ftstack::diag

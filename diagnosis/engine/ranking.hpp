@@ -1,4 +1,4 @@
-// Ranking of the candidate effects: each alone, then pairs (internal to diagnosis/).
+// Ranking of the candidate effects: each alone, then pairs, then a third (internal to diagnosis/).
 #pragma once
 
 #include <Eigen/Dense>
@@ -47,5 +47,24 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
 /// penalised held-out score among the qualifying pairs; independent of the thread count).
 bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Scored>& singles,
               const Sums& base, EffectFit* pa, EffectFit* pb);
+
+/// The significant singles' fits, without their predictions (the growth stage's starting points).
+std::vector<EffectFit> SignificantFits(std::vector<Scored>& singles);
+
+/// Growth: a third effect beside a claimed pair. Every other significant single is refitted near
+/// its own fit to what the pair leaves and scored there; the kGrowthTries best that are
+/// significant there are backfitted with the pair from two starts (the candidate as fitted to the
+/// pair's remainder, and as fitted alone) and claimed when it adds a significant held-out
+/// improvement over the pair, carries a visible share of the excess over noise, all three stay
+/// resolved, and nothing confounds it beside the refitted pair (CheckConfounders). True with the
+/// claims replaced by the three backfitted fits (the new one last).
+bool GrowThird(const Context& cx, const DiagnoseOptions& options,
+               const std::vector<EffectFit>& near, std::vector<EffectFit>* claimed);
+
+/// The share of the held-out excess over noise a partner or a third must add (not a misfit's
+/// remainder).
+inline constexpr double kVisibleShare = 0.002;
+/// Candidates for the third claim backfitted with the pair, best first, at most.
+inline constexpr std::size_t kGrowthTries = 2;
 
 }  // namespace ftstack::diag

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <random>
 
+#include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/diagnose.hpp"
 #include "diagnosis/engine/effect.hpp"
 #include "diagnosis/engine/plausibility.hpp"
@@ -543,6 +544,56 @@ TEST(DiagConditioning, ARampsFootAndTheBounceAreExcludedAndTheRingingIsNot) {
   EXPECT_LE(tr[0].excluded_from_s, 29.5 + 1e-9);
   EXPECT_GE(tr[0].excluded_to_s, 31.8);
   EXPECT_LE(tr[0].excluded_to_s, 33.9);
+}
+
+TEST(DiagConditioning, CreepFloorIsThreeTimesTheMedianSettlingOfTheLaggingChanges) {
+  // At 10 Hz, five reference steps (0 -> 1 -> 2 -> 3 -> 4 -> 5 mV/V, every 60 s). The real load
+  // follows three of them as linear ramps of 1, 2 and 4 s (they lag), and two at once (they do
+  // not, and are not excluded). By hand, each lagging change's excluded window holds at least the
+  // rows off the reference by more than 0.1 (from the change to 0.9 of the ramp) and ends by the
+  // ramp's end plus half a second; the floor is 3 x the median window, the 2 s ramp's: between
+  // 3 x 1.8 and 3 x 2.6 s. Counting the prompt steps (no window) would halve it; 3 x the median
+  // 10-90 % rise (the ramps' own lengths: 2 s) would miss the settling after the ramp.
+  const std::vector<double> ramp_s = {1.0, 0.0, 2.0, 0.0, 4.0};
+  const auto ref = [](int i, int) { return static_cast<double>(std::min(i / 600, 5)); };
+  const auto real = [&](int i, int) {
+    const int k = i / 600;
+    if (k == 0) return 0.0;
+    const double len = ramp_s[static_cast<std::size_t>(k - 1)];
+    const double into = 0.1 * (i - 600 * k);
+    return (k - 1) + (len > 0 ? std::min(1.0, (into + 0.05) / len) : 1.0);
+  };
+  const DiagData d = NoisyRecording(3600, 1, 0.1, 11, ref, real);
+  const Context cx = MakeContext(d);
+  const auto& tr = cx.conditioning.transitions;
+  ASSERT_EQ(tr.size(), 5u);
+  std::vector<double> windows;
+  for (std::size_t k = 0; k < tr.size(); ++k) {
+    const double len = ramp_s[k];
+    EXPECT_EQ(tr[k].excluded, len > 0) << "change " << k;
+    if (len == 0) continue;
+    EXPECT_NEAR(tr[k].application_s, len, 0.1) << "change " << k;
+    EXPECT_LE(tr[k].excluded_from_s, tr[k].t_s) << "change " << k;
+    EXPECT_GE(tr[k].excluded_to_s, tr[k].t_s + 0.9 * len - 0.1) << "change " << k;
+    EXPECT_LE(tr[k].excluded_to_s, tr[k].t_s + len + 0.5) << "change " << k;
+    windows.push_back(tr[k].excluded_to_s - tr[k].excluded_from_s);
+  }
+  ASSERT_EQ(windows.size(), 3u);
+  std::sort(windows.begin(), windows.end());
+  EXPECT_NEAR(fx::CreepTauFloor(cx), 3.0 * windows[1], 1e-9);
+  EXPECT_GE(fx::CreepTauFloor(cx), 3.0 * 1.8);
+  EXPECT_LE(fx::CreepTauFloor(cx), 3.0 * 2.6);
+  EXPECT_GT(fx::CreepTauFloor(cx), 3.0 * 2.0 + 0.1);  // more than the rise alone gives
+  // The floor is creep's physical range too: a time constant below it is not a finding.
+  const auto ranges = FindEffect("creep")->ranges(cx);
+  ASSERT_FALSE(ranges.empty());
+  EXPECT_EQ(ranges.front().lo, fx::CreepTauFloor(cx));
+  // Without lagging changes the floor is 3 samples or 0.2 s, whichever is longer.
+  Context quiet = cx;
+  quiet.conditioning.transitions.clear();
+  EXPECT_NEAR(fx::CreepTauFloor(quiet), 0.3, 1e-12);
+  quiet.dt = 0.01;
+  EXPECT_NEAR(fx::CreepTauFloor(quiet), 0.2, 1e-12);
 }
 
 }  // namespace

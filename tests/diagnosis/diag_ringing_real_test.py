@@ -9,7 +9,9 @@ References ftdiag shares no code with:
   the line frequency per hold and the creep tau per hold.
 
 Asserted on every generator seed (106: fifteen load changes in 30 min, one in most spectral
-segments): the strongest line of the report's residual spectrum within 2 % of the per-hold fits'
+segments; 105, 117 and 123 were missed by a diagnosis that claimed two effects at most, or whose
+creep search bent τ to a gain the user's static model had taken): the claims are the truth's
+classes (resonance, creep, zero_drift where it shifted the zero), no other; the strongest line of the report's residual spectrum within 2 % of the per-hold fits'
 median line, `resonance` claimed within 5 % of the true frequency, any creep
 claimed has its tau inside the per-hold fits' range (widened by 50 %: a hold fits one exponential
 to two) and every fraction below 2 %, the held-out RMS lowered by at least 30 % (issue 26's bar
@@ -149,6 +151,13 @@ def check_generator(ftdiag, work, seed, failures):
                         f"ringing at {line_hz:.4f} Hz")
     check_common(f"seed {seed}", report, per_hold_taus(fits), failures)
     check_zero_shifts(seed, truth, report, failures)
+    # The same kind of statement as the truth: its ringing, creep and zero shifts, each under its
+    # own name, and no physics the generator did not put in.
+    claimed = {e["name"] for e in report["effects"]}
+    want = {"resonance"} | ({"creep"} if truth.get("creep") else set()) | (
+        {"zero_drift"} if any(tr.get("zero_shift_counts") for tr in truth["transitions"]) else set())
+    if claimed != want:
+        failures.append(f"seed {seed}: claims {sorted(claimed)}, the truth holds {sorted(want)}")
 
 
 def check_real(ftdiag, work, file, failures):
@@ -166,7 +175,7 @@ def main():
     ftdiag = sys.argv[1]
     failures = []
     with tempfile.TemporaryDirectory() as work:
-        for seed in (101, 102, 103, 104, 106, 110):
+        for seed in (101, 102, 103, 104, 105, 106, 110, 117, 123):
             check_generator(ftdiag, work, seed, failures)
         for file in ("ketter133_2024-02-14.csv", "seesl_2024-01-22.csv"):
             check_real(ftdiag, work, file, failures)
