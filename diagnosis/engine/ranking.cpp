@@ -507,9 +507,11 @@ bool GrowThird(const Context& cx, const DiagnoseOptions& options,
   }
   const double excess =
       Score(cx, cx.resid, nullptr).hold_sse - static_cast<double>(cx.n_hold) * cx.nc;
+  Progress(options, 0.98, "a third: candidates");
   std::vector<ThirdCandidate> thirds =
       ScanThirds(cx, options, todo, rest, Score(cx, rest, nullptr).hold_sse, excess);
   for (ThirdCandidate& candidate : thirds) {
+    Progress(options, 0.99, "a third: backfits");
     auto best = BackfitThird(cx, options.z_claim, *claimed, rest, excess, &candidate);
     if (!best) continue;
     // Identified beside the refitted pair, or not claimed: an offset per hold, a function of the
