@@ -87,6 +87,9 @@ std::optional<EffectFit> ExcitationSearch(const Context& cx, const Series& targe
 }  // namespace
 
 std::optional<EffectFit> FitExcitation(const Context& cx, const Series& target) {
+  // A ratiometric converter's reference follows the excitation: its drift cancels in every
+  // reading, and a common gain that wanders there is some other physics (a creep within holds).
+  if (cx.data->real_ratiometric) return std::nullopt;
   return ExcitationSearch(
       cx, target,
       std::vector<int>(std::begin(kExcitationIntervals), std::end(kExcitationIntervals)));
@@ -94,6 +97,7 @@ std::optional<EffectFit> FitExcitation(const Context& cx, const Series& target) 
 
 std::optional<EffectFit> RefitExcitation(const Context& cx, const Series& target,
                                          const EffectFit& near, bool /*uncertainty*/) {
+  if (cx.data->real_ratiometric) return std::nullopt;
   // The knot count of near and its two neighbours in the list.
   const int k_near = near.params.value("knots", 0) - 1;
   const auto* it =

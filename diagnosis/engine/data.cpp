@@ -40,9 +40,13 @@ void UnitScale(const InputUnit& u, std::string* symbol, double* per_mvv) {
 }
 
 std::string ToMvv(Recording* rec, bool check_assumed, std::string* symbol = nullptr,
-                  double* per_mvv = nullptr) {
+                  double* per_mvv = nullptr, bool* ratiometric = nullptr) {
   const InputUnit u = ResolveInputUnit(*rec);
   if (symbol != nullptr && per_mvv != nullptr) UnitScale(u, symbol, per_mvv);
+  if (ratiometric != nullptr) {
+    *ratiometric =
+        u.unit == BridgeUnit::kCounts && u.source != "format default" && u.converter.ratiometric;
+  }
   const std::size_t n = rec->BridgeCount();
   ValueRange r;
   r.unit = ToString(u.unit);
@@ -73,8 +77,8 @@ Recording Read(const std::string& path, ProgressRelay* relay, DiagData* unit_of,
   }
   Recording rec = ReadRecording(path, opt);
   if (unit_of != nullptr) {
-    unit_of->real_unit =
-        ToMvv(&rec, check_assumed, &unit_of->real_unit_symbol, &unit_of->real_units_per_mvv);
+    unit_of->real_unit = ToMvv(&rec, check_assumed, &unit_of->real_unit_symbol,
+                               &unit_of->real_units_per_mvv, &unit_of->real_ratiometric);
   } else {
     (void)ToMvv(&rec, check_assumed);
   }
@@ -222,6 +226,7 @@ DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path, 
     d.real_unit = units.real_unit;
     d.real_unit_symbol = units.real_unit_symbol;
     d.real_units_per_mvv = units.real_units_per_mvv;
+    d.real_ratiometric = units.real_ratiometric;
     return d;
   } catch (const RecordingError& e) {
     throw DiagInputError(e.what());
@@ -236,6 +241,7 @@ DiagData LoadPredictedReal(const std::string& real_path, const std::string& mode
   std::string unit;
   std::string symbol;
   double per_mvv = 1.0;
+  bool ratiometric = false;
   try {
     ReadOptions opt;
     opt.required = {"t"};
@@ -246,7 +252,7 @@ DiagData LoadPredictedReal(const std::string& real_path, const std::string& mode
       opt.progress_user = &r1;
     }
     real = ReadRecording(real_path, opt);
-    unit = ToMvv(&real, true, &symbol, &per_mvv);
+    unit = ToMvv(&real, true, &symbol, &per_mvv, &ratiometric);
   } catch (const RecordingError& e) {
     throw DiagInputError(e.what());
   }
@@ -262,6 +268,7 @@ DiagData LoadPredictedReal(const std::string& real_path, const std::string& mode
   d.real_unit = unit;
   d.real_unit_symbol = symbol;
   d.real_units_per_mvv = per_mvv;
+  d.real_ratiometric = ratiometric;
   d.t_s = real.Column("t");
   d.real_mvv = Bridges(real, nr);
   d.wrench = WrenchOf(real);

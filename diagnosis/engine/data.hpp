@@ -39,6 +39,9 @@ struct DiagData {
   std::string real_unit = "mV/V";  ///< the real file's declared bridge unit (converted to mV/V)
   std::string real_unit_symbol = "mV/V";  ///< that unit's symbol: mV/V, V or counts
   double real_units_per_mvv = 1.0;  ///< the declared unit's values per mV/V (0: scale unknown)
+  /// The real file declares the codes of a ratiometric converter (its reference follows the
+  /// bridge excitation): a drift of the excitation cancels in every reading.
+  bool real_ratiometric = false;
   /// Bridges whose sim_mvv and real_mvv became a context's load and residual
   /// (MakeContext(DiagData*), which leaves both matrices empty to save their memory); 0 while they
   /// are held here.

@@ -3,10 +3,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <random>
 
+#include <unistd.h>
+
 #include "diagnosis/effects/families.hpp"
+#include "diagnosis/engine/data.hpp"
 #include "diagnosis/engine/diagnose.hpp"
 #include "diagnosis/engine/effect.hpp"
 #include "diagnosis/engine/plausibility.hpp"
@@ -403,6 +408,47 @@ TEST(DiagFixtureSubtle, WithoutTemperatureThermalDriftIsNotClaimed) {
   const Report r = Diagnose(fx.data);
   EXPECT_EQ(r.verdict, "zero_drift");
   EXPECT_GE(ExcessRemoved(r), 0.7);
+}
+
+// A ratiometric converter's reference follows the bridge excitation, so a drift of the excitation
+// cancels in every reading: declared so, the common gain drift of the fixture is not called
+// excitation_drift (not even a candidate). The control, undeclared, names it.
+TEST(DiagFixtureRatiometric, DeclaredRatiometricReadingsHaveNoExcitationDrift) {
+  auto fx = testing::MakeFixture({{"excitation_drift", 6}}, 5, 200.0, kNoise, 4.0);
+  const Report plain = Diagnose(fx.data);
+  EXPECT_EQ(plain.verdict, "excitation_drift");
+  fx.data.real_ratiometric = true;
+  const Report ratiometric = Diagnose(fx.data);
+  EXPECT_NE(ratiometric.verdict, "excitation_drift");
+  for (const auto& e : ratiometric.effects) EXPECT_NE(e.fit.name, "excitation_drift");
+  for (const auto& c : ratiometric.candidates) EXPECT_NE(c.name, "excitation_drift");
+}
+
+// The flag comes from the real file's declaration: the codes of a ratiometric converter set it;
+// a non-ratiometric one (with its excitation) and plain mV/V do not.
+TEST(DiagFixtureRatiometric, LoaderReadsTheDeclaredConverter) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("diag_ratiometric_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto write = [&](const std::string& name, const std::string& meta, int code) {
+    std::ofstream f(dir / name);
+    f << meta << "t,Fx,Fy,Fz,Mx,My,Mz,b0\n";
+    for (int i = 0; i < 100; ++i)
+      f << 0.1 * i << ",0,0," << (i < 50 ? 0 : 10) << ",0,0,0," << code << "\n";
+  };
+  write("sim.csv", "", 0);
+  const std::string counts =
+      "# bridge_unit: counts\n# converter: bits=24, coding=signed, gain=128, ";
+  write("ratio.csv", counts + "ratiometric=yes\n", 1000);
+  write("fixed.csv", counts + "ratiometric=no, reference_v=2.5\n# excitation_v: 5\n", 1000);
+  write("mvv.csv", "", 0);
+  const auto load = [&](const std::string& real) {
+    return LoadSimReal((dir / "sim.csv").string(), (dir / real).string()).real_ratiometric;
+  };
+  EXPECT_TRUE(load("ratio.csv"));
+  EXPECT_FALSE(load("fixed.csv"));
+  EXPECT_FALSE(load("mvv.csv"));
+  std::filesystem::remove_all(dir);
 }
 
 TEST(DiagConditioning, WrongCodesOnLoadRampsAreFoundAndStepsAreNot) {
