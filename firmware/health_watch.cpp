@@ -54,6 +54,13 @@ bool HealthWatch::Configure(std::uint32_t rate_hz, const WrenchLsb& rated_lsb) {
       return false;
     }
   }
+  max_diff_ = std::min(tone50_[0].max_diff(), tone60_[0].max_diff());
+  // The level's sub-blocks: the fewest samples each that keep the ring within kLevelRing and
+  // divide the block exactly (the ring then spans whole periods of 50 and 60 Hz).
+  level_sub_ = 1;
+  while (block_ / level_sub_ > kLevelRing || block_ % level_sub_ != 0) ++level_sub_;
+  level_len_ = block_ / level_sub_;
+  ResetLevel();
   capture_stride_ = rate_hz <= 2000 ? 1 : rate_hz / 1000;
   for (std::size_t r = 0; r < kAxes; ++r) {
     // Turning points beyond 2 % of rated (noise makes none); cycles of 10 % of rated and more.
@@ -190,19 +197,19 @@ void HealthWatch::Step(const HealthInput& in) {
       prev_ = in.tared;
       filters_ready_ = true;
     }
-    bool stable = true;
-    bool moving = false;
+    // Moving and stable are judged on the 0.1 s level, in which a steady 50 or 60 Hz tone (and
+    // its harmonics) cancels: a tone of any size is then not a load change.
+    const bool moving = UpdateLevel(in);
+    bool stable = level_filled_ >= level_len_;
     WrenchLsb d{};
     for (std::size_t r = 0; r < kAxes; ++r) {
       const std::int64_t y_q8 = std::int64_t{in.tared[r]} * 256;
       fast_q8_[r] += (y_q8 - fast_q8_[r]) >> fast_shift_;
       slow_q8_[r] += (y_q8 - slow_q8_[r]) >> slow_shift_;
-      stable = stable && Abs(fast_q8_[r] - slow_q8_[r]) <= band_[r] * 256;
-      moving = moving || Abs(y_q8 - fast_q8_[r]) > move_[r] * 256;
+      stable = stable && Abs(level_q8_[r] - slow_q8_[r]) <= band_[r] * 256;
       const std::int64_t diff = std::int64_t{in.tared[r]} - prev_[r];
-      d[r] = static_cast<std::int32_t>(diff > ToneDetector::kMaxDiff    ? ToneDetector::kMaxDiff
-                                       : diff < -ToneDetector::kMaxDiff ? -ToneDetector::kMaxDiff
-                                                                        : diff);
+      d[r] = static_cast<std::int32_t>(diff > max_diff_ ? max_diff_
+                                                        : (diff < -max_diff_ ? -max_diff_ : diff));
     }
     prev_ = in.tared;
     if (moving) block_moved_ = true;
@@ -214,10 +221,48 @@ void HealthWatch::Step(const HealthInput& in) {
   Publish(in);
 }
 
+void HealthWatch::ResetLevel() {
+  level_pos_ = 0;
+  level_at_ = 0;
+  level_filled_ = 0;
+  level_acc_ = {};
+  level_sum_ = {};
+  level_moving_ = true;
+}
+
+bool HealthWatch::UpdateLevel(const HealthInput& in) {
+  for (std::size_t r = 0; r < kAxes; ++r) level_acc_[r] += in.tared[r];
+  if (++level_pos_ < level_sub_) return level_moving_;
+  level_pos_ = 0;
+  // The ring's old slots are not cleared at a reset (that would cost the whole ring in one
+  // sample): while it fills, nothing leaves the sum.
+  const bool full = level_filled_ >= level_len_;
+  bool moving = false;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    const std::int32_t m = Sat32(level_acc_[r] / static_cast<std::int64_t>(level_sub_));
+    level_acc_[r] = 0;
+    level_sum_[r] += m - (full ? level_ring_[r][level_at_] : 0);
+    level_ring_[r][level_at_] = m;
+    level_q8_[r] = level_sum_[r] * 256 / static_cast<std::int64_t>(level_len_);
+    // The mean of the last 0.1 s against that of the previous whole window (0.1–0.2 s earlier):
+    // a step shows at once, a ramp as its rise over 0.1–0.2 s.
+    moving = moving ||
+             Abs(level_sum_[r] - level_prev_[r]) > move_[r] * static_cast<std::int64_t>(level_len_);
+  }
+  if (level_filled_ <= level_len_) ++level_filled_;
+  if (++level_at_ == level_len_) {
+    level_at_ = 0;
+    level_prev_ = level_sum_;
+  }
+  // Until a whole previous window exists, nothing is known: taken as moving.
+  level_moving_ = moving || level_filled_ <= level_len_;
+  return level_moving_;
+}
+
 void HealthWatch::UpdateZero(const HealthInput& in, bool stable) {
   bool unloaded = stable;
   for (std::size_t r = 0; r < kAxes && unloaded; ++r) {
-    unloaded = Abs(fast_q8_[r] >> 8) <= window_[r];
+    unloaded = Abs(level_q8_[r] >> 8) <= window_[r];
   }
   if (!unloaded) {
     stable_run_ = 0;
@@ -331,36 +376,42 @@ void HealthWatch::UpdateBlock(const HealthInput& in, const WrenchLsb& d) {
 }
 
 void HealthWatch::FinishBlock() {
-  const bool use = !block_moved_;
   const std::int64_t n = block_;
+  BlockResult b;
   for (std::size_t r = 0; r < kAxes; ++r) {
-    std::int64_t a50 = 0, a60 = 0, p50 = 0, p60 = 0;
-    tone50_[r].Finish(&a50, &p50);
-    tone60_[r].Finish(&a60, &p60);
-    if (use) {
-      // The difference's variance less the tones: what is left is broadband noise; for white
-      // noise of σ per sample the difference has 2σ².
-      const std::int64_t var_q8 =
-          (sum_d2_[r] * 256 - (sum_d_[r] * sum_d_[r] * 256) / n) / n - p50 - p60;
-      const std::int64_t sigma_q8 =
-          var_q8 <= 0 ? 0 : ISqrt64(static_cast<std::uint64_t>(var_q8) * 128);
-      if (blocks_seen_ == 0) {
-        a50_q8_[r] = a50;
-        a60_q8_[r] = a60;
-        sigma_q8_[r] = sigma_q8;
-      } else {  // averages over ≈ 8 blocks
-        a50_q8_[r] += (a50 - a50_q8_[r]) / 8;
-        a60_q8_[r] += (a60 - a60_q8_[r]) / 8;
-        sigma_q8_[r] += (sigma_q8 - sigma_q8_[r]) / 8;
-      }
-      if (commission_blocks_ > 0) sigma_ref_sum_q8_[r] += sigma_q8;
-    }
+    std::int64_t p50 = 0, p60 = 0;
+    tone50_[r].Finish(&b.a50[r], &p50);
+    tone60_[r].Finish(&b.a60[r], &p60);
+    // The difference's variance less the tones: what is left is broadband noise; for white
+    // noise of σ per sample the difference has 2σ².
+    const std::int64_t var_q8 =
+        (sum_d2_[r] * 256 - (sum_d_[r] * sum_d_[r] * 256) / n) / n - p50 - p60;
+    b.sigma[r] = var_q8 <= 0 ? 0 : ISqrt64(static_cast<std::uint64_t>(var_q8) * 128);
     sum_d_[r] = 0;
     sum_d2_[r] = 0;
   }
+  const bool use = pending_use_ && !block_moved_;
+  const BlockResult previous = pending_;
+  pending_ = b;
+  pending_use_ = !block_moved_;
   block_pos_ = 0;
   block_moved_ = false;
-  if (!use) return;
+  if (use) TakeBlock(previous);
+}
+
+void HealthWatch::TakeBlock(const BlockResult& b) {
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    if (blocks_seen_ == 0) {
+      a50_q8_[r] = b.a50[r];
+      a60_q8_[r] = b.a60[r];
+      sigma_q8_[r] = b.sigma[r];
+    } else {  // averages over ≈ 8 blocks
+      a50_q8_[r] += (b.a50[r] - a50_q8_[r]) / 8;
+      a60_q8_[r] += (b.a60[r] - a60_q8_[r]) / 8;
+      sigma_q8_[r] += (b.sigma[r] - sigma_q8_[r]) / 8;
+    }
+    if (commission_blocks_ > 0) sigma_ref_sum_q8_[r] += b.sigma[r];
+  }
   ++blocks_seen_;
   if (commission_blocks_ > 0 && --commission_blocks_ == 0) {
     for (std::size_t r = 0; r < kAxes; ++r) {
@@ -411,10 +462,13 @@ void HealthWatch::UpdateRinging(const HealthInput& in) {
     return;
   }
   if (!capturing_) {
-    if (refractory_ > 0) return;
+    // Not before a block has measured the tones the trigger allows for.
+    if (refractory_ > 0 || blocks_seen_ == 0) return;
     bool jump = false;
     for (std::size_t r = 0; r < kAxes && !jump; ++r) {
-      jump = Abs(std::int64_t{in.tared[r]} * 256 - fast_q8_[r]) > step_[r] * 256;
+      // Beyond the tracked tones' peaks: a steady tone is no transient.
+      jump = Abs(std::int64_t{in.tared[r]} * 256 - fast_q8_[r]) >
+             step_[r] * 256 + a50_q8_[r] + a60_q8_[r];
     }
     if (!jump) return;
     capturing_ = true;
@@ -496,7 +550,7 @@ void HealthWatch::UpdateCreep(const HealthInput& in, bool moving) {
       return;
     case CreepPhase::kHold:
       if (moving) {  // the hold ended early: this move is the next one judged
-        for (std::size_t r = 0; r < kAxes; ++r) pre_level_[r] = fast_q8_[r] >> 8;
+        for (std::size_t r = 0; r < kAxes; ++r) pre_level_[r] = level_q8_[r] >> 8;
         creep_phase_ = CreepPhase::kMoving;
         return;
       }

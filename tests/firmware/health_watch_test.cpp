@@ -232,6 +232,27 @@ TEST(HealthWatch, MainsPickUpAt50And60Hz) {
   }
 }
 
+TEST(HealthWatch, MainsPickUpLargerThanALoadChangeIsStillFlagged) {
+  // A tone far above the load-change gate (1 % of rated): 2.5 % and 10 % of rated on Fz and
+  // Mx. A steady tone is no load change: the watch keeps judging and flags it with its size.
+  for (const double share : {0.025, 0.1}) {
+    Scene s;
+    s.load = [&](double t, std::array<double, 6>& y, double&) {
+      y[2] = share * kRated[2] * std::sin(2 * M_PI * 50.0 * t);
+      y[3] = share * kRated[3] * std::sin(2 * M_PI * 50.0 * t + 0.5);
+    };
+    Runner run(s);
+    run.Run(3);
+    ASSERT_TRUE(Has(run.report(), HealthCause::kMains50)) << share;
+    const HealthFinding* fd = Slot(run.report(), HealthCause::kMains50);
+    ASSERT_NE(fd, nullptr);
+    EXPECT_NEAR(fd->error_lsb[2], share * kRated[2], 0.03 * share * kRated[2]) << share;
+    EXPECT_NEAR(fd->error_lsb[3], share * kRated[3], 0.03 * share * kRated[3]) << share;
+    // Nor is it a transient to measure the mount on.
+    EXPECT_EQ(run.report().ring_mhz, 0) << share;
+  }
+}
+
 TEST(HealthWatch, NoiseFloorAboveCommissioning) {
   // From 8 s, extra white noise of 4× the floor on Fy (the commissioning took the first 5 s).
   Noise extra;

@@ -211,6 +211,36 @@ TEST(FtdHealth, MainsAt50And60HzFlaggedWithTheirAmplitude) {
   }
 }
 
+/// Mains pick-up of any size, on every bridge or on one (`channels=[1]`): a steady tone is not a
+/// load change, so the watch keeps judging and flags it with its amplitude. The truth is the
+/// injected peak per bridge through the calibration matrix.
+void ExpectMainsFlagged(double amplitude_mvv, bool one_bridge) {
+  const std::string spec =
+      "mains_interference:freq_hz=50,amplitude_mvv=" + std::to_string(amplitude_mvv) +
+      (one_bridge ? ",channels=[1]" : "");
+  Health h({"--sim-span-s", "60", "--sim-effect", spec}, 5);
+  ASSERT_GT(h.port(), 0) << h.Stderr();
+  const Flag f = h.WaitFor(fw::HealthCause::kMains50, 10.0);
+  ASSERT_TRUE(f.found) << spec << " not flagged\n" << h.Stderr();
+  ExpectFlaggedBy(f, 5.0);
+  std::array<double, 6> mvv{};
+  for (std::size_t c = 0; c < 6; ++c) mvv[c] = (!one_bridge || c == 1) ? amplitude_mvv : 0.0;
+  auto truth = OnAxes(mvv);
+  for (double& t : truth) t = std::fabs(t);
+  ExpectWithinFactor2(f.error, truth, 2e-4, 2e-4);
+  std::printf("%s: error", spec.c_str());
+  for (std::size_t a = 0; a < 6; ++a) std::printf(" %.4g/%.4g", f.error[a], truth[a]);
+  std::printf("\n");
+}
+
+TEST(FtdHealth, MainsOfAnyAmplitudeOnEveryBridgeFlagged) {
+  for (const double a : {0.002, 0.05, 0.2}) ExpectMainsFlagged(a, false);
+}
+
+TEST(FtdHealth, MainsOfAnyAmplitudeOnOneBridgeFlagged) {
+  for (const double a : {0.002, 0.05, 0.2}) ExpectMainsFlagged(a, true);
+}
+
 TEST(FtdHealth, ThermalZeroDriftFlaggedAndAttributed) {
   test::TempDir dir;
   // 20 → 30 °C over 40 s, held 30 s, back to 25 °C by 100 s; no load.
