@@ -106,6 +106,7 @@ void HealthWatch::Clear() {
   error_ = {};
   ResetReference(0, false);  // the next sample's temperature becomes the reference
   ring_measured_ = 0;
+  creep_streak_ = 0;
   for (RainflowCounter& c : rainflow_) c.Clear();
   cycles_changed_ = true;
 }
@@ -568,28 +569,65 @@ void HealthWatch::FinishCreep() {
   const std::int64_t n = seg_len_;
   std::size_t dom = 0;
   std::int64_t best = -1;
-  std::array<std::int64_t, kAxes> step{};
+  std::array<std::int64_t, kAxes> step{}, share{};
+  std::array<std::array<std::int64_t, kAxes>, 3> m{};
   for (std::size_t r = 0; r < kAxes; ++r) {
-    step[r] = seg_sum_[0][r] / n - pre_level_[r];
-    const std::int64_t share = Abs(step[r]) * 10000 / rated_[r];
-    if (share > best) {
-      best = share;
+    for (std::size_t k = 0; k < 3; ++k) m[k][r] = seg_sum_[k][r] / n;
+    step[r] = m[0][r] - pre_level_[r];
+    share[r] = Abs(step[r]) * 10000 / rated_[r];
+    if (share[r] > best) {
+      best = share[r];
       dom = r;
     }
   }
   if (best < kMinStepBp) return;  // too small a load change to judge creep on
+  // The segment means carry noise σ/√n each (n = 20 blocks: 1/√n ≈ 1/(4·√block)); a change
+  // must stand 6 such σ above it.
+  const auto guard = [this](std::size_t r) {
+    return ((6 * sigma_q8_[r] * inv_sqrt_block_q16_) >> 16) / (std::int64_t{4} * 256) + 1;
+  };
+  const std::int64_t d1 = m[1][dom] - m[0][dom];
+  const std::int64_t d2 = m[2][dom] - m[1][dom];
+  const std::int64_t seen = d1 + d2;
+  // A first-order approach keeps the increments' sign and lets them decay (τ below ≈ 40 s); its
+  // creep still to come is extrapolated. Otherwise what was seen is all there is.
+  const bool decays = d1 != 0 && (d1 > 0) == (d2 > 0) && Abs(d2) * 20 < Abs(d1) * 19;
+  const std::int64_t estimate = decays ? CreepRemaining(m[0][dom], m[1][dom], m[2][dom]) : seen;
+  // A still hold without creep: its evidence counts against the findings so far.
+  if (Abs(estimate) * 10000 <= Abs(step[dom]) * th_.creep_limit_bp || Abs(seen) <= guard(dom)) {
+    report_.creep_bp = Sat32(estimate * 10000 / step[dom]);
+    creep_streak_ = 0;
+    SetFinding(HealthCause::kCreep, false, {});
+    return;
+  }
+  // A ramp, or a load change that starts or stops inside the hold, is the load moving: no
+  // verdict either way.
+  if (!decays) return;
+  // The load's own trend: axes that did not step (under a tenth of the main step's share) creep
+  // by a tenth of its creep at most; more there is the load moving (a part re-oriented).
+  const std::int64_t quiet_bp = Abs(seen) * 10000 / rated_[dom] / 2;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    if (r == dom || share[r] * 10 >= best) continue;
+    const std::int64_t moved = Abs(m[2][r] - m[0][r]);
+    if (moved > guard(r) && moved * 10000 / rated_[r] > quiet_bp) return;
+  }
   WrenchLsb creep{};
   for (std::size_t r = 0; r < kAxes; ++r) {
-    creep[r] = Sat32(CreepRemaining(seg_sum_[0][r] / n, seg_sum_[1][r] / n, seg_sum_[2][r] / n));
+    creep[r] = Sat32(CreepRemaining(m[0][r], m[1][r], m[2][r]));
   }
   report_.creep_bp = Sat32(std::int64_t{creep[dom]} * 10000 / step[dom]);
-  // The segment means carry noise σ/√n each: a creep must also stand 6 such σ above it.
-  // (n = 20 blocks: 1/√n ≈ 1/(4·√block)).
-  const std::int64_t guard =
-      ((6 * sigma_q8_[dom] * inv_sqrt_block_q16_) >> 16) / (std::int64_t{4} * 256) + 1;
-  const bool creeps =
-      Abs(creep[dom]) * 10000 > Abs(step[dom]) * th_.creep_limit_bp && Abs(creep[dom]) > guard;
-  SetFinding(HealthCause::kCreep, creeps, creep);
+  const int sign = (seen > 0) == (step[dom] > 0) ? 1 : -1;
+  const std::int64_t ratio_q16 = d2 * 65536 / d1;  // e^(−2 s/τ), in (0, 0.95)
+  // τ within a factor 2 of the streak's: ln q within a factor 2, i.e. q² ≤ q' and q'² ≤ q.
+  const bool agrees = creep_streak_ > 0 && sign == creep_sign_ &&
+                      ratio_q16 * ratio_q16 <= creep_ratio_q16_ * 65536 &&
+                      creep_ratio_q16_ * creep_ratio_q16_ <= ratio_q16 * 65536;
+  creep_streak_ = agrees ? creep_streak_ + 1 : 1;
+  if (!agrees) {  // the streak's first hold is what the others are compared with
+    creep_sign_ = sign;
+    creep_ratio_q16_ = ratio_q16;
+  }
+  if (creep_streak_ >= kCreepHolds) SetFinding(HealthCause::kCreep, true, creep);
 }
 
 void HealthWatch::Publish(const HealthInput& in) {

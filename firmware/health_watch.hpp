@@ -27,12 +27,13 @@ struct HealthInput {
 /// one slice of kRingSlice samples of a ringing analysis (after a transient capture ends, its six
 /// axes are analysed a slice per sample: 4 samples per axis).
 /// Single-threaded: the sampling thread calls everything.
-/// Members are grouped by watch, not by size: 64 bytes of padding in a 13 KB object.
+/// Members are grouped by watch, not by size: some padding in a 20 KB object.
 class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
  public:
   static constexpr std::size_t kRingCapture = 512;  ///< samples of a transient capture
   static constexpr std::size_t kRingSlice = 128;    ///< capture samples analysed per Step
   static constexpr std::size_t kLevelRing = 128;    ///< sub-block means of the 0.1 s level
+  static constexpr std::uint32_t kCreepHolds = 3;   ///< still holds that must agree on a creep
 
   /// Rate and rated range per axis (LSB, each > 0). False (the watch stays off) otherwise, or at
   /// a rate below 100 Hz.
@@ -168,6 +169,11 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   std::array<std::array<std::int64_t, kAxes>, 3> seg_sum_{};
   std::uint32_t creep_count_ = 0;
   std::uint32_t seg_len_ = 0;
+  // Independent holds that read as creep, in a row, with the same sign (relative to their step)
+  // and time constants within a factor 2 (d2/d1 of the segments: e^(−2 s/τ), Q16).
+  std::uint32_t creep_streak_ = 0;
+  int creep_sign_ = 0;
+  std::int64_t creep_ratio_q16_ = 0;
 
   // Load history: rainflow cycles of the untared load per axis.
   std::array<RainflowCounter, kAxes> rainflow_{};
