@@ -220,6 +220,11 @@ std::string Ftd::StatusLine() const {
                 w[5] * fw::kMomentLsbNm, d.sample.status,
                 st.elapsed_s > 0 ? static_cast<double>(st.samples) / st.elapsed_s : 0.0);
   std::string line = buf;
+  if (d.health_on) {  // NE 107 state, findings and coverage: bit (cause − 1), as input 100–101, 196
+    std::snprintf(buf, sizeof(buf), "  health=%d findings=0x%02x covers=0x%02x",
+                  static_cast<int>(d.health.state), d.health.findings, d.health.coverage);
+    line += buf;
+  }
   if (const fw::ServerCounters* c = servers_.tcp_counters()) {
     line += "  tcp " + std::to_string(c->requests.load()) + " req";
   }

@@ -305,6 +305,7 @@ void HealthWatch::AddZeroPoint(const HealthInput& in) {
       SetFinding(HealthCause::kOverloadShift, true, shift);
     }
     overload_seen_ = false;
+    Judged(HealthCause::kOverloadShift);
   }
   if (spell_rejected_) return;
   const std::int64_t dt_s = static_cast<std::int64_t>((samples_ - ref_sample_) / rate_);
@@ -355,6 +356,8 @@ void HealthWatch::JudgeZero(const HealthInput& in) {
     if (stt_ > 0) explained_time += szt_[r] * szt_[r] / stt_;
   }
   report_.thermal_ppm_per_k = Sat32(worst_ppm);
+  Judged(HealthCause::kZeroDrift);
+  if (dtemp_max_ - dtemp_min_ >= 100) Judged(HealthCause::kThermalZeroDrift);
   report_.zero_points = points_;
   // Thermal when the temperature moved ≥ 1 K and explains ≥ 3/4 of the zero's variation, and
   // at least as much as time does.
@@ -420,6 +423,9 @@ void HealthWatch::TakeBlock(const BlockResult& b) {
     }
   }
   if (blocks_seen_ < 8) return;  // the averages need 8 blocks
+  Judged(HealthCause::kMains50);
+  Judged(HealthCause::kMains60);
+  if (commission_blocks_ == 0) Judged(HealthCause::kNoiseFloor);
   bool mains50 = false, mains60 = false, noisy = false;
   std::int64_t worst50 = 0, worst60 = 0, worst_ratio = 0;
   WrenchLsb e50{}, e60{}, en{};
@@ -523,6 +529,7 @@ void HealthWatch::FinishRinging() {
     return;
   }
   if (ring_measured_ < 3) return;
+  Judged(HealthCause::kResonanceShift);
   const std::int64_t now = Median3(ring_last_mhz_);
   const bool shifted =
       Abs(now - ring_ref_mhz_) * 1000 > std::int64_t{ring_ref_mhz_} * th_.resonance_shift_pm;
@@ -596,6 +603,7 @@ void HealthWatch::FinishCreep() {
   // A still hold without creep: its evidence counts against the findings so far.
   if (Abs(estimate) * 10000 <= Abs(step[dom]) * th_.creep_limit_bp || Abs(seen) <= guard(dom)) {
     report_.creep_bp = Sat32(estimate * 10000 / step[dom]);
+    Judged(HealthCause::kCreep);
     creep_streak_ = 0;
     SetFinding(HealthCause::kCreep, false, {});
     return;
@@ -611,6 +619,7 @@ void HealthWatch::FinishCreep() {
     const std::int64_t moved = Abs(m[2][r] - m[0][r]);
     if (moved > guard(r) && moved * 10000 / rated_[r] > quiet_bp) return;
   }
+  Judged(HealthCause::kCreep);
   WrenchLsb creep{};
   for (std::size_t r = 0; r < kAxes; ++r) {
     creep[r] = Sat32(CreepRemaining(m[0][r], m[1][r], m[2][r]));
@@ -633,6 +642,14 @@ void HealthWatch::FinishCreep() {
 void HealthWatch::Publish(const HealthInput& in) {
   HealthReport& r = report_;
   r.findings = active_;
+  if (samples_ % rate_ == 0) {  // the coverage, once a second: causes judged within the hour
+    const std::uint64_t hour = std::uint64_t{3600} * rate_;
+    std::uint16_t covered = 0;
+    for (std::size_t i = 0; i < kHealthCauses; ++i) {
+      if (judged_at_[i] != 0 && samples_ - judged_at_[i] < hour) covered |= 1u << i;
+    }
+    r.coverage = covered;
+  }
   r.ring_ref_mhz = ring_ref_mhz_;
   r.tare_age_s = static_cast<std::uint32_t>(samples_ / rate_) - tare_sample_;
   // The counts change only when a cycle closes: copy them then, not every sample.

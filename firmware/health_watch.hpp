@@ -81,6 +81,8 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   void UpdateCreep(const HealthInput& in, bool moving);
   void FinishCreep();
   void SetFinding(HealthCause cause, bool on, const WrenchLsb& error);
+  /// The watch judged `cause` at this sample (its coverage).
+  void Judged(HealthCause cause) { judged_at_[static_cast<std::size_t>(cause) - 1] = samples_; }
   void Publish(const HealthInput& in);
 
   bool configured_ = false;
@@ -179,8 +181,9 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   std::array<RainflowCounter, kAxes> rainflow_{};
   bool cycles_changed_ = true;  ///< a count changed since the report last copied them
 
-  // Findings.
+  // Findings, and when each cause was last judged (sample count; 0: never).
   std::uint16_t active_ = 0;
+  std::array<std::uint64_t, kHealthCauses> judged_at_{};
   std::array<WrenchLsb, kHealthCauses> error_{};
   std::uint32_t tare_sample_ = 0;
   std::uint32_t tares_completed_ = 0;

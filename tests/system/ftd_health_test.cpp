@@ -267,6 +267,11 @@ TEST(FtdHealth, ThermalZeroDriftFlaggedAndAttributed) {
   EXPECT_EQ(f.retare, 1);
   EXPECT_EQ(f.reason, static_cast<int>(fw::HealthCause::kThermalZeroDrift));
   std::printf("thermal: flagged at %.1f s (%.2f °C)\n", t, temp);
+  // The temperature moved: the coverage (input 196) says a thermal drift could be judged; no
+  // load change came, so creep could not.
+  const int coverage = static_cast<int>(h.Read("3", 196, 1)[196]);
+  EXPECT_NE(coverage & (1 << (static_cast<int>(fw::HealthCause::kThermalZeroDrift) - 1)), 0);
+  EXPECT_EQ(coverage & (1 << (static_cast<int>(fw::HealthCause::kCreep) - 1)), 0);
 }
 
 TEST(FtdHealth, CreepFlaggedWithItsSize) {
@@ -380,6 +385,60 @@ TEST(FtdHealth, MachineTendingWithCreepFlagsIt) {
   EXPECT_GT(std::fabs(f.error[2]), 0.5 * 0.004 * 39.24);
   EXPECT_LT(std::fabs(f.error[2]), 2.0 * 0.004 * 78.48);
   std::printf("machine tending, creep τ 6 s: flagged at %.1f s; Fz %.3f N\n", f.sim_s, f.error[2]);
+}
+
+/// Input 196 (health_coverage) once the simulated time passed `at_s`.
+int CoverageAt(Health& h, double at_s) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (h.SimSeconds() >= at_s) return static_cast<int>(h.Read("3", 196, 1)[196]);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ADD_FAILURE() << "the simulated time did not reach " << at_s << " s";
+  return -1;
+}
+
+constexpr int Bit(fw::HealthCause c) { return 1 << (static_cast<int>(c) - 1); }
+
+TEST(FtdHealth, CoverageSaysWhatTheWatchCouldJudge) {
+  using C = fw::HealthCause;
+  test::TempDir dir;
+  {  // Steps between 0 and 160 N at 20 °C: zero spells, holds, quiet blocks; no temperature change.
+    Health h({"--sim-profile", StepProfile(dir), "--sim-span-s", "90"});
+    ASSERT_GT(h.port(), 0) << h.Stderr();
+    const int c = CoverageAt(h, 60.0);
+    std::printf("steps: coverage 0x%x\n", c);
+    for (const C k :
+         {C::kZeroDrift, C::kMains50, C::kMains60, C::kNoiseFloor, C::kCreep, C::kOverloadShift}) {
+      EXPECT_NE(c & Bit(k), 0) << static_cast<int>(k);
+    }
+    EXPECT_EQ(c & Bit(C::kThermalZeroDrift), 0);
+  }
+  {  // A constant load of 100 N on Fz: never unloaded, never a step.
+    Health h({"--sim-wrench", "0,0,100,0,0,0"});
+    ASSERT_GT(h.port(), 0) << h.Stderr();
+    const int c = CoverageAt(h, 20.0);
+    std::printf("held load: coverage 0x%x\n", c);
+    EXPECT_EQ(c, Bit(C::kMains50) | Bit(C::kMains60) | Bit(C::kNoiseFloor));
+  }
+}
+
+TEST(FtdHealth, StatusLineCarriesTheCoverage) {
+  // The reading lines on stdout (--print-hz) are the status line: state, findings, coverage.
+  std::string out;
+  const std::string cmd = std::string(FTSTACK_BIN_DIR) +
+                          "/ftd --adc sim --sim-wrench 0,0,100,0,0,0 --sim-speed 10 "
+                          "--print-hz 2 --duration-s 3 2>/dev/null";
+  ASSERT_EQ(test::RunShell(cmd, &out), 0) << out;
+  const std::size_t last = out.rfind("health=");
+  ASSERT_NE(last, std::string::npos) << out;
+  // A held load, no effect: normal, nothing found, tones and noise judged, no zero spell.
+  const int expected = (1 << (static_cast<int>(fw::HealthCause::kMains50) - 1)) |
+                       (1 << (static_cast<int>(fw::HealthCause::kMains60) - 1)) |
+                       (1 << (static_cast<int>(fw::HealthCause::kNoiseFloor) - 1));
+  char want[64];
+  std::snprintf(want, sizeof want, "health=0 findings=0x00 covers=0x%02x", expected);
+  EXPECT_EQ(out.substr(last, std::string(want).size()), want) << out.substr(last);
 }
 
 TEST(FtdHealth, MountResonanceShiftOfTenPercent) {
