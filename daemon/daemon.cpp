@@ -93,9 +93,13 @@ void Ftd::Start() {
     map_->SetMqttCounters(&mqtt_->counters());
   }
   if (!opt_.log.empty()) {
+    // The paced simulator stamps wall-clock conversion times (n / (rate · speed)): scaled by
+    // the speed, the log's t is the simulated time the samples were composed at.
+    const bool sim_paced = opt_.adc == "sim" && opt_.paced && opt_.sim_speed > 0;
     log_.Open(opt_.log,
               {"source: ftd", "adc: " + opt_.adc, "rate_hz: " + std::to_string(opt_.rate_hz),
-               "wrench: measured (tool frame), N and N·m"});
+               "wrench: measured (tool frame), N and N·m"},
+              sim_paced ? opt_.sim_speed : 1.0);
   }
   StartThreads();
 }
