@@ -207,7 +207,9 @@ void HealthWatch::Step(const HealthInput& in) {
       const std::int64_t y_q8 = std::int64_t{in.tared[r]} * 256;
       fast_q8_[r] += (y_q8 - fast_q8_[r]) >> fast_shift_;
       slow_q8_[r] += (y_q8 - slow_q8_[r]) >> slow_shift_;
-      stable = stable && Abs(level_q8_[r] - slow_q8_[r]) <= band_[r] * 256;
+      // |level − slow| within the band, compared in the ring's sum (no division per sample).
+      const std::int64_t len = level_len_;
+      stable = stable && Abs(level_sum_[r] * 256 - slow_q8_[r] * len) <= band_[r] * 256 * len;
       const std::int64_t diff = std::int64_t{in.tared[r]} - prev_[r];
       d[r] = static_cast<std::int32_t>(diff > max_diff_ ? max_diff_
                                                         : (diff < -max_diff_ ? -max_diff_ : diff));
@@ -240,11 +242,11 @@ bool HealthWatch::UpdateLevel(const HealthInput& in) {
   const bool full = level_filled_ >= level_len_;
   bool moving = false;
   for (std::size_t r = 0; r < kAxes; ++r) {
-    const std::int32_t m = Sat32(level_acc_[r] / static_cast<std::int64_t>(level_sub_));
+    const std::int32_t m = Sat32(
+        level_sub_ == 1 ? level_acc_[r] : level_acc_[r] / static_cast<std::int64_t>(level_sub_));
     level_acc_[r] = 0;
     level_sum_[r] += m - (full ? level_ring_[r][level_at_] : 0);
     level_ring_[r][level_at_] = m;
-    level_q8_[r] = level_sum_[r] * 256 / static_cast<std::int64_t>(level_len_);
     // The mean of the last 0.1 s against that of the previous whole window (0.1–0.2 s earlier):
     // a step shows at once, a ramp as its rise over 0.1–0.2 s.
     moving = moving ||
@@ -263,7 +265,7 @@ bool HealthWatch::UpdateLevel(const HealthInput& in) {
 void HealthWatch::UpdateZero(const HealthInput& in, bool stable) {
   bool unloaded = stable;
   for (std::size_t r = 0; r < kAxes && unloaded; ++r) {
-    unloaded = Abs(level_q8_[r] >> 8) <= window_[r];
+    unloaded = Abs(level_sum_[r]) <= window_[r] * static_cast<std::int64_t>(level_len_);
   }
   if (!unloaded) {
     stable_run_ = 0;
@@ -558,7 +560,9 @@ void HealthWatch::UpdateCreep(const HealthInput& in, bool moving) {
       return;
     case CreepPhase::kHold:
       if (moving) {  // the hold ended early: this move is the next one judged
-        for (std::size_t r = 0; r < kAxes; ++r) pre_level_[r] = level_q8_[r] >> 8;
+        for (std::size_t r = 0; r < kAxes; ++r) {
+          pre_level_[r] = level_sum_[r] / static_cast<std::int64_t>(level_len_);
+        }
         creep_phase_ = CreepPhase::kMoving;
         return;
       }

@@ -112,7 +112,6 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   std::array<std::array<std::int32_t, kLevelRing>, kAxes> level_ring_{};
   std::array<std::int64_t, kAxes> level_sum_{};   ///< Σ of the ring: level × level_len_
   std::array<std::int64_t, kAxes> level_prev_{};  ///< that sum at the last wrap of the ring
-  std::array<std::int64_t, kAxes> level_q8_{};    ///< the level, Q8 LSB
   bool level_moving_ = true;
 
   // Zero watch: spells, zero points (one per second of a qualified spell), regression.
