@@ -233,10 +233,12 @@ TEST(HealthWatch, MainsPickUpAt50And60Hz) {
 }
 
 TEST(HealthWatch, MainsPickUpLargerThanALoadChangeIsStillFlagged) {
-  // A tone far above the load-change gate (1 % of rated): 2.5 % and 10 % of rated on Fz and
+  // A tone far above the load-change gate (1 % of rated): 2.5 % and 10 % (1 kHz), 50 % (8 kHz)
+  // of rated on Fz and
   // Mx. A steady tone is no load change: the watch keeps judging and flags it with its size.
-  for (const double share : {0.025, 0.1}) {
+  for (const double share : {0.025, 0.1, 0.5}) {
     Scene s;
+    s.rate = share == 0.5 ? 8000 : 1000;  // and at 8 kHz (8 samples per sub-block of the level)
     s.load = [&](double t, std::array<double, 6>& y, double&) {
       y[2] = share * kRated[2] * std::sin(2 * M_PI * 50.0 * t);
       y[3] = share * kRated[3] * std::sin(2 * M_PI * 50.0 * t + 0.5);
