@@ -234,8 +234,8 @@ TEST(HealthWatch, MainsPickUpAt50And60Hz) {
 
 TEST(HealthWatch, MainsPickUpLargerThanALoadChangeIsStillFlagged) {
   // A tone far above the load-change gate (1 % of rated): 2.5 % and 10 % (1 kHz), 50 % (8 kHz)
-  // of rated on Fz and
-  // Mx. A steady tone is no load change: the watch keeps judging and flags it with its size.
+  // of rated on Fz and Mx. A steady tone is no load change: the watch keeps judging and flags it
+  // with its size.
   for (const double share : {0.025, 0.1, 0.5}) {
     Scene s;
     s.rate = share == 0.5 ? 8000 : 1000;  // and at 8 kHz (8 samples per sub-block of the level)
