@@ -93,9 +93,13 @@ void Ftd::Start() {
     map_->SetMqttCounters(&mqtt_->counters());
   }
   if (!opt_.log.empty()) {
+    // The paced simulator stamps wall-clock conversion times (n / (rate · speed)): scaled by
+    // the speed, the log's t is the simulated time the samples were composed at.
+    const bool sim_paced = opt_.adc == "sim" && opt_.paced && opt_.sim_speed > 0;
     log_.Open(opt_.log,
               {"source: ftd", "adc: " + opt_.adc, "rate_hz: " + std::to_string(opt_.rate_hz),
-               "wrench: measured (tool frame), N and N·m"});
+               "wrench: measured (tool frame), N and N·m"},
+              sim_paced ? opt_.sim_speed : 1.0);
   }
   StartThreads();
 }
@@ -220,6 +224,11 @@ std::string Ftd::StatusLine() const {
                 w[5] * fw::kMomentLsbNm, d.sample.status,
                 st.elapsed_s > 0 ? static_cast<double>(st.samples) / st.elapsed_s : 0.0);
   std::string line = buf;
+  if (d.health_on) {  // NE 107 state, findings and coverage: bit (cause − 1), as input 100–101, 196
+    std::snprintf(buf, sizeof(buf), "  health=%d findings=0x%02x covers=0x%02x",
+                  static_cast<int>(d.health.state), d.health.findings, d.health.coverage);
+    line += buf;
+  }
   if (const fw::ServerCounters* c = servers_.tcp_counters()) {
     line += "  tcp " + std::to_string(c->requests.load()) + " req";
   }

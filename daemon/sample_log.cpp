@@ -17,7 +17,8 @@ constexpr std::size_t kLogRingCapacity = std::size_t{1} << 15;
 SampleLog::SampleLog() = default;
 SampleLog::~SampleLog() = default;
 
-void SampleLog::Open(const std::string& path, std::vector<std::string> metadata) {
+void SampleLog::Open(const std::string& path, std::vector<std::string> metadata,
+                     double time_scale) {
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (f == nullptr) {
     throw FtdError(path + ": cannot write: " + std::system_category().message(errno));
@@ -25,6 +26,7 @@ void SampleLog::Open(const std::string& path, std::vector<std::string> metadata)
   std::fclose(f);
   path_ = path;
   metadata_ = std::move(metadata);
+  time_scale_ = time_scale;
   ring_.resize(kLogRingCapacity);
 }
 
@@ -63,7 +65,7 @@ void SampleLog::Drain(const hal::AdcInfo& adc) {
     }
     last_timestamp_us_ = s.timestamp_us;
     row.clear();
-    row.push_back(static_cast<double>(time_base_us_ + s.timestamp_us) * 1e-6);
+    row.push_back(static_cast<double>(time_base_us_ + s.timestamp_us) * 1e-6 * time_scale_);
     for (std::size_t c = 0; c < s.channel_count; ++c) {
       row.push_back(s.raw_counts[c] * mvv_per_count);
     }

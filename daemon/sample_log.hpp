@@ -26,7 +26,9 @@ class SampleLog {
 
   /// Checks that `path` can be written (throws FtdError) and sizes the ring; the recording's
   /// header and `metadata` are written with the first row.
-  void Open(const std::string& path, std::vector<std::string> metadata);
+  /// `time_scale` multiplies the sample times into the log's `t`: the paced simulator's
+  /// --sim-speed (its conversion times are wall-clock µs; t is then simulated time), else 1.
+  void Open(const std::string& path, std::vector<std::string> metadata, double time_scale = 1.0);
   [[nodiscard]] bool enabled() const { return !ring_.empty(); }
   /// Sampling thread: queues one published sample; counts it dropped when the ring is full.
   void Push(const fw::DeviceSample& sample);
@@ -49,6 +51,7 @@ class SampleLog {
   std::uint64_t logged_rows_ = 0;
   std::uint64_t time_base_us_ = 0;  ///< added to the 32-bit µs timestamp after each wrap
   std::uint32_t last_timestamp_us_ = 0;
+  double time_scale_ = 1.0;
 };
 
 }  // namespace ftstack::daemon

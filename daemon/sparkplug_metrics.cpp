@@ -66,6 +66,10 @@ std::vector<Metric> ExceptionMetrics(const DeviceState& s) {
   }
   m.push_back(UInt("Events/Overload Events", DataType::kUInt32, d.overload_events));
   m.push_back(UInt("Events/Late Samples", DataType::kUInt32, d.late_samples));
+  // The health watch (input 100, 101, 196): NE 107 state, findings and coverage, bit (cause − 1).
+  m.push_back(UInt("Health/State", DataType::kUInt8, static_cast<std::uint64_t>(d.health.state)));
+  m.push_back(UInt("Health/Findings", DataType::kUInt16, d.health.findings));
+  m.push_back(UInt("Health/Coverage", DataType::kUInt16, d.health.coverage));
   for (std::size_t i = 0; i < 6; ++i) {
     const bool invalid = (d.peaks_invalid_axes & (1u << i)) != 0;
     m.push_back(Real(std::string("Peaks/") + kAxisMetric[i], DataType::kDouble,

@@ -62,6 +62,7 @@ void BuildHealthInputRegisters(const DeviceSample& d, std::uint16_t* regs) {
   PackU32(h.tare_age_s, at(kInTareAge));
   PackFloat32(static_cast<float>(h.tare_temp_mdegc * 1e-3), at(kInTareTemp));
   *at(kInTareCount) = h.tare_count;
+  *at(kInCoverage) = h.coverage;
   for (std::size_t r = 0; r < kAxes; ++r) {
     *at(static_cast<std::uint16_t>(kInCycles + r)) =
         static_cast<std::uint16_t>(h.cycles[r] > 0xFFFFu ? 0xFFFFu : h.cycles[r]);

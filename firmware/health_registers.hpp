@@ -31,7 +31,8 @@ enum HealthInputRegister : std::uint16_t {
   kInTareTemp = 187,       ///< float32 °C at the last tare (0 without one)
   kInTareCount = 189,      ///< uint16, tares since start
   kInCycles = 190,         ///< uint16 × 6, rainflow cycles ≥ 10 % of rated per axis (saturating)
-  kInHealthReserved = 196,  ///< 196 … 199 reserved, read 0
+  kInCoverage = 196,       ///< bit (cause − 1) per cause judged within the last hour
+  kInHealthReserved = 197,  ///< 197 … 199 reserved, read 0
   kInHealthEnd = 200,
 };
 

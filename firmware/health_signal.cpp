@@ -1,5 +1,6 @@
 #include "firmware/health_signal.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "firmware/overload.hpp"
@@ -24,13 +25,17 @@ bool ToneDetector::Configure(std::uint32_t freq_hz, std::uint32_t rate_hz, std::
   coef_q30_ = std::llround(2.0 * std::cos(w) * 1073741824.0);
   gain_q16_ = std::llround(65536.0 / (block * std::sin(w / 2.0)));
   block_ = block;
+  // coef·s within 2^62 (|s| ≤ 2^31) and the block's (Σd)² · 256 within 2^63 (|Σd| ≤ 2^27).
+  const double growth = block * std::min<double>(block, 1.0 / std::fabs(std::sin(w)));
+  const double limit = std::min({2147483648.0 / growth, 134217728.0 / block, 16777216.0});
+  max_diff_ = static_cast<std::int32_t>(std::max(limit, 1.0));
   s1_ = 0;
   s2_ = 0;
   return true;
 }
 
 void ToneDetector::Finish(std::int64_t* amplitude_q8, std::int64_t* diff_power_q8) {
-  // |X|² = s1² + s2² − c·s1·s2 (the Goertzel power at the tone); bounded by (N·kMaxDiff)².
+  // |X|² = s1² + s2² − c·s1·s2 (the Goertzel power at the tone); bounded by (N·max_diff)².
   const Int128 p = static_cast<Int128>(s1_) * s1_ + static_cast<Int128>(s2_) * s2_ -
                    ((static_cast<Int128>(coef_q30_) * s1_ * s2_) >> 30);
   const std::uint64_t pu =

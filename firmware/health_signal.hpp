@@ -15,7 +15,7 @@ class ToneDetector {
   /// Tone `freq_hz` at `rate_hz` over blocks of `block` samples. False if the tone is not below
   /// the Nyquist frequency or the block is shorter than 8 samples.
   [[nodiscard]] bool Configure(std::uint32_t freq_hz, std::uint32_t rate_hz, std::uint32_t block);
-  /// One first difference d (clamped by the caller to ±kMaxDiff).
+  /// One first difference d (clamped by the caller to ±max_diff()).
   void Add(std::int32_t d) {
     const std::int64_t s0 = d + ((coef_q30_ * s1_) >> 30) - s2_;
     s2_ = s1_;
@@ -24,12 +24,15 @@ class ToneDetector {
   /// The block's tone amplitude in the original signal (peak, Q8 LSB) and the mean square of the
   /// difference signal this tone explains (Q8 LSB²); restarts the detector.
   void Finish(std::int64_t* amplitude_q8, std::int64_t* diff_power_q8);
-  static constexpr std::int32_t kMaxDiff = 1 << 15;
+  /// The largest |d| for which no sum overflows 64 bits at this rate and block: the
+  /// resonator grows to at most N · min(N, 1/sin ω) · |d|.
+  [[nodiscard]] std::int32_t max_diff() const { return max_diff_; }
 
  private:
   std::int64_t coef_q30_ = 0;  ///< 2·cos(2π f / rate), Q30
   std::int64_t gain_q16_ = 0;  ///< 1 / (N · sin(π f / rate)), Q16: |X| → amplitude
   std::uint32_t block_ = 0;
+  std::int32_t max_diff_ = 1 << 15;
   std::int64_t s1_ = 0;
   std::int64_t s2_ = 0;
 };

@@ -85,6 +85,10 @@ struct HealthFinding {
 struct HealthReport {
   Ne107State state = Ne107State::kNormal;
   std::uint16_t findings = 0;  ///< bit (cause − 1) per active finding
+  /// bit (cause − 1) per cause the watch could judge within the last hour (enough still holds,
+  /// unloaded spells, temperature change, ringing steps, quiet blocks): "no finding" from
+  /// "could not look".
+  std::uint16_t coverage = 0;
   bool retare_suggested = false;
   HealthCause retare_reason = HealthCause::kNone;
   std::array<HealthFinding, kHealthSlots> slots{};  ///< active findings, cause order

@@ -54,6 +54,13 @@ bool HealthWatch::Configure(std::uint32_t rate_hz, const WrenchLsb& rated_lsb) {
       return false;
     }
   }
+  max_diff_ = std::min(tone50_[0].max_diff(), tone60_[0].max_diff());
+  // The level's sub-blocks: the fewest samples each that keep the ring within kLevelRing and
+  // divide the block exactly (the ring then spans whole periods of 50 and 60 Hz).
+  level_sub_ = 1;
+  while (block_ / level_sub_ > kLevelRing || block_ % level_sub_ != 0) ++level_sub_;
+  level_len_ = block_ / level_sub_;
+  ResetLevel();
   capture_stride_ = rate_hz <= 2000 ? 1 : rate_hz / 1000;
   for (std::size_t r = 0; r < kAxes; ++r) {
     // Turning points beyond 2 % of rated (noise makes none); cycles of 10 % of rated and more.
@@ -99,6 +106,7 @@ void HealthWatch::Clear() {
   error_ = {};
   ResetReference(0, false);  // the next sample's temperature becomes the reference
   ring_measured_ = 0;
+  creep_streak_ = 0;
   for (RainflowCounter& c : rainflow_) c.Clear();
   cycles_changed_ = true;
 }
@@ -190,19 +198,21 @@ void HealthWatch::Step(const HealthInput& in) {
       prev_ = in.tared;
       filters_ready_ = true;
     }
-    bool stable = true;
-    bool moving = false;
+    // Moving and stable are judged on the 0.1 s level, in which a steady 50 or 60 Hz tone (and
+    // its harmonics) cancels: a tone of any size is then not a load change.
+    const bool moving = UpdateLevel(in);
+    bool stable = level_filled_ >= level_len_;
     WrenchLsb d{};
     for (std::size_t r = 0; r < kAxes; ++r) {
       const std::int64_t y_q8 = std::int64_t{in.tared[r]} * 256;
       fast_q8_[r] += (y_q8 - fast_q8_[r]) >> fast_shift_;
       slow_q8_[r] += (y_q8 - slow_q8_[r]) >> slow_shift_;
-      stable = stable && Abs(fast_q8_[r] - slow_q8_[r]) <= band_[r] * 256;
-      moving = moving || Abs(y_q8 - fast_q8_[r]) > move_[r] * 256;
+      // |level − slow| within the band, compared in the ring's sum (no division per sample).
+      const std::int64_t len = level_len_;
+      stable = stable && Abs(level_sum_[r] * 256 - slow_q8_[r] * len) <= band_[r] * 256 * len;
       const std::int64_t diff = std::int64_t{in.tared[r]} - prev_[r];
-      d[r] = static_cast<std::int32_t>(diff > ToneDetector::kMaxDiff    ? ToneDetector::kMaxDiff
-                                       : diff < -ToneDetector::kMaxDiff ? -ToneDetector::kMaxDiff
-                                                                        : diff);
+      d[r] = static_cast<std::int32_t>(diff > max_diff_ ? max_diff_
+                                                        : (diff < -max_diff_ ? -max_diff_ : diff));
     }
     prev_ = in.tared;
     if (moving) block_moved_ = true;
@@ -214,10 +224,48 @@ void HealthWatch::Step(const HealthInput& in) {
   Publish(in);
 }
 
+void HealthWatch::ResetLevel() {
+  level_pos_ = 0;
+  level_at_ = 0;
+  level_filled_ = 0;
+  level_acc_ = {};
+  level_sum_ = {};
+  level_moving_ = true;
+}
+
+bool HealthWatch::UpdateLevel(const HealthInput& in) {
+  for (std::size_t r = 0; r < kAxes; ++r) level_acc_[r] += in.tared[r];
+  if (++level_pos_ < level_sub_) return level_moving_;
+  level_pos_ = 0;
+  // The ring's old slots are not cleared at a reset (that would cost the whole ring in one
+  // sample): while it fills, nothing leaves the sum.
+  const bool full = level_filled_ >= level_len_;
+  bool moving = false;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    const std::int32_t m = Sat32(
+        level_sub_ == 1 ? level_acc_[r] : level_acc_[r] / static_cast<std::int64_t>(level_sub_));
+    level_acc_[r] = 0;
+    level_sum_[r] += m - (full ? level_ring_[r][level_at_] : 0);
+    level_ring_[r][level_at_] = m;
+    // The mean of the last 0.1 s against that of the previous whole window (0.1–0.2 s earlier):
+    // a step shows at once, a ramp as its rise over 0.1–0.2 s.
+    moving = moving ||
+             Abs(level_sum_[r] - level_prev_[r]) > move_[r] * static_cast<std::int64_t>(level_len_);
+  }
+  if (level_filled_ <= level_len_) ++level_filled_;
+  if (++level_at_ == level_len_) {
+    level_at_ = 0;
+    level_prev_ = level_sum_;
+  }
+  // Until a whole previous window exists, nothing is known: taken as moving.
+  level_moving_ = moving || level_filled_ <= level_len_;
+  return level_moving_;
+}
+
 void HealthWatch::UpdateZero(const HealthInput& in, bool stable) {
   bool unloaded = stable;
   for (std::size_t r = 0; r < kAxes && unloaded; ++r) {
-    unloaded = Abs(fast_q8_[r] >> 8) <= window_[r];
+    unloaded = Abs(level_sum_[r]) <= window_[r] * static_cast<std::int64_t>(level_len_);
   }
   if (!unloaded) {
     stable_run_ = 0;
@@ -259,6 +307,7 @@ void HealthWatch::AddZeroPoint(const HealthInput& in) {
       SetFinding(HealthCause::kOverloadShift, true, shift);
     }
     overload_seen_ = false;
+    Judged(HealthCause::kOverloadShift);
   }
   if (spell_rejected_) return;
   const std::int64_t dt_s = static_cast<std::int64_t>((samples_ - ref_sample_) / rate_);
@@ -309,6 +358,8 @@ void HealthWatch::JudgeZero(const HealthInput& in) {
     if (stt_ > 0) explained_time += szt_[r] * szt_[r] / stt_;
   }
   report_.thermal_ppm_per_k = Sat32(worst_ppm);
+  Judged(HealthCause::kZeroDrift);
+  if (dtemp_max_ - dtemp_min_ >= 100) Judged(HealthCause::kThermalZeroDrift);
   report_.zero_points = points_;
   // Thermal when the temperature moved ≥ 1 K and explains ≥ 3/4 of the zero's variation, and
   // at least as much as time does.
@@ -331,36 +382,42 @@ void HealthWatch::UpdateBlock(const HealthInput& in, const WrenchLsb& d) {
 }
 
 void HealthWatch::FinishBlock() {
-  const bool use = !block_moved_;
   const std::int64_t n = block_;
+  BlockResult b;
   for (std::size_t r = 0; r < kAxes; ++r) {
-    std::int64_t a50 = 0, a60 = 0, p50 = 0, p60 = 0;
-    tone50_[r].Finish(&a50, &p50);
-    tone60_[r].Finish(&a60, &p60);
-    if (use) {
-      // The difference's variance less the tones: what is left is broadband noise; for white
-      // noise of σ per sample the difference has 2σ².
-      const std::int64_t var_q8 =
-          (sum_d2_[r] * 256 - (sum_d_[r] * sum_d_[r] * 256) / n) / n - p50 - p60;
-      const std::int64_t sigma_q8 =
-          var_q8 <= 0 ? 0 : ISqrt64(static_cast<std::uint64_t>(var_q8) * 128);
-      if (blocks_seen_ == 0) {
-        a50_q8_[r] = a50;
-        a60_q8_[r] = a60;
-        sigma_q8_[r] = sigma_q8;
-      } else {  // averages over ≈ 8 blocks
-        a50_q8_[r] += (a50 - a50_q8_[r]) / 8;
-        a60_q8_[r] += (a60 - a60_q8_[r]) / 8;
-        sigma_q8_[r] += (sigma_q8 - sigma_q8_[r]) / 8;
-      }
-      if (commission_blocks_ > 0) sigma_ref_sum_q8_[r] += sigma_q8;
-    }
+    std::int64_t p50 = 0, p60 = 0;
+    tone50_[r].Finish(&b.a50[r], &p50);
+    tone60_[r].Finish(&b.a60[r], &p60);
+    // The difference's variance less the tones: what is left is broadband noise; for white
+    // noise of σ per sample the difference has 2σ².
+    const std::int64_t var_q8 =
+        (sum_d2_[r] * 256 - (sum_d_[r] * sum_d_[r] * 256) / n) / n - p50 - p60;
+    b.sigma[r] = var_q8 <= 0 ? 0 : ISqrt64(static_cast<std::uint64_t>(var_q8) * 128);
     sum_d_[r] = 0;
     sum_d2_[r] = 0;
   }
+  const bool use = pending_use_ && !block_moved_;
+  const BlockResult previous = pending_;
+  pending_ = b;
+  pending_use_ = !block_moved_;
   block_pos_ = 0;
   block_moved_ = false;
-  if (!use) return;
+  if (use) TakeBlock(previous);
+}
+
+void HealthWatch::TakeBlock(const BlockResult& b) {
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    if (blocks_seen_ == 0) {
+      a50_q8_[r] = b.a50[r];
+      a60_q8_[r] = b.a60[r];
+      sigma_q8_[r] = b.sigma[r];
+    } else {  // averages over ≈ 8 blocks
+      a50_q8_[r] += (b.a50[r] - a50_q8_[r]) / 8;
+      a60_q8_[r] += (b.a60[r] - a60_q8_[r]) / 8;
+      sigma_q8_[r] += (b.sigma[r] - sigma_q8_[r]) / 8;
+    }
+    if (commission_blocks_ > 0) sigma_ref_sum_q8_[r] += b.sigma[r];
+  }
   ++blocks_seen_;
   if (commission_blocks_ > 0 && --commission_blocks_ == 0) {
     for (std::size_t r = 0; r < kAxes; ++r) {
@@ -368,6 +425,9 @@ void HealthWatch::FinishBlock() {
     }
   }
   if (blocks_seen_ < 8) return;  // the averages need 8 blocks
+  Judged(HealthCause::kMains50);
+  Judged(HealthCause::kMains60);
+  if (commission_blocks_ == 0) Judged(HealthCause::kNoiseFloor);
   bool mains50 = false, mains60 = false, noisy = false;
   std::int64_t worst50 = 0, worst60 = 0, worst_ratio = 0;
   WrenchLsb e50{}, e60{}, en{};
@@ -411,10 +471,13 @@ void HealthWatch::UpdateRinging(const HealthInput& in) {
     return;
   }
   if (!capturing_) {
-    if (refractory_ > 0) return;
+    // Not before a block has measured the tones the trigger allows for.
+    if (refractory_ > 0 || blocks_seen_ == 0) return;
     bool jump = false;
     for (std::size_t r = 0; r < kAxes && !jump; ++r) {
-      jump = Abs(std::int64_t{in.tared[r]} * 256 - fast_q8_[r]) > step_[r] * 256;
+      // Beyond the tracked tones' peaks: a steady tone is no transient.
+      jump = Abs(std::int64_t{in.tared[r]} * 256 - fast_q8_[r]) >
+             step_[r] * 256 + a50_q8_[r] + a60_q8_[r];
     }
     if (!jump) return;
     capturing_ = true;
@@ -468,6 +531,7 @@ void HealthWatch::FinishRinging() {
     return;
   }
   if (ring_measured_ < 3) return;
+  Judged(HealthCause::kResonanceShift);
   const std::int64_t now = Median3(ring_last_mhz_);
   const bool shifted =
       Abs(now - ring_ref_mhz_) * 1000 > std::int64_t{ring_ref_mhz_} * th_.resonance_shift_pm;
@@ -496,7 +560,9 @@ void HealthWatch::UpdateCreep(const HealthInput& in, bool moving) {
       return;
     case CreepPhase::kHold:
       if (moving) {  // the hold ended early: this move is the next one judged
-        for (std::size_t r = 0; r < kAxes; ++r) pre_level_[r] = fast_q8_[r] >> 8;
+        for (std::size_t r = 0; r < kAxes; ++r) {
+          pre_level_[r] = level_sum_[r] / static_cast<std::int64_t>(level_len_);
+        }
         creep_phase_ = CreepPhase::kMoving;
         return;
       }
@@ -514,33 +580,80 @@ void HealthWatch::FinishCreep() {
   const std::int64_t n = seg_len_;
   std::size_t dom = 0;
   std::int64_t best = -1;
-  std::array<std::int64_t, kAxes> step{};
+  std::array<std::int64_t, kAxes> step{}, share{};
+  std::array<std::array<std::int64_t, kAxes>, 3> m{};
   for (std::size_t r = 0; r < kAxes; ++r) {
-    step[r] = seg_sum_[0][r] / n - pre_level_[r];
-    const std::int64_t share = Abs(step[r]) * 10000 / rated_[r];
-    if (share > best) {
-      best = share;
+    for (std::size_t k = 0; k < 3; ++k) m[k][r] = seg_sum_[k][r] / n;
+    step[r] = m[0][r] - pre_level_[r];
+    share[r] = Abs(step[r]) * 10000 / rated_[r];
+    if (share[r] > best) {
+      best = share[r];
       dom = r;
     }
   }
   if (best < kMinStepBp) return;  // too small a load change to judge creep on
+  // The segment means carry noise σ/√n each (n = 20 blocks: 1/√n ≈ 1/(4·√block)); a change
+  // must stand 6 such σ above it.
+  const auto guard = [this](std::size_t r) {
+    return ((6 * sigma_q8_[r] * inv_sqrt_block_q16_) >> 16) / (std::int64_t{4} * 256) + 1;
+  };
+  const std::int64_t d1 = m[1][dom] - m[0][dom];
+  const std::int64_t d2 = m[2][dom] - m[1][dom];
+  const std::int64_t seen = d1 + d2;
+  // A first-order approach keeps the increments' sign and lets them decay (τ below ≈ 40 s); its
+  // creep still to come is extrapolated. Otherwise what was seen is all there is.
+  const bool decays = d1 != 0 && (d1 > 0) == (d2 > 0) && Abs(d2) * 20 < Abs(d1) * 19;
+  const std::int64_t estimate = decays ? CreepRemaining(m[0][dom], m[1][dom], m[2][dom]) : seen;
+  // A still hold without creep: its evidence counts against the findings so far.
+  if (Abs(estimate) * 10000 <= Abs(step[dom]) * th_.creep_limit_bp || Abs(seen) <= guard(dom)) {
+    report_.creep_bp = Sat32(estimate * 10000 / step[dom]);
+    Judged(HealthCause::kCreep);
+    creep_streak_ = 0;
+    SetFinding(HealthCause::kCreep, false, {});
+    return;
+  }
+  // A ramp, or a load change that starts or stops inside the hold, is the load moving: no
+  // verdict either way.
+  if (!decays) return;
+  // The load's own trend: axes that did not step (under a tenth of the main step's share) creep
+  // by a tenth of its creep at most; more there is the load moving (a part re-oriented).
+  const std::int64_t quiet_bp = Abs(seen) * 10000 / rated_[dom] / 2;
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    if (r == dom || share[r] * 10 >= best) continue;
+    const std::int64_t moved = Abs(m[2][r] - m[0][r]);
+    if (moved > guard(r) && moved * 10000 / rated_[r] > quiet_bp) return;
+  }
+  Judged(HealthCause::kCreep);
   WrenchLsb creep{};
   for (std::size_t r = 0; r < kAxes; ++r) {
-    creep[r] = Sat32(CreepRemaining(seg_sum_[0][r] / n, seg_sum_[1][r] / n, seg_sum_[2][r] / n));
+    creep[r] = Sat32(CreepRemaining(m[0][r], m[1][r], m[2][r]));
   }
   report_.creep_bp = Sat32(std::int64_t{creep[dom]} * 10000 / step[dom]);
-  // The segment means carry noise σ/√n each: a creep must also stand 6 such σ above it.
-  // (n = 20 blocks: 1/√n ≈ 1/(4·√block)).
-  const std::int64_t guard =
-      ((6 * sigma_q8_[dom] * inv_sqrt_block_q16_) >> 16) / (std::int64_t{4} * 256) + 1;
-  const bool creeps =
-      Abs(creep[dom]) * 10000 > Abs(step[dom]) * th_.creep_limit_bp && Abs(creep[dom]) > guard;
-  SetFinding(HealthCause::kCreep, creeps, creep);
+  const int sign = (seen > 0) == (step[dom] > 0) ? 1 : -1;
+  const std::int64_t ratio_q16 = d2 * 65536 / d1;  // e^(−2 s/τ), in (0, 0.95)
+  // τ within a factor 2 of the streak's: ln q within a factor 2, i.e. q² ≤ q' and q'² ≤ q.
+  const bool agrees = creep_streak_ > 0 && sign == creep_sign_ &&
+                      ratio_q16 * ratio_q16 <= creep_ratio_q16_ * 65536 &&
+                      creep_ratio_q16_ * creep_ratio_q16_ <= ratio_q16 * 65536;
+  creep_streak_ = agrees ? creep_streak_ + 1 : 1;
+  if (!agrees) {  // the streak's first hold is what the others are compared with
+    creep_sign_ = sign;
+    creep_ratio_q16_ = ratio_q16;
+  }
+  if (creep_streak_ >= kCreepHolds) SetFinding(HealthCause::kCreep, true, creep);
 }
 
 void HealthWatch::Publish(const HealthInput& in) {
   HealthReport& r = report_;
   r.findings = active_;
+  if (samples_ % rate_ == 0) {  // the coverage, once a second: causes judged within the hour
+    const std::uint64_t hour = std::uint64_t{3600} * rate_;
+    std::uint16_t covered = 0;
+    for (std::size_t i = 0; i < kHealthCauses; ++i) {
+      if (judged_at_[i] != 0 && samples_ - judged_at_[i] < hour) covered |= 1u << i;
+    }
+    r.coverage = covered;
+  }
   r.ring_ref_mhz = ring_ref_mhz_;
   r.tare_age_s = static_cast<std::uint32_t>(samples_ / rate_) - tare_sample_;
   // The counts change only when a cycle closes: copy them then, not every sample.

@@ -27,11 +27,13 @@ struct HealthInput {
 /// one slice of kRingSlice samples of a ringing analysis (after a transient capture ends, its six
 /// axes are analysed a slice per sample: 4 samples per axis).
 /// Single-threaded: the sampling thread calls everything.
-/// Members are grouped by watch, not by size: 64 bytes of padding in a 13 KB object.
+/// Members are grouped by watch, not by size: some padding in a 20 KB object.
 class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
  public:
   static constexpr std::size_t kRingCapture = 512;  ///< samples of a transient capture
   static constexpr std::size_t kRingSlice = 128;    ///< capture samples analysed per Step
+  static constexpr std::size_t kLevelRing = 128;    ///< sub-block means of the 0.1 s level
+  static constexpr std::uint32_t kCreepHolds = 3;   ///< still holds that must agree on a creep
 
   /// Rate and rated range per axis (LSB, each > 0). False (the watch stays off) otherwise, or at
   /// a rate below 100 Hz.
@@ -55,13 +57,23 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   enum class CreepPhase : std::uint8_t { kIdle, kMoving, kSettling, kHold };
   __extension__ using Int128 = __int128;
 
-  void ResetFilters() { filters_ready_ = false; }
+  void ResetFilters() {
+    filters_ready_ = false;
+    ResetLevel();
+  }
   void ResetReference(std::int32_t temperature_mdegc, bool has_temperature);
+  [[nodiscard]] bool UpdateLevel(const HealthInput& in);
+  void ResetLevel();
   void UpdateZero(const HealthInput& in, bool stable);
   void AddZeroPoint(const HealthInput& in);
   void JudgeZero(const HealthInput& in);
   void UpdateBlock(const HealthInput& in, const WrenchLsb& d);
+  /// One block's tones and noise per axis, Q8 LSB.
+  struct BlockResult {
+    std::array<std::int64_t, kAxes> a50{}, a60{}, sigma{};
+  };
   void FinishBlock();
+  void TakeBlock(const BlockResult& b);
   void UpdateRinging(const HealthInput& in);
   void StartAxis(std::size_t axis);
   void FinishAxis(std::size_t axis);
@@ -69,6 +81,8 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   void UpdateCreep(const HealthInput& in, bool moving);
   void FinishCreep();
   void SetFinding(HealthCause cause, bool on, const WrenchLsb& error);
+  /// The watch judged `cause` at this sample (its coverage).
+  void Judged(HealthCause cause) { judged_at_[static_cast<std::size_t>(cause) - 1] = samples_; }
   void Publish(const HealthInput& in);
 
   bool configured_ = false;
@@ -85,6 +99,20 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   bool filters_ready_ = false;
   std::array<std::int64_t, kAxes> fast_q8_{}, slow_q8_{};
   WrenchLsb prev_{};
+
+  // The level: the mean over the last 0.1 s (whole periods of 50 and 60 Hz and their harmonics,
+  // so a steady tone leaves nothing in it), kept as a ring of sub-block means. A load change is
+  // judged on it against the previous whole 0.1 s window, never on a single sample.
+  std::uint32_t level_sub_ = 1;     ///< samples per sub-block (block = level_sub_ · level_len_)
+  std::uint32_t level_len_ = 1;     ///< sub-blocks in the ring
+  std::uint32_t level_pos_ = 0;     ///< samples in the current sub-block
+  std::uint32_t level_at_ = 0;      ///< the ring's next slot
+  std::uint32_t level_filled_ = 0;  ///< sub-blocks since the last reset (up to 2 · level_len_)
+  std::array<std::int64_t, kAxes> level_acc_{};  ///< the current sub-block's sum
+  std::array<std::array<std::int32_t, kLevelRing>, kAxes> level_ring_{};
+  std::array<std::int64_t, kAxes> level_sum_{};   ///< Σ of the ring: level × level_len_
+  std::array<std::int64_t, kAxes> level_prev_{};  ///< that sum at the last wrap of the ring
+  bool level_moving_ = true;
 
   // Zero watch: spells, zero points (one per second of a qualified spell), regression.
   std::uint32_t stable_run_ = 0;
@@ -106,7 +134,12 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   std::uint32_t block_ = 0;
   std::uint32_t block_pos_ = 0;
   bool block_moved_ = false;
+  // A block is judged one block late, and only when the next one did not move either: a load
+  // change near a block's end shows in the 0.1 s level only during the next block.
+  BlockResult pending_{};
+  bool pending_use_ = false;
   std::int64_t inv_sqrt_block_q16_ = 0;  ///< 2^16 / sqrt(block)
+  std::int32_t max_diff_ = 0;            ///< first differences are clamped to ± this
   std::array<ToneDetector, kAxes> tone50_{}, tone60_{};
   std::array<std::int64_t, kAxes> sum_d_{}, sum_d2_{};
   std::array<std::int64_t, kAxes> a50_q8_{}, a60_q8_{}, sigma_q8_{};
@@ -137,13 +170,19 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   std::array<std::array<std::int64_t, kAxes>, 3> seg_sum_{};
   std::uint32_t creep_count_ = 0;
   std::uint32_t seg_len_ = 0;
+  // Independent holds that read as creep, in a row, with the same sign (relative to their step)
+  // and time constants within a factor 2 (d2/d1 of the segments: e^(−2 s/τ), Q16).
+  std::uint32_t creep_streak_ = 0;
+  int creep_sign_ = 0;
+  std::int64_t creep_ratio_q16_ = 0;
 
   // Load history: rainflow cycles of the untared load per axis.
   std::array<RainflowCounter, kAxes> rainflow_{};
   bool cycles_changed_ = true;  ///< a count changed since the report last copied them
 
-  // Findings.
+  // Findings, and when each cause was last judged (sample count; 0: never).
   std::uint16_t active_ = 0;
+  std::array<std::uint64_t, kHealthCauses> judged_at_{};
   std::array<WrenchLsb, kHealthCauses> error_{};
   std::uint32_t tare_sample_ = 0;
   std::uint32_t tares_completed_ = 0;

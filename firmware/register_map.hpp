@@ -131,7 +131,7 @@ class RegisterMap {
 
   /// Function 04. 02 when [addr, addr+count) leaves 0 … kInputAddressSpan − 1 (a read may span
   /// the blocks; the sample's registers of one reply come from one sample); reserved 81 … 99,
-  /// 196 … 199 and 207 … 209 read 0.
+  /// 197 … 199 and 207 … 209 read 0.
   [[nodiscard]] ModbusException ReadInput(std::uint16_t addr, std::uint16_t count,
                                           std::uint16_t* out);
   /// Function 03. 02 when any address is outside 0 … 79; reserved 5 … 9, 29, 42 … 49 and 60 … 79

@@ -265,13 +265,13 @@ std::map<std::string, Expected> ReferenceInputValues(
   e["payload_mass_kg"] = {2.375, 2.375 * 6e-8, "float32"};  // the payload CodeCheck loads
   e["payload_crc32"] = {static_cast<double>(0x0BADC0DEu), 0, "uint32"};
   for (int a = 81; a <= 99; ++a) e["reserved_" + std::to_string(a)] = {0, 0, "uint16"};
-  for (int a = 196; a <= 199; ++a) e["reserved_" + std::to_string(a)] = {0, 0, "uint16"};
+  for (int a = 197; a <= 199; ++a) e["reserved_" + std::to_string(a)] = {0, 0, "uint16"};
   // The health watch three samples after start (the fixture has a rated range: it runs): normal,
   // nothing found, nothing measured yet.
   for (const char* tag :
        {"health_state", "health_findings", "retare_suggested", "retare_reason", "finding1_cause",
         "finding2_cause", "finding3_cause", "finding4_cause", "tare_count", "cycles_Fx",
-        "cycles_Fy", "cycles_Fz", "cycles_Mx", "cycles_My", "cycles_Mz"}) {
+        "cycles_Fy", "cycles_Fz", "cycles_Mx", "cycles_My", "cycles_Mz", "health_coverage"}) {
     e[tag] = {0, 0, "uint16"};
   }
   e["health_watch_on"] = {1, 0, "uint16"};

@@ -111,13 +111,21 @@ class MqttTest(unittest.TestCase):
             "Config/Tool Transform/Dz_m": "Float", "Config/Decimation": "UInt16",
             "MQTT/Dropped": "UInt64", "MQTT/Reconnects": "UInt32",
             "Device Control/Tare": "Boolean", "Device Control/Clear Peaks": "Boolean",
-            "Device Control/Commands": "UInt32", "Device Control/Last Result": "String"}
+            "Device Control/Commands": "UInt32", "Device Control/Last Result": "String",
+            "Health/State": "UInt8", "Health/Findings": "UInt16", "Health/Coverage": "UInt16"}
         for name, t in expected_types.items():
             self.assertIn(name, dbirth.metrics, name)
             self.assertEqual(dbirth.type_name(name), t, name)
         self.assertTrue(dbirth.value("Status/Simulated"))
         self.assertEqual(dbirth.value("Status/Bits") & 0x80, 0x80)
         data = [self.host.wait_for(lambda m: m.kind == "DDATA", 10, "DDATA") for _ in range(20)]
+        # The health watch's coverage (input 196) by exception: a held load, no effect — the
+        # tones (bits 2, 3) and the noise (bit 4, after the 5 s commissioning) could be judged.
+        covered = self.host.wait_for(
+            lambda m: m.kind == "DDATA" and "Health/Coverage" in m.metrics
+            and m.value("Health/Coverage") & 0x1C == 0x1C, 15, "Health/Coverage")
+        self.assertEqual(covered.value("Health/Coverage") & 0x1C, 0x1C)
+        self.assertEqual(dbirth.value("Health/Findings"), 0)
         for m in data:
             self.assertEqual(m.topic, DDATA_TOPIC)
             for a in AXES:

@@ -136,6 +136,71 @@ TEST(FtdRealtime, LogTimeIsTheConversionTimeAndSamplesReadLateAreCounted) {
   EXPECT_LE(t.back(), wall_s);
 }
 
+TEST(FtdRealtime, LogTimeUnderSimSpeedIsSimulatedTime) {
+  // --sim-speed 10 for 2 s of wall clock: about 20 s of simulated samples; the log's t is the
+  // simulated time, one period per row (the conversion time is kept in whole µs of the paced
+  // schedule, so each t is within 10 µs — the speed times 1 µs — of k / rate).
+  test::TempDir dir("ftd_rt");
+  const std::string log = dir / "log.csv";
+  test::FtdProcess ftd({"--adc", "sim", "--rate-hz", "1000", "--sim-speed", "10", "--duration-s",
+                        "2", "--log", log, "--modbus-tcp", "127.0.0.1:0"});
+  ASSERT_GT(ftd.port(), 0) << ftd.Stderr();
+  ASSERT_EQ(ftd.Wait(20.0), 0) << ftd.Stderr();
+  ASSERT_EQ(ftd.Stderr().find("log dropped"), std::string::npos) << ftd.Stderr();
+  ReadOptions ro;
+  ro.required = {"t"};
+  const Recording rec = ReadRecording(log, ro);
+  const std::vector<double>& t = rec.Column("t");
+  ASSERT_GE(rec.rows(), 5000u);  // > 2 s of wall clock at 1 kHz: the speed was applied
+  for (std::size_t k = 0; k < rec.rows(); ++k) {
+    ASSERT_NEAR(t[k], t[0] + 0.001 * static_cast<double>(k), 11e-6) << "row " << k;
+  }
+  EXPECT_GT(t.back() - t.front(), 4.0);  // simulated seconds, not the 2 s of wall clock
+}
+
+/// The first `rows` rows of raw counts of an ftd run with `seed` and a zero-drift effect (a
+/// random walk drawn from the seed), at --sim-speed 10 for 1 s of wall clock.
+std::vector<std::vector<double>> SeededRun(const std::string& dir, int seed, std::size_t rows) {
+  const std::string log = dir + "/seed" + std::to_string(seed) + ".csv";
+  test::FtdProcess ftd({"--adc", "sim", "--rate-hz", "1000", "--sim-speed", "10", "--duration-s",
+                        "1", "--seed", std::to_string(seed), "--sim-span-s", "5", "--sim-effect",
+                        "zero_drift:amplitude_mvv=0.01", "--log", log, "--modbus-tcp",
+                        "127.0.0.1:0"});
+  EXPECT_EQ(ftd.Wait(20.0), 0) << ftd.Stderr();
+  ReadOptions ro;
+  ro.required = {"raw0", "raw5"};
+  const Recording rec = ReadRecording(log, ro);
+  std::vector<std::vector<double>> out;
+  for (const char* c : {"raw0", "raw1", "raw2", "raw3", "raw4", "raw5"}) {
+    const std::vector<double>& v = rec.Column(c);
+    out.emplace_back(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(std::min(rows, v.size())));
+  }
+  return out;
+}
+
+TEST(FtdRealtime, SeedFixesNoiseAndEffectsAndDurationStopsTheRun) {
+  // --seed: the same seed gives the same bridge counts, sample for sample (the ADC's noise and
+  // the effect's random walk); another seed does not. --duration-s: exit 0 after that much wall
+  // clock.
+  test::TempDir dir("ftd_seed");
+  const auto t0 = Clock::now();
+  const auto a = SeededRun(dir.path().string(), 5, 3000);
+  const double wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  EXPECT_GE(wall_s, 1.0);
+  EXPECT_LT(wall_s, 15.0);
+  const auto b = SeededRun(dir.path().string(), 5, 3000);
+  const auto c = SeededRun(dir.path().string(), 6, 3000);
+  ASSERT_EQ(a[0].size(), 3000u);
+  ASSERT_EQ(b[0].size(), 3000u);
+  ASSERT_EQ(c[0].size(), 3000u);
+  EXPECT_EQ(a, b);
+  std::size_t differ = 0;
+  for (std::size_t ch = 0; ch < 6; ++ch) {
+    for (std::size_t k = 0; k < 3000; ++k) differ += a[ch][k] != c[ch][k] ? 1 : 0;
+  }
+  EXPECT_GT(differ, 9000u);  // noise of a few counts: most of the 18 000 differ
+}
+
 TEST(FtdRealtime, TenThousandPollsUnderLoadEveryStaleReplyIsALateSampleCounted) {
   // Steady state at 1 kHz with two busy processes on the machine, and a simulated ADC that
   // stalls 10 ms every 1000 samples so that stale replies certainly occur. Every stale reply
