@@ -18,7 +18,7 @@ PACKAGES=(build-essential cmake ninja-build pkg-config ccache
   libeigen3-dev libmodbus-dev libgpiod-dev gpiod
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev libfmt-dev
-  mbpoll socat gnuplot-nox chromium
+  mbpoll socat gnuplot-nox chromium libcpp-httplib-dev
   mosquitto mosquitto-clients libmosquitto-dev libprotobuf-c-dev protobuf-c-compiler
   protobuf-compiler python3-paho-mqtt python3-protobuf python3-numpy openssl
   calculix-ccx gmsh python3-gmsh valgrind)

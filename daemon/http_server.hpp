@@ -1,0 +1,94 @@
+// ftd's web page and JSON API over HTTP(S) (cpp-httplib): reads the register map, writes through it.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "daemon/options.hpp"
+#include "firmware/register_map.hpp"
+
+namespace ftstack::daemon {
+
+/// API version of the JSON paths (/api/v1/...); docs/web.md.
+inline constexpr int kWebApiVersion = 1;
+/// Largest request body accepted (a command or a settings object is far smaller): 413 beyond.
+inline constexpr std::size_t kWebMaxBodyBytes = 4096;
+/// Worker threads of the server: each open stream holds one.
+inline constexpr std::size_t kWebThreads = 24;
+/// Stream rates the API accepts, events per second (default kWebStreamDefaultHz).
+inline constexpr int kWebStreamMaxHz = 50;
+inline constexpr int kWebStreamDefaultHz = 20;
+
+/// One calibration slot as the page names it (from its file; the built-in one has no file).
+struct WebCalLabel {
+  bool present = false;
+  std::string file;  ///< "" for the built-in calibration
+  std::string serial;
+  std::string date;
+};
+
+/// What does not change while ftd runs: rated range, calibration labels, configured rate.
+struct WebStaticInfo {
+  std::array<double, 6> rated{};  ///< N and N·m per axis (all 0: no rating, no overload rule)
+  std::array<WebCalLabel, 2> slots{};
+  unsigned rate_hz = 0;
+  std::string adc;
+};
+
+/// Request counters (any thread).
+struct WebStats {
+  std::uint64_t requests = 0;      ///< requests answered (any status)
+  std::uint64_t errors = 0;        ///< of which 4xx / 5xx
+  std::uint64_t writes = 0;        ///< writes accepted into the register map
+  std::uint32_t streams_open = 0;  ///< live streams now
+};
+
+/// Decodes the whole input table (`in`, kInputAddressSpan registers) and the holding registers
+/// (`hold`, kHoldingRegisterSpan) into the API's state object (docs/web.md): the same numbers a
+/// Modbus master reads, with the status bits, causes and states in words.
+[[nodiscard]] nlohmann::json StateFromRegisters(const std::uint16_t* in, const std::uint16_t* hold,
+                                                const WebStaticInfo& info);
+/// The stream's event: the live part of StateFromRegisters (wrench, status, health).
+[[nodiscard]] nlohmann::json LiveFromRegisters(const std::uint16_t* in);
+
+/// The server. Open() binds (port 0: any free); Run() serves on a pool of worker threads until
+/// `stop`. It never touches the sampling thread: reads copy the published sample through
+/// RegisterMap::ReadInput (the seqlock), writes go through RegisterMap::WriteHolding with
+/// TareSource::kWeb, the path Modbus writes take.
+class HttpServer {
+ public:
+  /// `runtime` gives the live figures the map does not hold (sample rate, clients), as JSON.
+  HttpServer(const FtdOptions& options, fw::RegisterMap* map, WebStaticInfo info,
+             std::function<nlohmann::json()> runtime);
+  ~HttpServer();
+  HttpServer(const HttpServer&) = delete;
+  HttpServer& operator=(const HttpServer&) = delete;
+
+  /// Reads the credentials and certificate, binds; throws FtdError.
+  void Open();
+  void Run(const std::atomic<bool>& stop);
+
+  [[nodiscard]] std::uint16_t port() const { return port_; }
+  [[nodiscard]] bool tls() const { return tls_; }
+  [[nodiscard]] const std::string& host() const { return host_; }
+  [[nodiscard]] WebStats stats() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::string host_;
+  std::uint16_t port_ = 0;
+  bool tls_ = false;
+};
+
+/// True when this ftd was built with the web server, and with HTTPS.
+[[nodiscard]] bool WebServerBuilt();
+[[nodiscard]] bool WebHttpsBuilt();
+
+}  // namespace ftstack::daemon
