@@ -180,8 +180,10 @@ void Ftd::OpenHttp(const fw::DeviceConfig& cfg) {
   http_ = std::make_unique<HttpServer>(opt_, map_.get(), std::move(info),
                                        [this] { return WebRuntime(); });
   http_->Open();
-  std::fprintf(stderr, "ftd: serving the web page on %s://%s:%u/\n", http_->tls() ? "https" : "http",
-               http_->host().c_str(), static_cast<unsigned>(http_->port()));
+  const unsigned port = http_->port();
+  std::fprintf(stderr, "ftd: serving the web page on %s:%u — open %s://%s:%u/\n",
+               http_->host().c_str(), port, http_->tls() ? "https" : "http", http_->host().c_str(),
+               port);
 }
 
 nlohmann::json Ftd::WebRuntime() const {
