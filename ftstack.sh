@@ -41,8 +41,27 @@ deps() {
   $sudo apt-get -o DPkg::Lock::Timeout=600 install -y -q --no-install-recommends "${missing[@]}"
 }
 
+# The web page's browser test (tests/web): puppeteer-core from its lock file, into tests/web only.
+# Node comes from Debian unless one is already installed.
+web_test_deps() {
+  if ! command -v npm >/dev/null 2>&1; then
+    local sudo=""
+    [ "$(id -u)" -ne 0 ] && sudo="sudo"
+    log "installing nodejs and npm for the web page's browser test"
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get -o DPkg::Lock::Timeout=600 install -y -q \
+      --no-install-recommends nodejs npm || { log "no npm: the browser test will be skipped"; return 0; }
+  fi
+  local lock="$ROOT/tests/web/package-lock.json" stamp="$ROOT/tests/web/node_modules/.ftstack-lock"
+  if [ ! -f "$stamp" ] || ! cmp -s "$lock" "$stamp"; then
+    log "installing the browser test's npm packages (tests/web, npm ci)"
+    (cd "$ROOT/tests/web" && npm ci --no-audit --no-fund --loglevel=error) &&
+      cp "$lock" "$stamp" || log "npm ci failed: the browser test will be skipped"
+  fi
+}
+
 build() {
   deps
+  web_test_deps
   if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
     log "configuring $BUILD_DIR"
     cmake -S "$ROOT" -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release -DFTSTACK_WERROR=ON
@@ -82,7 +101,7 @@ mqtt_demo() {
 cmd=${1:-help}
 shift || true
 case "$cmd" in
-  deps) deps ;;
+  deps) deps; web_test_deps ;;
   build) build ;;
   run)
     build

@@ -23,11 +23,22 @@ constexpr const char* kAxes[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
 constexpr const char* kUnits[6] = {"N", "N", "N", "N·m", "N·m", "N·m"};
 
 /// Status bit names (input register 1), bit 0 first; "" for a bit the map does not use.
-constexpr const char* kStatusWords[16] = {
-    "saturated",     "overload", "bridge fault",   "ADC fault",     "calibration invalid",
-    "tare active",   "temperature out of range",   "simulated",     "stale",
-    "late sample",   "axis invalid",               "",              "payload compensated",
-    "",              "",         ""};
+constexpr const char* kStatusWords[16] = {"saturated",
+                                          "overload",
+                                          "bridge fault",
+                                          "ADC fault",
+                                          "calibration invalid",
+                                          "tare active",
+                                          "temperature out of range",
+                                          "simulated",
+                                          "stale",
+                                          "late sample",
+                                          "axis invalid",
+                                          "",
+                                          "payload compensated",
+                                          "",
+                                          "",
+                                          ""};
 
 constexpr const char* kNe107[5] = {"normal", "failure", "check function", "out of specification",
                                    "maintenance required"};
@@ -49,8 +60,7 @@ constexpr CauseText kCauses[fw::kHealthCauses + 1] = {
      "check the cable shield and grounding; raise the low-pass (holding 1)"},
     {"noise_floor", "noise above the commissioning's",
      "check the cable, connectors and excitation supply"},
-    {"resonance_shift", "mount resonance moved",
-     "check the mounting and the tool for loose parts"},
+    {"resonance_shift", "mount resonance moved", "check the mounting and the tool for loose parts"},
     {"creep", "creep in holds", "wait for readings to settle after load changes; re-calibrate"},
     {"overload_shift", "zero jumped across an overload",
      "inspect for damage; re-calibrate before trusting the readings"},
@@ -136,8 +146,9 @@ nlohmann::json StateFromRegisters(const std::uint16_t* in, const std::uint16_t* 
   s["payload"] = {{"mass_kg", FJ(in + fw::kInPayloadMass)},
                   {"crc32", fw::UnpackU32(in + fw::kInPayloadCrc)},
                   {"compensation_on", hold[fw::kHoldGravityComp] != 0},
-                  {"gravity_mps2", {FJ(hold + fw::kHoldGravity), FJ(hold + fw::kHoldGravity + 2),
-                                    FJ(hold + fw::kHoldGravity + 4)}}};
+                  {"gravity_mps2",
+                   {FJ(hold + fw::kHoldGravity), FJ(hold + fw::kHoldGravity + 2),
+                    FJ(hold + fw::kHoldGravity + 4)}}};
   s["tool_transform"] = {{"translation_m", nlohmann::json::array()},
                          {"rotation_deg", nlohmann::json::array()}};
   s["mount_transform"] = {{"translation_m", nlohmann::json::array()},
@@ -335,10 +346,9 @@ struct HttpServer::Impl {
     }
     nlohmann::json slots = nlohmann::json::array();
     for (const WebCalLabel& l : info.slots) {
-      slots.push_back(l.present ? nlohmann::json{{"serial", l.serial},
-                                                 {"date", l.date},
-                                                 {"file", l.file}}
-                                : nlohmann::json(nullptr));
+      slots.push_back(l.present
+                          ? nlohmann::json{{"serial", l.serial}, {"date", l.date}, {"file", l.file}}
+                          : nlohmann::json(nullptr));
     }
     return {{"api_version", kWebApiVersion},
             {"axes", kAxes},
@@ -371,8 +381,7 @@ struct HttpServer::Impl {
       return;
     }
     const nlohmann::json j = nlohmann::json::parse(req.body, nullptr, false);
-    if (j.is_discarded() || !j.is_object() || !j.contains("command") ||
-        !j["command"].is_string()) {
+    if (j.is_discarded() || !j.is_object() || !j.contains("command") || !j["command"].is_string()) {
       SendError(res, 400, "expected a JSON object {\"command\": NAME}");
       return;
     }
@@ -395,9 +404,9 @@ struct HttpServer::Impl {
         return;
       }
     }
-    SendError(res, 400,
-              "unknown command '" + c +
-                  "' (tare, clear_tare, clear_peaks, clear_findings, commission)");
+    SendError(
+        res, 400,
+        "unknown command '" + c + "' (tare, clear_tare, clear_peaks, clear_findings, commission)");
   }
 
   /// Settings: each given key is one register write; all are checked before any is written.
@@ -435,8 +444,8 @@ struct HttpServer::Impl {
         writes_asked.push_back({fw::kHoldCalSlot, {v}});
       } else if (key == "health_thresholds_51_59") {
         const nlohmann::json& x = *it;
-        if (!x.is_array() || x.size() != fw::kHoldHealthLastThreshold -
-                                             fw::kHoldHealthFirstThreshold + 1) {
+        if (!x.is_array() ||
+            x.size() != fw::kHoldHealthLastThreshold - fw::kHoldHealthFirstThreshold + 1) {
           SendError(res, 400, "'health_thresholds_51_59' must be an array of 9 integers");
           return;
         }
@@ -492,8 +501,8 @@ struct HttpServer::Impl {
     const auto period = std::chrono::microseconds(1000000 / hz);
     res.set_chunked_content_provider(
         "text/event-stream",
-        [this, period, next = std::chrono::steady_clock::now()](
-            std::size_t, httplib::DataSink& sink) mutable {
+        [this, period, next = std::chrono::steady_clock::now()](std::size_t,
+                                                                httplib::DataSink& sink) mutable {
           if (stopping.load()) return false;
           std::this_thread::sleep_until(next);
           next += period;
@@ -531,10 +540,10 @@ struct HttpServer::Impl {
     s.set_read_timeout(5, 0);
     s.set_write_timeout(5, 0);
     s.new_task_queue = [] { return new httplib::ThreadPool(kWebThreads); };
-    s.set_default_headers({{"X-Content-Type-Options", "nosniff"},
-                           {"Content-Security-Policy",
-                            "default-src 'self'; style-src 'self' 'unsafe-inline'"},
-                           {"X-Frame-Options", "DENY"}});
+    s.set_default_headers(
+        {{"X-Content-Type-Options", "nosniff"},
+         {"Content-Security-Policy", "default-src 'self'; style-src 'self' 'unsafe-inline'"},
+         {"X-Frame-Options", "DENY"}});
     s.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
       requests.fetch_add(1, std::memory_order_relaxed);
       if (Authorized(req)) return httplib::Server::HandlerResponse::Unhandled;
@@ -547,7 +556,7 @@ struct HttpServer::Impl {
     });
     s.set_error_handler([](const httplib::Request&, httplib::Response& res) {
       if (res.body.empty()) {
-        const std::string m = res.status == 413   ? "request body larger than " +
+        const std::string m = res.status == 413 ? "request body larger than " +
                                                       std::to_string(kWebMaxBodyBytes) + " bytes"
                               : res.status == 404 ? "no such path"
                                                   : "bad request";
@@ -559,12 +568,12 @@ struct HttpServer::Impl {
       s.Get(p, [this](const httplib::Request& q, httplib::Response& r) { Asset(q, r); });
     }
     s.Get("/api/v1", [](const httplib::Request&, httplib::Response& r) {
-      SendJson(r, 200,
-               {{"api_version", kWebApiVersion},
-                {"paths",
-                 {"GET /api/v1/info", "GET /api/v1/state", "GET /api/v1/wrench",
-                  "GET /api/v1/runtime", "GET /api/v1/stream", "POST /api/v1/command",
-                  "POST /api/v1/settings"}}});
+      SendJson(
+          r, 200,
+          {{"api_version", kWebApiVersion},
+           {"paths",
+            {"GET /api/v1/info", "GET /api/v1/state", "GET /api/v1/wrench", "GET /api/v1/runtime",
+             "GET /api/v1/stream", "POST /api/v1/command", "POST /api/v1/settings"}}});
     });
     s.Get("/api/v1/info",
           [this](const httplib::Request&, httplib::Response& r) { SendJson(r, 200, Info()); });
@@ -594,8 +603,8 @@ struct HttpServer::Impl {
       for (const Route& rt : kRoutes) {
         if (q.path == rt.path) {
           r.set_header("Allow", rt.method);
-          return SendError(r, 405, q.method + " not allowed on " + q.path + " (" + rt.method +
-                                       " only)");
+          return SendError(r, 405,
+                           q.method + " not allowed on " + q.path + " (" + rt.method + " only)");
         }
       }
       SendError(r, 404, "no such path");
@@ -633,14 +642,16 @@ void HttpServer::Open() {
   Impl& m = *impl_;
   ParseHostPort(m.opt.http, &host_, &port_);
   if (!m.opt.http_credentials.empty()) {
-    std::tie(m.user, m.password) = ReadCredentialsFile("--http-credentials", m.opt.http_credentials);
+    std::tie(m.user, m.password) =
+        ReadCredentialsFile("--http-credentials", m.opt.http_credentials);
   }
   if (m.opt.http_cert.empty() != m.opt.http_key.empty()) {
     throw FtdError("--http-cert and --http-key go together");
   }
   if (!m.opt.http_cert.empty()) {
 #ifdef CPPHTTPLIB_OPENSSL_SUPPORT
-    auto ssl = std::make_unique<httplib::SSLServer>(m.opt.http_cert.c_str(), m.opt.http_key.c_str());
+    auto ssl =
+        std::make_unique<httplib::SSLServer>(m.opt.http_cert.c_str(), m.opt.http_key.c_str());
     if (!ssl->is_valid()) {
       throw FtdError("--http-cert " + m.opt.http_cert + " / --http-key " + m.opt.http_key +
                      ": not a usable PEM certificate and key");

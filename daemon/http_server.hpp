@@ -1,4 +1,5 @@
-// ftd's web page and JSON API over HTTP(S) (cpp-httplib): reads the register map, writes through it.
+// ftd's web page and JSON API over HTTP(S) (cpp-httplib): reads the register map, writes through
+// it.
 #pragma once
 
 #include <array>

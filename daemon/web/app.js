@@ -110,7 +110,7 @@
     const max = Math.max(1, ...counts.flat());
     const ns = 'http://www.w3.org/2000/svg';
     const svg = document.createElementNS(ns, 'svg');
-    svg.setAttribute('viewBox', `0 0 ${W} ${H}`); svg.setAttribute('width', W); svg.setAttribute('height', H);
+    svg.setAttribute('viewBox', `0 0 ${W} ${H}`); svg.setAttribute('width', '100%');
     const bw = (W - pad) / bins;
     const y = (c) => (H - pad) * (1 - Math.log10(1 + c) / Math.log10(1 + max));
     for (let b = 0; b < bins; ++b) {
@@ -131,7 +131,9 @@
     }
     const cap = document.createElementNS(ns, 'text');
     cap.setAttribute('x', 2); cap.setAttribute('y', 10); cap.setAttribute('font-size', 10);
-    cap.textContent = `full cycles (log scale, max ${max}); bins: range in % of rated; ` + AXES.join(' ');
+    cap.textContent = counts.flat().some((c) => c > 0)
+      ? `full cycles per axis (bars Fx … Mz, log scale, max ${max}); bins: range in % of rated`
+      : 'no full cycle counted yet (bins: range in % of rated)';
     svg.append(cap);
     $('plot-rainflow').replaceChildren(svg);
   }

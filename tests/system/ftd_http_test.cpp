@@ -27,8 +27,8 @@
 namespace ftstack {
 namespace {
 
-constexpr double kForceLsbN = 0.001;     // input registers 18–23 (int32 mN): one LSB
-constexpr double kMomentLsbNm = 0.001;   // the same in mN·m
+constexpr double kForceLsbN = 0.001;    // input registers 18–23 (int32 mN): one LSB
+constexpr double kMomentLsbNm = 0.001;  // the same in mN·m
 
 /// Runs curl; returns the HTTP status and fills `body` (and `headers` when given).
 int Curl(const std::string& args, std::string* body, std::string* headers = nullptr) {
@@ -73,9 +73,9 @@ struct Ftd {
     http = proc.ServedPort("the web page");
   }
   static std::vector<std::string> Args(std::vector<std::string> extra) {
-    std::vector<std::string> a = {"--modbus-tcp",          "127.0.0.1:0", "--http", "127.0.0.1:0",
-                                  "--print-hz",            "0",           "--sim-wrench",
-                                  "10,-4,-50,0.2,0.5,-0.1"};
+    std::vector<std::string> a = {
+        "--modbus-tcp", "127.0.0.1:0", "--http",       "127.0.0.1:0",
+        "--print-hz",   "0",           "--sim-wrench", "10,-4,-50,0.2,0.5,-0.1"};
     a.insert(a.end(), extra.begin(), extra.end());
     return a;
   }
@@ -139,10 +139,11 @@ TEST(FtdHttp, UnknownPathsWrongMethodsAndBadBodiesAreRefusedWithoutDisturbingSam
   EXPECT_EQ(Curl("'" + ftd.Url("/api/v1/stream?rate_hz=1000") + "'", &body), 400);
   // 64 kB body: refused by size before it is parsed.
   std::string out;
-  test::RunShell("head -c 65536 /dev/zero | tr '\\0' x | curl -s -m 10 -o /dev/null -w "
-                 "'%{http_code}' -X POST --data-binary @- " +
-                     ftd.Url("/api/v1/command"),
-                 &out);
+  test::RunShell(
+      "head -c 65536 /dev/zero | tr '\\0' x | curl -s -m 10 -o /dev/null -w "
+      "'%{http_code}' -X POST --data-binary @- " +
+          ftd.Url("/api/v1/command"),
+      &out);
   EXPECT_EQ(out, "413");
   // A request line that is not HTTP: 400 from the library, the connection closed.
   test::RunShell("printf 'GARBAGE\\r\\n\\r\\n' | timeout 5 socat -t 2 - TCP:127.0.0.1:" +
@@ -170,10 +171,10 @@ TEST(FtdHttp, WrongCredentialsGet401RightOnesGetThrough) {
   EXPECT_EQ(Curl("-u operator:wrong " + ftd.Url("/api/v1/state"), &body), 401);
   EXPECT_EQ(Curl("-u operator:s3cret " + ftd.Url("/api/v1/state"), &body), 401);
   EXPECT_EQ(Curl("-u other:s3cret:pw " + ftd.Url("/"), &body), 401);
-  EXPECT_EQ(Curl("-X POST -d '{\"command\":\"tare\"}' -u operator:wrong " +
-                     ftd.Url("/api/v1/command"),
-                 &body),
-            401);
+  EXPECT_EQ(
+      Curl("-X POST -d '{\"command\":\"tare\"}' -u operator:wrong " + ftd.Url("/api/v1/command"),
+           &body),
+      401);
   EXPECT_EQ(Curl("-u operator:s3cret:pw " + ftd.Url("/api/v1/state"), &body), 200);
   EXPECT_EQ(Curl("-u operator:s3cret:pw " + ftd.Url("/"), &body), 200);
   EXPECT_NE(body.find("<title>"), std::string::npos);
