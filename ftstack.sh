@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # ftstack.sh — set-up and entry point: installs missing Debian packages, configures, builds, runs.
-#   ./ftstack.sh run  [ftd options]   simulated sensor daemon, Modbus TCP on 127.0.0.1:1502
+#   ./ftstack.sh run  [ftd options]   simulated sensor daemon, Modbus TCP on 127.0.0.1:1502, page on :8080
 #   ./ftstack.sh test                 the whole test suite
 #   ./ftstack.sh sanitize             every test of compiled code under ASan+UBSan (build-debug/)
 #   ./ftstack.sh mqtt-demo            a local mosquitto and two simulated sensors publishing Sparkplug B
@@ -107,7 +107,8 @@ case "$cmd" in
     build
     log "starting the simulated sensor daemon; poll it with:"
     log "  mbpoll -m tcp -p 1502 -a 1 -t 3:float -B -r 7 -c 6 -1 127.0.0.1   (README: more examples)"
-    exec "$BUILD_DIR/bin/ftd" --adc sim --modbus-tcp 127.0.0.1:1502 "$@"
+    log "or open the web page: http://127.0.0.1:8080/   (docs/web.md)"
+    exec "$BUILD_DIR/bin/ftd" --adc sim --modbus-tcp 127.0.0.1:1502 --http 127.0.0.1:8080 "$@"
     ;;
   test)
     build

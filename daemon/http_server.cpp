@@ -496,8 +496,13 @@ struct HttpServer::Impl {
       }
       hz = static_cast<int>(v);
     }
+    if (streams.fetch_add(1) >= kWebMaxStreams) {
+      streams.fetch_sub(1);
+      SendError(res, 503,
+                "too many streams open (" + std::to_string(kWebMaxStreams) + "); poll instead");
+      return;
+    }
     res.set_header("Cache-Control", "no-store");
-    streams.fetch_add(1, std::memory_order_relaxed);
     const auto period = std::chrono::microseconds(1000000 / hz);
     res.set_chunked_content_provider(
         "text/event-stream",
@@ -536,7 +541,7 @@ struct HttpServer::Impl {
   void Routes() {
     httplib::Server& s = *server;
     s.set_payload_max_length(kWebMaxBodyBytes);
-    s.set_keep_alive_max_count(1000);
+    s.set_keep_alive_max_count(1);
     s.set_read_timeout(5, 0);
     s.set_write_timeout(5, 0);
     s.new_task_queue = [] { return new httplib::ThreadPool(kWebThreads); };

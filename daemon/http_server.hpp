@@ -20,8 +20,11 @@ namespace ftstack::daemon {
 inline constexpr int kWebApiVersion = 1;
 /// Largest request body accepted (a command or a settings object is far smaller): 413 beyond.
 inline constexpr std::size_t kWebMaxBodyBytes = 4096;
-/// Worker threads of the server: each open stream holds one.
-inline constexpr std::size_t kWebThreads = 24;
+/// Worker threads of the server. A stream holds one while open; a request holds one only while
+/// it is answered (connections are not kept alive: an idle browser tab would hold a thread).
+inline constexpr std::size_t kWebThreads = 32;
+/// Streams open at once; one more is 503 (threads stay free for requests).
+inline constexpr std::uint32_t kWebMaxStreams = 16;
 /// Stream rates the API accepts, events per second (default kWebStreamDefaultHz).
 inline constexpr int kWebStreamMaxHz = 50;
 inline constexpr int kWebStreamDefaultHz = 20;
