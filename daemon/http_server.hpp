@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "daemon/options.hpp"
+#include "daemon/web_state.hpp"
 #include "firmware/register_map.hpp"
 
 namespace ftstack::daemon {
@@ -29,22 +30,6 @@ inline constexpr std::uint32_t kWebMaxStreams = 16;
 inline constexpr int kWebStreamMaxHz = 50;
 inline constexpr int kWebStreamDefaultHz = 20;
 
-/// One calibration slot as the page names it (from its file; the built-in one has no file).
-struct WebCalLabel {
-  bool present = false;
-  std::string file;  ///< "" for the built-in calibration
-  std::string serial;
-  std::string date;
-};
-
-/// What does not change while ftd runs: rated range, calibration labels, configured rate.
-struct WebStaticInfo {
-  std::array<double, 6> rated{};  ///< N and N·m per axis (all 0: no rating, no overload rule)
-  std::array<WebCalLabel, 2> slots{};
-  unsigned rate_hz = 0;
-  std::string adc;
-};
-
 /// Request counters (any thread).
 struct WebStats {
   std::uint64_t requests = 0;      ///< requests answered (any status)
@@ -52,14 +37,6 @@ struct WebStats {
   std::uint64_t writes = 0;        ///< writes accepted into the register map
   std::uint32_t streams_open = 0;  ///< live streams now
 };
-
-/// Decodes the whole input table (`in`, kInputAddressSpan registers) and the holding registers
-/// (`hold`, kHoldingRegisterSpan) into the API's state object (docs/web.md): the same numbers a
-/// Modbus master reads, with the status bits, causes and states in words.
-[[nodiscard]] nlohmann::json StateFromRegisters(const std::uint16_t* in, const std::uint16_t* hold,
-                                                const WebStaticInfo& info);
-/// The stream's event: the live part of StateFromRegisters (wrench, status, health).
-[[nodiscard]] nlohmann::json LiveFromRegisters(const std::uint16_t* in);
 
 /// The server. Open() binds (port 0: any free); Run() serves on a pool of worker threads until
 /// `stop`. It never touches the sampling thread: reads copy the published sample through

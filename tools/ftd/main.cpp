@@ -10,6 +10,7 @@
 
 #include "daemon/daemon.hpp"
 #include "tools/common.hpp"
+#include "tools/ftd/http_options.hpp"
 #include "tools/ftd/mqtt_options.hpp"
 #if FTSTACK_FTD_SIMULATOR
 #include "daemon/sim/sim_backend.hpp"
@@ -20,9 +21,6 @@ namespace {
 std::atomic<bool> g_stop{false};
 void OnSignal(int) { g_stop = true; }
 
-}  // namespace
-
-namespace {
 /// The --rdt options (ATI Net F/T RDT server).
 void AddRdtOptions(CLI::App& app, ftstack::daemon::FtdOptions& opt) {
   app.add_option("--rdt", opt.rdt,
@@ -36,28 +34,6 @@ void AddRdtOptions(CLI::App& app, ftstack::daemon::FtdOptions& opt) {
   app.add_option("--rdt-status-mask", opt.rdt_status_mask,
                  "status bits copied into RDT records (default 0xFFFF: all)")
       ->check(CLI::Range(0u, 0xFFFFu));
-}
-
-/// The --http options (the web page and JSON API, docs/web.md).
-void AddHttpOptions(CLI::App& app, ftstack::daemon::FtdOptions& opt) {
-  auto* http = app.add_option(
-      "--http", opt.http,
-      "serve the web page and JSON API on HOST:PORT (e.g. 127.0.0.1:8080; 0: any free port)");
-  app.add_option("--http-credentials", opt.http_credentials,
-                 "file with the page's user name (line 1) and password (line 2): HTTP Basic auth")
-      ->check(CLI::ExistingFile)
-      ->needs(http);
-  auto* cert = app.add_option("--http-cert", opt.http_cert, "PEM certificate: serve HTTPS")
-                   ->check(CLI::ExistingFile)
-                   ->needs(http);
-  auto* key = app.add_option("--http-key", opt.http_key, "the certificate's PEM private key")
-                  ->check(CLI::ExistingFile)
-                  ->needs(http);
-  cert->needs(key);
-  key->needs(cert);
-  app.add_flag("--http-write-protect", opt.http_write_protect,
-               "the page and API only read: every write (tare, settings) is refused")
-      ->needs(http);
 }
 
 /// ftd's exit codes (docs/spec: command lines).
@@ -103,7 +79,7 @@ void AddOptions(CLI::App& app, Args& a) {
                  "serve Modbus TCP on HOST:PORT (port 0: any free)");
   app.add_option("--modbus-rtu", opt.modbus_rtu, "serve Modbus RTU on a serial DEVICE");
   AddRdtOptions(app, opt);
-  AddHttpOptions(app, opt);
+  ftstack::tools::AddHttpOptions(app, opt);
   ftstack::tools::AddMqttOptions(app, opt);
   app.add_option("--baud", opt.baud, "RTU baud rate")->check(CLI::Range(300u, 4000000u));
   app.add_option("--parity", a.parity, "RTU parity N|E|O")->check(CLI::IsMember({"N", "E", "O"}));
