@@ -145,11 +145,14 @@ TEST(FtdHttp, UnknownPathsWrongMethodsAndBadBodiesAreRefusedWithoutDisturbingSam
           ftd.Url("/api/v1/command"),
       &out);
   EXPECT_EQ(out, "413");
-  // A request line that is not HTTP: 400 from the library, the connection closed.
-  test::RunShell("printf 'GARBAGE\\r\\n\\r\\n' | timeout 5 socat -t 2 - TCP:127.0.0.1:" +
-                     std::to_string(ftd.http),
-                 &out);
-  EXPECT_NE(out.find("400"), std::string::npos) << out;
+  // Requests that are not HTTP: refused with 400, or the connection closed without a reply (the
+  // library does either, depending on when it sees the client's half-close); never served.
+  const std::string sock = " | timeout 5 socat -t 2 - TCP:127.0.0.1:" + std::to_string(ftd.http);
+  for (const char* req : {"GARBAGE / HTTP/1.1\\r\\nHost: x\\r\\n\\r\\n", "GARBAGE\\r\\n\\r\\n",
+                          "GET /api/v1/state HTTP/9.9\\r\\n\\r\\n"}) {
+    test::RunShell(std::string("printf '") + req + "'" + sock, &out);
+    EXPECT_TRUE(out.empty() || out.rfind("HTTP/1.1 400", 0) == 0) << req << ": " << out;
+  }
   // Sampling went on, not stale, and the page still answers.
   EXPECT_EQ(Curl(ftd.Url("/api/v1/wrench"), &body), 200);
   std::array<std::uint16_t, 2> status{};
