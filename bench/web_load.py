@@ -61,7 +61,7 @@ def rss_kb(pid):
 class Load:
     """Pollers and streams against one port until stop() ."""
 
-    def __init__(self, port, pollers, streams, stream_hz=20):
+    def __init__(self, port, pollers, streams, stream_hz=10):
         self.port, self.stop_flag = port, threading.Event()
         self.requests = self.errors = self.events = 0
         self.lock = threading.Lock()
@@ -147,7 +147,7 @@ def soak(a):
                 p.wait()
     half = len(rss) // 2
     print(f"soak {a.seconds} s at {a.rate} Hz: {a.pollers} pollers (10 Hz each), {a.streams} "
-          f"streams (20 Hz): {load.requests} requests, {load.events} stream events, "
+          f"streams (10 Hz): {load.requests} requests, {load.events} stream events, "
           f"{load.errors} errors, ftd alive: {alive}")
     print(f"  late samples in the window: loaded ftd {late1[0] - late0[0]}, idle ftd beside it "
           f"{late1[1] - late0[1]}")

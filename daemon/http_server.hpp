@@ -28,7 +28,7 @@ inline constexpr std::size_t kWebThreads = 32;
 inline constexpr std::uint32_t kWebMaxStreams = 16;
 /// Stream rates the API accepts, events per second (default kWebStreamDefaultHz).
 inline constexpr int kWebStreamMaxHz = 50;
-inline constexpr int kWebStreamDefaultHz = 20;
+inline constexpr int kWebStreamDefaultHz = 10;
 
 /// Request counters (any thread).
 struct WebStats {

@@ -215,7 +215,7 @@
       post('api/v1/settings', { filter_length: Number(f.filter_length.value), cal_slot: Number(f.cal_slot.value),
         health_thresholds_51_59: th });
     });
-    const es = new EventSource('api/v1/stream?rate_hz=20');
+    const es = new EventSource('api/v1/stream');
     es.addEventListener('live', (ev) => onLive(JSON.parse(ev.data)));
     es.onopen = () => { $('conn').textContent = 'live'; $('conn').className = 'badge ok'; };
     es.onerror = () => { $('conn').textContent = 'reconnecting…'; $('conn').className = 'badge bad'; };
