@@ -233,5 +233,26 @@ TEST(FtdHttp, TareOverTheApiZeroesAndIsRecordedWithSourceWeb) {
   EXPECT_EQ(j["runtime"]["http"]["writes"], 1);
 }
 
+TEST(FtdHttp, HttpsWithACertificateAndKey) {
+  test::TempDir dir;
+  const std::string cert = (dir.path() / "cert.pem").string();
+  const std::string key = (dir.path() / "key.pem").string();
+  std::string out;
+  ASSERT_EQ(test::RunShell("openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=127.0.0.1 "
+                           "-keyout " +
+                               key + " -out " + cert,
+                           &out),
+            0)
+      << out;
+  Ftd ftd({"--http-cert", cert, "--http-key", key});
+  ASSERT_GT(ftd.http, 0) << ftd.proc.Stderr();
+  EXPECT_NE(ftd.proc.Stderr().find("open https://"), std::string::npos) << ftd.proc.Stderr();
+  const std::string url = "https://127.0.0.1:" + std::to_string(ftd.http) + "/api/v1/info";
+  std::string body;
+  EXPECT_EQ(Curl("--cacert " + cert + " " + url, &body), 200) << body;
+  EXPECT_NE(body.find("\"api_version\":1"), std::string::npos) << body;
+  EXPECT_NE(Curl(ftd.Url("/api/v1/info"), &body), 200);  // plain HTTP is not served
+}
+
 }  // namespace
 }  // namespace ftstack
