@@ -41,6 +41,11 @@ set(ENV{PKG_CONFIG_LIBDIR}
     "${FTSTACK_SYSROOT}/usr/lib/${FTSTACK_TRIPLET}/pkgconfig:${FTSTACK_SYSROOT}/usr/share/pkgconfig")
 set(ENV{PKG_CONFIG_SYSROOT_DIR} "${FTSTACK_SYSROOT}")
 
+# Multiarch headers of the sysroot (e.g. openssl/opensslconf.h, which cpp-httplib's header pulls in):
+# the host compiler searches /usr/include/<triplet> by itself, the cross compiler does not.
+string(APPEND CMAKE_CXX_FLAGS_INIT " -isystem ${FTSTACK_SYSROOT}/usr/include/${FTSTACK_TRIPLET}")
+string(APPEND CMAKE_C_FLAGS_INIT " -isystem ${FTSTACK_SYSROOT}/usr/include/${FTSTACK_TRIPLET}")
+
 # Libraries of the sysroot that other libraries pull in at link time.
 set(_ftstack_libdir "${FTSTACK_SYSROOT}/usr/lib/${FTSTACK_TRIPLET}")
 string(APPEND CMAKE_EXE_LINKER_FLAGS_INIT " -Wl,-rpath-link,${_ftstack_libdir}")
