@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # ftstack.sh — set-up and entry point: installs missing Debian packages, configures, builds, runs.
-#   ./ftstack.sh run  [ftd options]   simulated sensor daemon, Modbus TCP on 127.0.0.1:1502
+#   ./ftstack.sh run  [ftd options]   simulated sensor daemon, Modbus TCP on 127.0.0.1:1502, page on :8080
 #   ./ftstack.sh test                 the whole test suite
 #   ./ftstack.sh sanitize             every test of compiled code under ASan+UBSan (build-debug/)
 #   ./ftstack.sh mqtt-demo            a local mosquitto and two simulated sensors publishing Sparkplug B
@@ -18,7 +18,7 @@ PACKAGES=(build-essential cmake ninja-build pkg-config ccache
   libeigen3-dev libmodbus-dev libgpiod-dev gpiod
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev libfmt-dev
-  mbpoll socat gnuplot-nox chromium
+  mbpoll socat gnuplot-nox chromium libcpp-httplib-dev
   mosquitto mosquitto-clients libmosquitto-dev libprotobuf-c-dev protobuf-c-compiler
   protobuf-compiler python3-paho-mqtt python3-protobuf python3-numpy openssl
   calculix-ccx gmsh python3-gmsh valgrind)
@@ -41,8 +41,27 @@ deps() {
   $sudo apt-get -o DPkg::Lock::Timeout=600 install -y -q --no-install-recommends "${missing[@]}"
 }
 
+# The web page's browser test (tests/web): puppeteer-core from its lock file, into tests/web only.
+# Node comes from Debian unless one is already installed.
+web_test_deps() {
+  if ! command -v npm >/dev/null 2>&1; then
+    local sudo=""
+    [ "$(id -u)" -ne 0 ] && sudo="sudo"
+    log "installing nodejs and npm for the web page's browser test"
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get -o DPkg::Lock::Timeout=600 install -y -q \
+      --no-install-recommends nodejs npm || { log "no npm: the browser test will be skipped"; return 0; }
+  fi
+  local lock="$ROOT/tests/web/package-lock.json" stamp="$ROOT/tests/web/node_modules/.ftstack-lock"
+  if [ ! -f "$stamp" ] || ! cmp -s "$lock" "$stamp"; then
+    log "installing the browser test's npm packages (tests/web, npm ci)"
+    (cd "$ROOT/tests/web" && npm ci --no-audit --no-fund --loglevel=error) &&
+      cp "$lock" "$stamp" || log "npm ci failed: the browser test will be skipped"
+  fi
+}
+
 build() {
   deps
+  web_test_deps
   if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
     log "configuring $BUILD_DIR"
     cmake -S "$ROOT" -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release -DFTSTACK_WERROR=ON
@@ -82,13 +101,14 @@ mqtt_demo() {
 cmd=${1:-help}
 shift || true
 case "$cmd" in
-  deps) deps ;;
+  deps) deps; web_test_deps ;;
   build) build ;;
   run)
     build
     log "starting the simulated sensor daemon; poll it with:"
     log "  mbpoll -m tcp -p 1502 -a 1 -t 3:float -B -r 7 -c 6 -1 127.0.0.1   (README: more examples)"
-    exec "$BUILD_DIR/bin/ftd" --adc sim --modbus-tcp 127.0.0.1:1502 "$@"
+    log "or open the web page: http://127.0.0.1:8080/   (docs/web.md)"
+    exec "$BUILD_DIR/bin/ftd" --adc sim --modbus-tcp 127.0.0.1:1502 --http 127.0.0.1:8080 "$@"
     ;;
   test)
     build

@@ -22,11 +22,13 @@ mirror=${FTSTACK_DEBIAN_MIRROR:-http://deb.debian.org/debian}
 suite=${FTSTACK_DEBIAN_SUITE:-bookworm}
 
 # Target -dev packages and the runtime libraries they link (the tests run these under qemu); ftd's
-# MQTT: libmosquitto (with the libssl3 and libcjson1 it links) and protobuf-c.
+# MQTT: libmosquitto (with the libssl3 and libcjson1 it links) and protobuf-c; ftd's web server:
+# cpp-httplib (its library links OpenSSL, zlib and brotli, whose -dev packages its .pc requires).
 packages=(libmodbus-dev libmodbus5 libgpiod-dev libgpiod2 libgtest-dev libgmock-dev googletest
   libeigen3-dev nlohmann-json3-dev libcli11-dev libfmt-dev libfmt9
   libbenchmark-dev libbenchmark1debian
-  libmosquitto-dev libmosquitto1 libcjson1 libssl3 libprotobuf-c-dev libprotobuf-c1)
+  libmosquitto-dev libmosquitto1 libcjson1 libssl3 libprotobuf-c-dev libprotobuf-c1
+  libcpp-httplib-dev libcpp-httplib0.11 libssl-dev libbrotli-dev libbrotli1 zlib1g-dev zlib1g)
 
 stamp="$dir/.ftstack-sysroot"
 want="$arch ${packages[*]}"

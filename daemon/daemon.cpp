@@ -1,9 +1,13 @@
 #include "daemon/daemon.hpp"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <ctime>
+#include <fstream>
 
+#include "calibration/file/cal_file.hpp"
 #include "daemon/hardware_adc.hpp"
 #include "daemon/realtime.hpp"
 
@@ -27,6 +31,25 @@ void ParseHostPort(const std::string& text, std::string* host, std::uint16_t* po
   }
   *host = text.substr(0, colon);
   *port = static_cast<std::uint16_t>(v);
+}
+
+std::pair<std::string, std::string> ReadCredentialsFile(const std::string& option,
+                                                        const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw FtdError(option + " " + path + ": cannot be read");
+  std::string user, password;
+  std::getline(in, user);
+  std::getline(in, password);
+  for (std::string* s : {&user, &password}) {
+    if (!s->empty() && s->back() == '\r') s->pop_back();
+  }
+  if (user.empty()) throw FtdError(option + " " + path + ":1: no user name");
+  struct stat st {};
+  if (stat(path.c_str(), &st) == 0 && (st.st_mode & (S_IRWXG | S_IRWXO)) != 0) {
+    std::fprintf(stderr, "ftd: warning: %s %s is readable by others (chmod 600)\n", option.c_str(),
+                 path.c_str());
+  }
+  return {user, password};
 }
 
 Ftd::Ftd(FtdOptions options, SimulatorFactory simulator)
@@ -92,6 +115,7 @@ void Ftd::Start() {
     mqtt_->Open();
     map_->SetMqttCounters(&mqtt_->counters());
   }
+  if (!opt_.http.empty()) OpenHttp(cfg);
   if (!opt_.log.empty()) {
     // The paced simulator stamps wall-clock conversion times (n / (rate · speed)): scaled by
     // the speed, the log's t is the simulated time the samples were composed at.
@@ -126,6 +150,70 @@ void Ftd::StartThreads() {
     threads_.emplace_back([this] { mqtt_->Run(stop_); });
     pthread_setname_np(threads_.back().native_handle(), "ftd-mqtt");
   }
+  if (http_) {
+    threads_.emplace_back([this] { http_->Run(stop_); });
+    pthread_setname_np(threads_.back().native_handle(), "ftd-http");
+  }
+}
+
+void Ftd::OpenHttp(const fw::DeviceConfig& cfg) {
+  WebStaticInfo info;
+  for (std::size_t i = 0; i < 6; ++i) {
+    info.rated[i] = static_cast<double>(cfg.rated_lsb[i]) * fw::AxisLsb(i);
+  }
+  const std::string files[2] = {opt_.cal, opt_.cal_b};
+  for (std::size_t k = 0; k < 2; ++k) {
+    WebCalLabel& l = info.slots[k];
+    l.present = cfg.slots[k].present;
+    if (!l.present) continue;
+    l.file = files[k];
+    if (files[k].empty()) {
+      l.serial = "built-in (" + opt_.adc + ")";
+      continue;
+    }
+    try {
+      const cal::CalFile f = cal::LoadCalFile(files[k]);
+      l.serial = f.serial;
+      l.date = f.date;
+    } catch (const std::exception&) {
+      l.serial = "unknown";  // the slot loaded it a moment ago; a file changed since is not fatal
+    }
+  }
+  info.rate_hz = opt_.rate_hz;
+  info.adc = opt_.adc;
+  http_ = std::make_unique<HttpServer>(opt_, map_.get(), std::move(info),
+                                       [this] { return WebRuntime(); });
+  http_->Open();
+  const unsigned port = http_->port();
+  std::fprintf(stderr, "ftd: serving the web page on %s:%u — open %s://%s:%u/\n",
+               http_->host().c_str(), port, http_->tls() ? "https" : "http", http_->host().c_str(),
+               port);
+}
+
+nlohmann::json Ftd::WebRuntime() const {
+  const FtdStats st = stats();
+  nlohmann::json j = {
+      {"sample_rate_hz", st.elapsed_s > 0 ? static_cast<double>(st.samples) / st.elapsed_s : 0.0},
+      {"samples", st.samples},
+      {"late_samples", st.late_samples},
+      {"adc_errors", st.adc_errors},
+      {"uptime_s", st.elapsed_s}};
+  nlohmann::json clients = nlohmann::json::object();
+  if (const fw::ServerCounters* c = servers_.tcp_counters()) {
+    clients["modbus_tcp"] = {{"connections_accepted", c->connections.load()},
+                             {"requests", c->requests.load()},
+                             {"exceptions", c->exceptions.load()}};
+  }
+  if (const RdtServer* r = servers_.rdt()) {
+    const RdtStats rs = r->stats();
+    clients["rdt"] = {{"requests", rs.requests}, {"packets_sent", rs.packets_sent}};
+  }
+  if (mqtt_) {
+    const MqttStats ms = mqtt_->stats();
+    clients["mqtt"] = {{"connected", ms.connected}, {"published", ms.published}};
+  }
+  j["clients"] = clients;
+  return j;
 }
 
 void Ftd::BackOff(std::uint32_t pause_us) {

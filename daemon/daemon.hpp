@@ -14,6 +14,7 @@
 
 #include "daemon/backend.hpp"
 #include "daemon/calibration_set.hpp"
+#include "daemon/http_server.hpp"
 #include "daemon/mqtt_publisher.hpp"
 #include "daemon/options.hpp"
 #include "daemon/sample_log.hpp"
@@ -66,6 +67,8 @@ class Ftd {
   [[nodiscard]] const RdtServer* rdt() const { return servers_.rdt(); }
   /// The Sparkplug B publisher (nullptr without --mqtt).
   [[nodiscard]] const MqttPublisher* mqtt() const { return mqtt_.get(); }
+  /// The web server (nullptr without --http).
+  [[nodiscard]] const HttpServer* http() const { return http_.get(); }
   /// One status line (no newline): sequence, wrench, status bits, sample rate, clients.
   [[nodiscard]] std::string StatusLine() const;
 
@@ -76,6 +79,10 @@ class Ftd {
   void StartThreads();
   void SamplingLoop();
   void BackOff(std::uint32_t pause_us);
+  /// Opens the web server of --http over the map; `cfg` gives the rated range and the slots.
+  void OpenHttp(const fw::DeviceConfig& cfg);
+  /// The live figures the web page shows beside the map: sample rate, clients.
+  [[nodiscard]] nlohmann::json WebRuntime() const;
 
   FtdOptions opt_;
   SimulatorFactory simulator_ = nullptr;
@@ -85,6 +92,7 @@ class Ftd {
   std::unique_ptr<fw::RegisterMap> map_;
   Servers servers_;
   std::unique_ptr<MqttPublisher> mqtt_;
+  std::unique_ptr<HttpServer> http_;
   SampleLog log_;
 
   std::atomic<bool> stop_{false};

@@ -1,7 +1,6 @@
 #include "daemon/mqtt_publisher.hpp"
 
 #include <mosquitto.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -10,7 +9,6 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
-#include <fstream>
 #include <mutex>
 #include <thread>
 
@@ -54,25 +52,6 @@ void CheckId(const char* option, const std::string& id) {
     throw FtdError(std::string(option) + " '" + id +
                    "': a Sparkplug name must be non-empty and contain no '/', '+' or '#'");
   }
-}
-
-/// User name (line 1) and password (line 2) from a file; throws FtdError.
-std::pair<std::string, std::string> ReadCredentials(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw FtdError("--mqtt-credentials " + path + ": cannot be read");
-  std::string user, password;
-  std::getline(in, user);
-  std::getline(in, password);
-  for (std::string* s : {&user, &password}) {
-    if (!s->empty() && s->back() == '\r') s->pop_back();
-  }
-  if (user.empty()) throw FtdError("--mqtt-credentials " + path + ":1: no user name");
-  struct stat st {};
-  if (stat(path.c_str(), &st) == 0 && (st.st_mode & (S_IRWXG | S_IRWXO)) != 0) {
-    std::fprintf(stderr, "ftd: warning: --mqtt-credentials %s is readable by others (chmod 600)\n",
-                 path.c_str());
-  }
-  return {user, password};
 }
 
 }  // namespace
@@ -160,7 +139,7 @@ void MqttPublisher::Open() {
     static_cast<MqttPublisher*>(self)->OnMessage(*m);
   });
   if (!opt_.mqtt_credentials.empty()) {
-    const auto [user, password] = ReadCredentials(opt_.mqtt_credentials);
+    const auto [user, password] = ReadCredentialsFile("--mqtt-credentials", opt_.mqtt_credentials);
     if (mosquitto_username_pw_set(mosq_, user.c_str(), password.c_str()) != MOSQ_ERR_SUCCESS) {
       throw FtdError("--mqtt-credentials: refused by libmosquitto");
     }

@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace ftstack::daemon {
@@ -70,7 +71,18 @@ struct FtdOptions {
   double mqtt_rate_hz = 10;  ///< wrench publications per second (means over each window)
   unsigned mqtt_keepalive_s = 10;
   bool mqtt_write_protect = false;  ///< refuse every command from the broker
+  // The web page and JSON API (daemon/http_server.hpp, docs/web.md).
+  std::string http;                 ///< HOST:PORT of the web server ("" = none)
+  std::string http_credentials;     ///< file: user name on line 1, password on line 2 ("" = open)
+  std::string http_cert;            ///< PEM certificate: serve HTTPS (with http_key)
+  std::string http_key;             ///< its private key
+  bool http_write_protect = false;  ///< refuse every write from the web (page and API)
 };
+
+/// User name (line 1) and password (line 2) from a file, as --mqtt-credentials and
+/// --http-credentials take them; throws FtdError naming `option` and the file.
+[[nodiscard]] std::pair<std::string, std::string> ReadCredentialsFile(const std::string& option,
+                                                                      const std::string& path);
 
 /// Parses "HOST:PORT"; throws FtdError naming the bad part.
 void ParseHostPort(const std::string& text, std::string* host, std::uint16_t* port);

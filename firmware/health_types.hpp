@@ -53,6 +53,7 @@ enum class TareSource : std::uint8_t {
   kModbus = 1,  ///< holding register 0 = 1 (TCP or RTU)
   kRdt = 2,     ///< ATI RDT command 0x0042 "set software bias" (ftd --rdt)
   kMqtt = 3,    ///< the Sparkplug command Device Control/Tare (ftd --mqtt)
+  kWeb = 4,     ///< the web page or its JSON API (ftd --http)
 };
 
 /// One completed tare, as the history keeps it.

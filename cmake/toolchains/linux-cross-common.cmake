@@ -41,10 +41,19 @@ set(ENV{PKG_CONFIG_LIBDIR}
     "${FTSTACK_SYSROOT}/usr/lib/${FTSTACK_TRIPLET}/pkgconfig:${FTSTACK_SYSROOT}/usr/share/pkgconfig")
 set(ENV{PKG_CONFIG_SYSROOT_DIR} "${FTSTACK_SYSROOT}")
 
+# Multiarch headers of the sysroot (e.g. openssl/opensslconf.h, which cpp-httplib's header pulls in):
+# the host compiler searches /usr/include/<triplet> by itself, the cross compiler does not.
+string(APPEND CMAKE_CXX_FLAGS_INIT " -isystem ${FTSTACK_SYSROOT}/usr/include/${FTSTACK_TRIPLET}")
+string(APPEND CMAKE_C_FLAGS_INIT " -isystem ${FTSTACK_SYSROOT}/usr/include/${FTSTACK_TRIPLET}")
+
 # Libraries of the sysroot that other libraries pull in at link time.
 set(_ftstack_libdir "${FTSTACK_SYSROOT}/usr/lib/${FTSTACK_TRIPLET}")
-string(APPEND CMAKE_EXE_LINKER_FLAGS_INIT " -Wl,-rpath-link,${_ftstack_libdir}")
-string(APPEND CMAKE_SHARED_LINKER_FLAGS_INIT " -Wl,-rpath-link,${_ftstack_libdir}")
+# zlib (which cpp-httplib's library links) sits in /lib/<triplet>, not /usr/lib/<triplet>.
+set(_ftstack_rootlibdir "${FTSTACK_SYSROOT}/lib/${FTSTACK_TRIPLET}")
+string(APPEND CMAKE_EXE_LINKER_FLAGS_INIT
+       " -Wl,-rpath-link,${_ftstack_libdir} -Wl,-rpath-link,${_ftstack_rootlibdir}")
+string(APPEND CMAKE_SHARED_LINKER_FLAGS_INIT
+       " -Wl,-rpath-link,${_ftstack_libdir} -Wl,-rpath-link,${_ftstack_rootlibdir}")
 
 # Run target programs (tests, gtest discovery) through qemu-user. -L gives the cross C library;
 # LD_LIBRARY_PATH keeps the loader on that one C library (a mixed one makes threads spin forever).

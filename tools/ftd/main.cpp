@@ -10,6 +10,7 @@
 
 #include "daemon/daemon.hpp"
 #include "tools/common.hpp"
+#include "tools/ftd/http_options.hpp"
 #include "tools/ftd/mqtt_options.hpp"
 #if FTSTACK_FTD_SIMULATOR
 #include "daemon/sim/sim_backend.hpp"
@@ -20,9 +21,6 @@ namespace {
 std::atomic<bool> g_stop{false};
 void OnSignal(int) { g_stop = true; }
 
-}  // namespace
-
-namespace {
 /// The --rdt options (ATI Net F/T RDT server).
 void AddRdtOptions(CLI::App& app, ftstack::daemon::FtdOptions& opt) {
   app.add_option("--rdt", opt.rdt,
@@ -81,6 +79,7 @@ void AddOptions(CLI::App& app, Args& a) {
                  "serve Modbus TCP on HOST:PORT (port 0: any free)");
   app.add_option("--modbus-rtu", opt.modbus_rtu, "serve Modbus RTU on a serial DEVICE");
   AddRdtOptions(app, opt);
+  ftstack::tools::AddHttpOptions(app, opt);
   ftstack::tools::AddMqttOptions(app, opt);
   app.add_option("--baud", opt.baud, "RTU baud rate")->check(CLI::Range(300u, 4000000u));
   app.add_option("--parity", a.parity, "RTU parity N|E|O")->check(CLI::IsMember({"N", "E", "O"}));
