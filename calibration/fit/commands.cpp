@@ -111,7 +111,7 @@ ApplyOutcome ApplyToFile(const std::string& cal_path, const std::string& in_path
   ReadOptions opt;
   opt.require_bridges = true;
   Recording in = ReadRecording(in_path, opt);
-  res.log += PrepareApplyInput(&in, units, cal) + "\n";
+  res.log += PrepareApplyInput(&in, units, cal, cal_path) + "\n";
   const Recording out = ApplyCalibration(cal, in);
   WriteRecording(out_path, out);
   res.log += "wrote " + std::to_string(in.rows()) + " rows to " + out_path + "\n";
@@ -203,7 +203,7 @@ CheckResult RunCheck(const CheckRequest& req, std::string* text) {
   ReadOptions opt;
   opt.require_bridges = true;
   Recording rec = ReadRecording(req.in_path, opt);
-  const std::string used = PrepareApplyInput(&rec, req.units, cal);
+  const std::string used = PrepareApplyInput(&rec, req.units, cal, req.cal_path);
   const CheckResult r = CheckCalibration(CheckPosesFromRecording(cal, rec), tool, cal.uncertainty);
   *text = used + "\n" + CheckSummary(r, tool);
   return r;

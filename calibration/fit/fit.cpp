@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <stdexcept>
@@ -231,6 +233,17 @@ Solved SolveWithoutFold(const Layout& layout, const Folds& folds, const std::vec
   return s;
 }
 
+/// Each fold's share of the score: Σ over axes of SSE / (rows · rated²) / 6.
+double FoldShare(const Eigen::Matrix<double, 6, 1>& sse, const std::array<double, 6>& rated,
+                 std::size_t rows) {
+  double share = 0.0;
+  for (std::size_t a = 0; a < 6; ++a) {
+    share +=
+        sse(static_cast<Eigen::Index>(a)) / static_cast<double>(rows) / std::pow(rated[a], 2) / 6.0;
+  }
+  return share;
+}
+
 /// Cross-validates every candidate model and ridge strength into res->candidates.
 void CrossValidate(const Layout& layout, const Folds& folds, const std::vector<ModelKind>& models,
                    const FitOptions& options, std::size_t rows, FitResult* res) {
@@ -238,41 +251,31 @@ void CrossValidate(const Layout& layout, const Folds& folds, const std::vector<M
     const std::vector<int> cols = layout.Columns(kind);
     if (cols.size() * 2 > rows) continue;  // not enough rows for this model
     for (double lambda : options.lambdas) {
+      CandidateScore c;
       Eigen::Matrix<double, 6, 1> sse = Eigen::Matrix<double, 6, 1>::Zero();
       for (int k = 0; k < folds.k; ++k) {
         const Solved s = SolveWithoutFold(layout, folds, cols, kind, lambda, k);
-        sse += HeldOutSse(folds.stats[static_cast<std::size_t>(k)], cols, s.beta);
+        const Eigen::Matrix<double, 6, 1> fold_sse =
+            HeldOutSse(folds.stats[static_cast<std::size_t>(k)], cols, s.beta);
+        c.fold_score.push_back(FoldShare(fold_sse, res->rated, rows));
+        sse += fold_sse;
       }
-      CandidateScore c;
       c.kind = kind;
       c.lambda = lambda;
       c.features = static_cast<int>(cols.size());
-      c.score = 0.0;
+      c.score = FoldShare(sse, res->rated, rows);
       for (std::size_t a = 0; a < 6; ++a) {
         c.rms_si[a] = std::sqrt(sse(static_cast<Eigen::Index>(a)) / static_cast<double>(rows));
-        c.score += std::pow(c.rms_si[a] / res->rated[a], 2) / 6.0;
       }
       if (std::isfinite(c.score)) res->candidates.push_back(c);
     }
   }
 }
 
-/// The best; then the simplest candidate within the tolerance of it.
-const CandidateScore& ChooseCandidate(const std::vector<CandidateScore>& candidates,
-                                      double simpler_tolerance) {
-  const auto best = std::min_element(
-      candidates.begin(), candidates.end(),
-      [](const CandidateScore& a, const CandidateScore& b) { return a.score < b.score; });
-  const double limit = best->score * (1.0 + simpler_tolerance);
-  int fewest = best->features;
-  for (const CandidateScore& c : candidates) {
-    if (c.score <= limit) fewest = std::min(fewest, c.features);
-  }
-  const CandidateScore* chosen = nullptr;
-  for (const CandidateScore& c : candidates) {
-    if (c.features == fewest && (chosen == nullptr || c.score < chosen->score)) chosen = &c;
-  }
-  return *chosen;
+std::string Name(const CandidateScore& c) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%s lambda=%g", ToString(c.kind), c.lambda);
+  return buf;
 }
 
 /// Held-out residuals of the chosen model, row by row, and their 95th percentile per axis.
@@ -368,21 +371,21 @@ std::vector<double> SuspectWeights(const RigData& d, const std::vector<BlockScor
   return weight;
 }
 
-/// The cross-validated score (as CandidateScore::score) of the chosen model trained on the
-/// weighted folds and tested on the unweighted held-out rows.
-double WeightedScore(const Layout& layout, const Folds& folds, const Folds& weighted,
-                     const std::vector<int>& cols, const FitResult& res, std::size_t rows) {
-  Eigen::Matrix<double, 6, 1> sse = Eigen::Matrix<double, 6, 1>::Zero();
+/// The chosen model trained on the weighted folds and tested on the unweighted held-out rows,
+/// scored as a candidate (with its per-fold shares).
+CandidateScore WeightedScore(const Layout& layout, const Folds& folds, const Folds& weighted,
+                             const std::vector<int>& cols, const FitResult& res, std::size_t rows) {
+  CandidateScore c;
+  c.kind = res.kind;
+  c.lambda = res.lambda;
+  c.features = static_cast<int>(cols.size());
   for (int k = 0; k < folds.k; ++k) {
     const Solved s = SolveWithoutFold(layout, weighted, cols, res.kind, res.lambda, k);
-    sse += HeldOutSse(folds.stats[static_cast<std::size_t>(k)], cols, s.beta);
+    c.fold_score.push_back(FoldShare(
+        HeldOutSse(folds.stats[static_cast<std::size_t>(k)], cols, s.beta), res.rated, rows));
+    c.score += c.fold_score.back();
   }
-  double score = 0.0;
-  for (std::size_t a = 0; a < 6; ++a) {
-    score += sse(static_cast<Eigen::Index>(a)) / static_cast<double>(rows) /
-             std::pow(res.rated[a], 2) / 6.0;
-  }
-  return score;
+  return c;
 }
 
 /// Training residual σ, the parameter part of the uncertainty and the design's condition number.
@@ -456,6 +459,79 @@ void ToCalibration(const Layout& layout, const Folds& folds, const Reference& re
 
 }  // namespace
 
+ChoiceMargin CompareCandidates(const CandidateScore& simpler, const CandidateScore& complex) {
+  ChoiceMargin m;
+  m.simpler = Name(simpler);
+  m.complex = Name(complex);
+  m.simpler_score = simpler.score;
+  const std::size_t k = std::min(simpler.fold_score.size(), complex.fold_score.size());
+  std::vector<double> d(k);
+  for (std::size_t i = 0; i < k; ++i) d[i] = simpler.fold_score[i] - complex.fold_score[i];
+  m.margin = std::accumulate(d.begin(), d.end(), 0.0);
+  if (k >= 2) {
+    const double mean = m.margin / static_cast<double>(k);
+    double ss = 0.0;
+    for (const double x : d) ss += (x - mean) * (x - mean);
+    m.se = std::sqrt(static_cast<double>(k) * ss / static_cast<double>(k - 1));
+  } else {
+    m.se = std::numeric_limits<double>::infinity();  // one fold: no estimate of the spread
+  }
+  return m;
+}
+
+bool SimplerThan(const CandidateScore& a, const CandidateScore& b) {
+  return a.features != b.features ? a.features < b.features : a.lambda < b.lambda;
+}
+
+std::size_t ChooseOneStandardError(const std::vector<CandidateScore>& candidates,
+                                   ChoiceMargin* over_simplest, ChoiceMargin* challenger) {
+  if (candidates.empty()) throw std::invalid_argument("no candidate model to choose from");
+  // Ranks: candidates of equal complexity (same coefficients and λ, different families) share
+  // one; the best-scoring of a rank stands for it.
+  std::vector<std::size_t> order(candidates.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+    return SimplerThan(candidates[x], candidates[y]);
+  });
+  std::vector<std::size_t> reps;  // best of each rank, simplest rank first
+  for (std::size_t i : order) {
+    if (!reps.empty() && !SimplerThan(candidates[reps.back()], candidates[i])) {
+      if (candidates[i].score < candidates[reps.back()].score) reps.back() = i;
+    } else {
+      reps.push_back(i);
+    }
+  }
+  std::size_t chosen = reps.back();
+  for (const std::size_t r : reps) {
+    bool beaten = false;
+    for (const CandidateScore& c : candidates) {
+      if (SimplerThan(candidates[r], c) && CompareCandidates(candidates[r], c).Significant()) {
+        beaten = true;
+        break;
+      }
+    }
+    if (!beaten) {
+      chosen = r;
+      break;
+    }
+  }
+  *over_simplest = ChoiceMargin{};
+  if (reps.front() != chosen)
+    *over_simplest = CompareCandidates(candidates[reps.front()], candidates[chosen]);
+  *challenger = ChoiceMargin{};
+  double closest = -std::numeric_limits<double>::infinity();
+  for (const CandidateScore& c : candidates) {
+    if (!SimplerThan(candidates[chosen], c)) continue;
+    const ChoiceMargin m = CompareCandidates(candidates[chosen], c);
+    const double z = m.se > 0 ? m.margin / m.se : (m.margin > 0 ? 1e300 : -1e300);
+    if (z > closest) {
+      closest = z;
+      *challenger = m;
+    }
+  }
+  return chosen;
+}
+
 FitResult FitCalibration(const RigData& d, const FitOptions& options) {
   const auto rows = static_cast<std::size_t>(d.bridges.rows());
   const int n = static_cast<int>(d.bridges.cols());
@@ -492,7 +568,8 @@ FitResult FitCalibration(const RigData& d, const FitOptions& options) {
 
   CrossValidate(layout, folds, models, options, rows, &res);
   if (res.candidates.empty()) throw std::invalid_argument(d.path + ": too few rows for any model");
-  const CandidateScore& chosen = ChooseCandidate(res.candidates, options.simpler_tolerance);
+  const CandidateScore chosen =
+      res.candidates[ChooseOneStandardError(res.candidates, &res.over_simplest, &res.challenger)];
   res.kind = chosen.kind;
   res.lambda = chosen.lambda;
   res.lambda_at_bound =
@@ -512,9 +589,12 @@ FitResult FitCalibration(const RigData& d, const FitOptions& options) {
     weighted.mu_y = folds.mu_y;
     AccumulateFolds(builder, layout.total, rows, &weighted, &weight);
     weighted.scale = folds.scale;
+    const CandidateScore robust = WeightedScore(layout, folds, weighted, cols, res, rows);
+    res.robust_margin = CompareCandidates(chosen, robust);
+    res.robust_margin.complex += " down-weighted";
     res.plain_score = chosen.score;
-    res.robust_score = WeightedScore(layout, folds, weighted, cols, res, rows);
-    res.robust = res.robust_score < res.plain_score;
+    res.robust_score = robust.score;
+    res.robust = res.robust_margin.Significant();
     if (res.robust) {
       HeldOutResiduals(builder, layout, folds, weighted, cols, rows, &res);
       for (std::size_t a = 0; a < 6; ++a) {

@@ -94,9 +94,6 @@ struct FitOptions {
   /// three), or whole blocks (holds).
   bool by_group = true;
   std::array<double, 6> rated{};  ///< rated range per axis; 0 → the largest |load| in the data
-  /// The model with the fewest coefficients whose score is within this fraction of the best one
-  /// wins (with its own best λ): a simpler model is preferred when it generalises as well.
-  double simpler_tolerance = 0.01;
 };
 
 /// Cross-validated score of one (model, λ) candidate.
@@ -106,7 +103,42 @@ struct CandidateScore {
   int features = 0;                ///< coefficients per axis (incl. intercept)
   double score = 0.0;              ///< mean over axes of (held-out RMS / rated)²
   std::array<double, 6> rms_si{};  ///< held-out RMS per axis, N and N·m
+  /// Each fold's share of `score` (its rows' squared errors over all rows): they sum to score,
+  /// and two candidates' shares, fold by fold, are the paired differences of the choice.
+  std::vector<double> fold_score;
 };
+
+/// One comparison of the choice: how much lower the more complex candidate's score is than the
+/// simpler one's (margin = Σ over folds of the paired differences) and the standard error of
+/// that sum (√K × the sample standard deviation of the K per-fold differences).
+struct ChoiceMargin {
+  std::string simpler;  ///< "linear lambda=0"
+  std::string complex;
+  double simpler_score = 0.0;
+  double margin = 0.0;  ///< simpler score − complex score (> 0: the complex one validated better)
+  double se = 0.0;
+  /// Taken when margin > se: better by more than one standard error of the comparison.
+  [[nodiscard]] bool Significant() const { return margin > se; }
+};
+
+/// The paired comparison of two candidates' per-fold scores (equal fold counts).
+[[nodiscard]] ChoiceMargin CompareCandidates(const CandidateScore& simpler,
+                                             const CandidateScore& complex);
+
+/// Whether `a` is simpler than `b`: fewer coefficients, then a smaller ridge λ (each step away
+/// from plain least squares is one more thing chosen on the data). Neither is simpler than the
+/// other when both agree (two families of equal size): they are alternatives of one rank.
+[[nodiscard]] bool SimplerThan(const CandidateScore& a, const CandidateScore& b);
+
+/// The one-standard-error choice (docs/calibration.md): going through the ranks from the
+/// simplest, the best-scoring candidate of a rank is taken unless some more complex candidate
+/// beats it by more than one standard error of their paired per-fold differences. Returns its
+/// index; *over_simplest (chosen against the best candidate of the simplest rank, when they
+/// differ) and *challenger (the more complex candidate closest to being taken, in margin / SE;
+/// empty `complex` when there is none) say why.
+[[nodiscard]] std::size_t ChooseOneStandardError(const std::vector<CandidateScore>& candidates,
+                                                 ChoiceMargin* over_simplest,
+                                                 ChoiceMargin* challenger);
 
 /// Held-out error of one block (or validation group) under the chosen model.
 struct BlockScore {
@@ -136,15 +168,19 @@ struct FitResult {
   double load_condition = 0.0;    ///< condition number of [1, wrench/rated] over the rows
   double design_condition = 0.0;  ///< condition number of the chosen model's standardised design
   std::vector<CandidateScore> candidates;
+  ChoiceMargin over_simplest;  ///< the chosen against the simplest (empty when it is the simplest)
+  ChoiceMargin challenger;     ///< the strongest more complex candidate not taken (may be empty)
   Eigen::MatrixXd heldout_residual;  ///< rows × 6: prediction − reference, held-out
   std::vector<BlockScore> blocks;    ///< worst first
   std::vector<BlockScore> groups;    ///< held-out error per validation group, worst first
   /// Blocks whose held-out error is an outlier (over 3.5 robust σ above the median block):
   /// reported, and down-weighted in the robust variant.
   std::vector<int> suspect_blocks;
-  bool robust = false;        ///< the robust variant validated better and was used
-  double plain_score = 0.0;   ///< cross-validated score without / with the down-weighting
-  double robust_score = 0.0;  ///< (0 when no block is suspect)
+  /// The robust variant beat the plain fit by more than one standard error and was used.
+  bool robust = false;
+  ChoiceMargin robust_margin;  ///< plain (simpler) against down-weighted (when a block is suspect)
+  double plain_score = 0.0;    ///< cross-validated score without / with the down-weighting
+  double robust_score = 0.0;   ///< (0 when no block is suspect)
 };
 
 /// Fits and cross-validates. Throws std::invalid_argument when the data cannot support a fit

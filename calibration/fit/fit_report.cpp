@@ -160,7 +160,43 @@ std::string Legend() {
   return o.str();
 }
 
+nlohmann::json MarginJson(const ChoiceMargin& m) {
+  if (m.complex.empty()) return nullptr;
+  return {{"simpler", m.simpler},
+          {"complex", m.complex},
+          {"margin", m.margin},
+          {"se", m.se},
+          {"simpler_score", m.simpler_score}};
+}
+
+/// "lower by 4.3 % of 1.2e-05 ± 7.1 % (0.61 SE)": a margin relative to the simpler score.
+std::string MarginText(const ChoiceMargin& m) {
+  const double rel = m.simpler_score > 0 ? m.margin / m.simpler_score * 100 : 0.0;
+  const double rel_se = m.simpler_score > 0 ? m.se / m.simpler_score * 100 : 0.0;
+  char buf[160];
+  std::snprintf(buf, sizeof buf,
+                "score lower by %.3g %% +- %.3g %% (margin %.3g, SE %.3g, %.2f SE)", rel, rel_se,
+                m.margin, m.se, m.se > 0 ? m.margin / m.se : 0.0);
+  return buf;
+}
+
 }  // namespace
+
+std::string ChoiceLine(const FitResult& fit) {
+  std::string s = "choice (one-standard-error rule, paired over " + std::to_string(fit.folds) +
+                  " folds): " + ToString(fit.kind) + " lambda=" + Fmt("%g", fit.lambda);
+  if (fit.over_simplest.complex.empty()) {
+    s += ", the simplest candidate";
+  } else {
+    s += " over " + fit.over_simplest.simpler + ": " + MarginText(fit.over_simplest);
+  }
+  s += "\n";
+  if (!fit.challenger.complex.empty()) {
+    s += "  closest not taken: " + fit.challenger.complex + ": " + MarginText(fit.challenger) +
+         " (needs > 1 SE)\n";
+  }
+  return s;
+}
 
 CalFile CalFileFromFit(const FitResult& fit, const hal::AdcInfo& adc, const std::string& serial,
                        const std::string& date) {
@@ -182,6 +218,10 @@ CalFile CalFileFromFit(const FitResult& fit, const hal::AdcInfo& adc, const std:
                     {"validation", fit.validation},
                     {"suspect_blocks", fit.suspect_blocks},
                     {"robust", fit.robust},
+                    {"choice_rule", "one standard error of paired per-fold differences"},
+                    {"choice_over_simplest", MarginJson(fit.over_simplest)},
+                    {"choice_challenger", MarginJson(fit.challenger)},
+                    {"robust_margin", MarginJson(fit.robust_margin)},
                     {"lambda_at_bound", fit.lambda_at_bound},
                     {"worst_group", fit.groups.empty() ? -1 : fit.groups.front().block},
                     {"worst_group_rms_pct", fit.groups.empty() ? 0.0 : fit.groups.front().rms_pct},
@@ -198,6 +238,7 @@ std::string FitSummary(const FitResult& fit, const fw::LoadReport& fixed) {
   o << "model: " << ToString(fit.kind) << ", ridge lambda " << Fmt("%g", fit.lambda)
     << " (chosen by " << fit.folds << "-fold cross-validation holding out whole " << fit.validation
     << ", " << fit.rows << " rows)\n";
+  o << ChoiceLine(fit);
   if (fit.lambda_at_bound)
     o << "warning: lambda is the largest tried; the penalty is not resolved by the data\n";
   o << "condition number: load set " << Fmt("%.3g", fit.load_condition) << ", design "
@@ -228,8 +269,8 @@ std::string FitSummary(const FitResult& fit, const fw::LoadReport& fixed) {
   if (!fit.suspect_blocks.empty()) {
     o << "suspect blocks (held-out error an outlier: recorded badly?):";
     for (const int b : fit.suspect_blocks) o << " #" << b;
-    o << "; down-weighted fit " << (fit.robust ? "used" : "not used") << " (score "
-      << Fmt("%.4g", fit.robust_score) << " against " << Fmt("%.4g", fit.plain_score) << ")\n";
+    o << "; down-weighted fit " << (fit.robust ? "used" : "not used") << ": "
+      << MarginText(fit.robust_margin) << "\n";
   }
   o << "worst blocks (RMS % of rated):";
   for (std::size_t i = 0; i < std::min<std::size_t>(5, fit.blocks.size()); ++i) {

@@ -39,6 +39,36 @@ void CheckRails(const Recording& rec, std::size_t channels, const hal::AdcInfo& 
   CheckBridgeRange(rec, channels, r, 0.5 * units_per_count / std::fabs(map.scale));
 }
 
+/// Where a recording's unit was declared: "--converter/--bridge-unit" or FILE:LINE of the first
+/// unit metadata line (metadata lines open the file, one a line).
+std::string DeclarationPlace(const Recording& rec, const UnitOverrides& cli) {
+  if (!cli.unit.empty() || !cli.converter.empty()) return "--bridge-unit/--converter";
+  for (std::size_t i = 0; i < rec.metadata.size(); ++i) {
+    const std::string& m = rec.metadata[i];
+    for (const char* key : {"bridge_unit:", "converter:", "excitation_v:"}) {
+      if (m.rfind(key, 0) == 0) return rec.path + ":" + std::to_string(i + 1);
+    }
+  }
+  return rec.path;
+}
+
+/// Refuses (FILE:LINE:COLUMN) a code that is not a whole number: not a count of any converter.
+void CheckWholeCodes(const Recording& rec, std::size_t channels, const Converter& c) {
+  for (std::size_t ch = 0; ch < channels; ++ch) {
+    const std::string name = "b" + std::to_string(ch);
+    const std::vector<double>& col = rec.Column(name);
+    for (std::size_t i = 0; i < col.size(); ++i) {
+      if (col[i] == std::nearbyint(col[i])) continue;
+      const std::size_t line = i < rec.data_lines.size() ? rec.data_lines[i] : i + 2;
+      throw RecordingError(
+          rec.path + ":" + std::to_string(line) + ":" +
+          std::to_string(FieldColumn(rec, line, static_cast<std::size_t>(rec.Find(name)))) + ": " +
+          name + " = " + Num(col[i]) + " is not a whole code of the " + std::to_string(c.bits) +
+          "-bit " + ToString(c.coding) + " converter: not counts");
+    }
+  }
+}
+
 void ApplyMap(Recording* rec, std::size_t channels, const Affine& map) {
   if (map.scale == 1.0 && map.zero == 0.0) return;
   for (std::size_t c = 0; c < channels; ++c) {
@@ -90,8 +120,9 @@ FitInput PrepareFitInput(Recording* rec, const UnitOverrides& cli, const hal::Ad
   return in;
 }
 
-std::string PrepareApplyInput(Recording* rec, const UnitOverrides& cli, const CalFile& cal) {
-  const InputUnit u = ResolveInputUnit(*rec, cli);
+std::string PrepareApplyInput(Recording* rec, const UnitOverrides& cli, const CalFile& cal,
+                              const std::string& cal_path) {
+  const InputUnit u = UnitForCalibration(*rec, cli, cal, cal_path);
   // Too few bridge columns: ApplyCalibration says so.
   const std::size_t n = std::min<std::size_t>(cal.cal.channel_count, rec->BridgeCount());
   Affine map;
@@ -126,6 +157,7 @@ std::string PrepareApplyInput(Recording* rec, const UnitOverrides& cli, const Ca
   } else {
     refuse("unknown calibration input unit");
   }
+  if (u.unit == BridgeUnit::kCounts) CheckWholeCodes(*rec, n, u.converter);
   const double per_count = 1.0 / fw::CountsPerMvv(cal.adc);
   CheckRails(*rec, n, cal.adc, per_count, map, ToString(u.unit),
              "the range of the calibration's converter (" + std::to_string(cal.adc.min_counts) +
@@ -134,12 +166,52 @@ std::string PrepareApplyInput(Recording* rec, const UnitOverrides& cli, const Ca
   return Describe(u) + "; applied in " + cu;
 }
 
+InputUnit UnitForCalibration(const Recording& rec, const UnitOverrides& cli, const CalFile& cal,
+                             const std::string& cal_path) {
+  InputUnit u = ResolveInputUnit(rec, cli);
+  const std::string fitted_unit = cal.extra.value("recording_unit", std::string());
+  if (fitted_unit.empty()) return u;  // a file that does not say: the recording's own (or default)
+  InputUnit fitted;
+  try {
+    fitted.unit = ParseBridgeUnit(fitted_unit);
+    const std::string conv = cal.extra.value("converter", std::string());
+    if (!conv.empty()) {
+      fitted.converter = ParseConverter(conv, cal_path + ": converter");
+      fitted.has_converter = true;
+    }
+  } catch (const std::invalid_argument& e) {
+    throw CalFileError(cal_path + ": recording_unit/converter: " + e.what());
+  }
+  fitted.excitation_v = cal.extra.value("excitation_v", 0.0);
+  fitted.source = "calibration " + cal_path;
+  if (u.source == "format default") {
+    if (fitted.unit == BridgeUnit::kVolts && !(fitted.excitation_v > 0)) return u;
+    return fitted;
+  }
+  const bool same_converter = !fitted.has_converter || !u.has_converter ||
+                              FormatConverter(fitted.converter) == FormatConverter(u.converter);
+  if (u.unit != fitted.unit || (fitted.unit == BridgeUnit::kCounts && !same_converter)) {
+    const std::string declared =
+        std::string(ToString(u.unit)) +
+        (u.has_converter ? " of converter (" + FormatConverter(u.converter) + ")" : "");
+    const std::string wanted =
+        std::string(ToString(fitted.unit)) +
+        (fitted.has_converter ? " of converter (" + FormatConverter(fitted.converter) + ")" : "");
+    throw RecordingError(DeclarationPlace(rec, cli) + ": declares bridge unit " + declared +
+                         ", but " + cal_path + " was fitted from " + wanted +
+                         ": refused (drop the declaration to use the calibration's)");
+  }
+  if (u.excitation_v <= 0) u.excitation_v = fitted.excitation_v;
+  return u;
+}
+
 void RecordInputUnit(const FitInput& in, CalFile* file) {
   file->input_unit = in.cal_unit;
   if (in.declared.has_converter) {
     file->extra["converter"] = FormatConverter(in.declared.converter);
   }
   file->extra["recording_unit"] = ToString(in.declared.unit);
+  if (in.declared.excitation_v > 0) file->extra["excitation_v"] = in.declared.excitation_v;
 }
 
 }  // namespace ftstack::cal

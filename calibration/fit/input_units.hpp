@@ -30,11 +30,20 @@ struct FitInput {
 [[nodiscard]] FitInput PrepareFitInput(Recording* rec, const UnitOverrides& cli,
                                        const hal::AdcInfo& assumed);
 
-/// Prepares `rec` for ApplyCalibration(cal, …): resolves its unit (default mV/V), converts the b*
-/// columns into cal.input_unit and refuses values outside cal.adc's rails. Returns one line
-/// saying which unit was used.
+/// The unit of `rec`'s bridge columns for applying `cal`: what the recording or `cli` declares;
+/// where nothing does, the unit and converter the calibration was fitted from (its
+/// recording_unit and converter); the format default (mV/V) only when neither says. Throws
+/// RecordingError (FILE:LINE of the declaration, or the option) when the declaration differs
+/// from the calibration's.
+[[nodiscard]] InputUnit UnitForCalibration(const Recording& rec, const UnitOverrides& cli,
+                                           const CalFile& cal, const std::string& cal_path);
+
+/// Prepares `rec` for ApplyCalibration(cal, …): resolves its unit (UnitForCalibration), converts
+/// the b* columns into cal.input_unit and refuses codes that are not whole numbers and values
+/// outside cal.adc's rails. Returns one line saying which unit was used and which source
+/// decided it.
 [[nodiscard]] std::string PrepareApplyInput(Recording* rec, const UnitOverrides& cli,
-                                            const CalFile& cal);
+                                            const CalFile& cal, const std::string& cal_path);
 
 /// Writes the converter and the input unit into `file` (input_unit and extra["converter"]).
 void RecordInputUnit(const FitInput& in, CalFile* file);

@@ -12,9 +12,11 @@
 #include <filesystem>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "calibration/file/cal_file.hpp"
 #include "calibration/fit/check.hpp"
+#include "calibration/fit/commands.hpp"
 #include "calibration/fit/input_units.hpp"
 #include "measurement/recording.hpp"
 #include "tests/calibration/run_ftcal.hpp"
@@ -230,6 +232,57 @@ TEST(CalCheck, CommandLineGivesAVerdictAndAnExitCodeAScriptCanUse) {
                 "check --cal " + cal_path + " --in " + (dir / "poses.csv").string(), &out),
             1);
   EXPECT_NE(out.find("needs the tool"), std::string::npos) << out;
+  std::filesystem::remove_all(dir);
+}
+
+// A calibration fitted from raw counts of a 24-bit converter: a pose recording of the same counts
+// without a unit declaration is read with the calibration's converter (the same report as when
+// declaring it), and a recording declaring another unit is refused with one line.
+TEST(CalCheck, UndeclaredCountsUseTheCalibrationsConverterAndAnotherDeclarationIsRefused) {
+  std::mt19937_64 rng(3);
+  CalFile cal = MakeCal(rng);
+  const std::string conv = "bits=24, coding=signed, full_scale_mvv=3.90625";
+  cal.extra["recording_unit"] = "counts";
+  cal.extra["converter"] = conv;
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("ftcal_check_units_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string cal_path = (dir / "cal.json").string();
+  ftstack::cal::SaveCalFile(cal_path, cal);
+  Recording rec = Generate(cal, Tool(2.5), {}, 5);
+  const double mvv_per_count = 3.90625 / 8388608.0;  // full scale over 2^23 codes
+  for (std::size_t c = 5; c < rec.columns.size(); ++c)
+    for (double& v : rec.columns[c]) v = std::nearbyint(v / mvv_per_count);
+  auto run = [&](const std::vector<std::string>& metadata, std::string* text) {
+    rec.metadata = metadata;
+    const std::string in = (dir / "poses.csv").string();
+    ftstack::WriteRecording(in, rec);
+    ftstack::cal::CheckRequest req;
+    req.cal_path = cal_path;
+    req.in_path = in;
+    req.mass_kg = 2.5;
+    req.com_m = {0.012, -0.018, 0.085};
+    return ftstack::cal::RunCheck(req, text);
+  };
+  std::string undeclared;
+  std::string declared;
+  const CheckResult a = run({}, &undeclared);
+  const CheckResult b = run({"bridge_unit: counts", "converter: " + conv}, &declared);
+  EXPECT_TRUE(a.pass) << undeclared;
+  EXPECT_NE(undeclared.find("[calibration " + cal_path + "]"), std::string::npos) << undeclared;
+  EXPECT_NE(declared.find("[metadata]"), std::string::npos) << declared;
+  // Past the unit line the two reports are the same text.
+  EXPECT_EQ(undeclared.substr(undeclared.find('\n')), declared.substr(declared.find('\n')));
+  EXPECT_EQ(a.pass, b.pass);
+  std::string text;
+  try {
+    (void)run({"bridge_unit: mV/V"}, &text);
+    ADD_FAILURE() << "a recording declared in mV/V was accepted";
+  } catch (const ftstack::RecordingError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("poses.csv:1: declares bridge unit mV/V"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
   std::filesystem::remove_all(dir);
 }
 

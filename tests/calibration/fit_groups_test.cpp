@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "calibration/fit/fit.hpp"
 
@@ -119,6 +121,61 @@ TEST(FitGroups, ABadlyRecordedPoseIsReportedAndDownWeighted) {
     ours += e.head<3>().squaredNorm();
   }
   EXPECT_LT(ours, 0.5 * ls);
+}
+
+/// A candidate with the given per-fold shares of its score.
+ftstack::cal::CandidateScore Candidate(ModelKind kind, int features, double lambda,
+                                       std::vector<double> shares) {
+  ftstack::cal::CandidateScore c;
+  c.kind = kind;
+  c.features = features;
+  c.lambda = lambda;
+  for (const double x : shares) c.score += x;
+  c.fold_score = std::move(shares);
+  return c;
+}
+
+// Margins and standard errors worked by hand: d_k = simpler − complex share, margin = Σ d_k,
+// SE = √K · sample standard deviation of the d_k.
+TEST(FitChoice, AMarginWithinOneStandardErrorKeepsTheSimplerModel) {
+  using ftstack::cal::ChoiceMargin;
+  const auto linear = Candidate(ModelKind::kLinear, 9, 0.0, {1.0, 1.0, 1.0, 1.0});
+  // 2.5 % lower score (a 1 %-of-best rule would take it), d = .5 −.5 .3 −.2: SE = √(4·.6275/3).
+  const auto noisy = Candidate(ModelKind::kQuadraticDiag, 17, 0.0, {0.5, 1.5, 0.7, 1.2});
+  ChoiceMargin over;
+  ChoiceMargin challenger;
+  std::vector<ftstack::cal::CandidateScore> c = {noisy, linear};
+  EXPECT_EQ(ftstack::cal::ChooseOneStandardError(c, &over, &challenger), 1u);
+  EXPECT_TRUE(over.complex.empty());
+  EXPECT_EQ(challenger.complex, "quadratic-diag lambda=0");
+  EXPECT_NEAR(challenger.margin, 0.1, 1e-12);
+  EXPECT_NEAR(challenger.se, std::sqrt(4 * 0.6275 / 3), 1e-12);
+  // Consistently lower in every fold, d = .2 .1 .15 .25: SE = √(4·.0125/3) < margin .7.
+  const auto steady = Candidate(ModelKind::kQuadraticDiag, 17, 0.0, {0.8, 0.9, 0.85, 0.75});
+  c = {linear, steady};
+  EXPECT_EQ(ftstack::cal::ChooseOneStandardError(c, &over, &challenger), 1u);
+  EXPECT_NEAR(over.margin, 0.7, 1e-12);
+  EXPECT_NEAR(over.se, std::sqrt(4 * 0.0125 / 3), 1e-12);
+  EXPECT_EQ(over.simpler, "linear lambda=0");
+  EXPECT_TRUE(challenger.complex.empty());
+}
+
+TEST(FitChoice, TheSmallestRidgeLambdaNotBeatenByMoreThanOneStandardErrorIsTaken) {
+  using ftstack::cal::ChoiceMargin;
+  const auto plain = Candidate(ModelKind::kLinear, 9, 0.0, {1.0, 1.0, 1.0, 1.0});
+  const auto mild = Candidate(ModelKind::kLinear, 9, 0.03, {0.82, 0.88, 0.86, 0.76});
+  // Lowest score, but only .02 below λ = 0.03 with SE √(4·.0009/3) ≈ .035.
+  const auto strong = Candidate(ModelKind::kLinear, 9, 0.1, {0.8, 0.9, 0.85, 0.75});
+  ChoiceMargin over;
+  ChoiceMargin challenger;
+  const std::vector<ftstack::cal::CandidateScore> c = {strong, plain, mild};
+  EXPECT_EQ(ftstack::cal::ChooseOneStandardError(c, &over, &challenger), 2u);
+  EXPECT_EQ(over.simpler, "linear lambda=0");
+  EXPECT_EQ(over.complex, "linear lambda=0.03");
+  EXPECT_EQ(challenger.complex, "linear lambda=0.1");
+  EXPECT_NEAR(challenger.margin, 0.02, 1e-12);
+  EXPECT_NEAR(challenger.se, std::sqrt(4 * 0.0009 / 3), 1e-12);
+  EXPECT_FALSE(challenger.Significant());
 }
 
 }  // namespace

@@ -271,4 +271,86 @@ TEST(FtcalUnits, ApplyRefusesOutOfRangeCodesAndFlagsSaturatedRows) {
   EXPECT_EQ(RunFtcal(apply + " --allow-flagged", tmp / "rail2.err"), 0);
 }
 
+/// The data lines of a written recording (metadata lines dropped).
+std::string DataLines(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::string out;
+  while (std::getline(in, line))
+    if (line.empty() || line[0] != '#') out += line + "\n";
+  return out;
+}
+
+/// Fits tmp/cal.json (linear) from the declared training rows of split 2.
+bool FitDeclared(const Tmp& tmp, const std::vector<Row>& rows) {
+  Write(tmp / "train.csv", rows, true, false, 2);
+  const int rc = RunFtcal("fit --in " + (tmp / "train.csv") + " --out " + (tmp / "cal.json") +
+                              " --model linear" + kRated,
+                          tmp / "fit.err");
+  if (rc != 0) ADD_FAILURE() << Slurp(tmp / "fit.err");
+  return rc == 0;
+}
+
+TEST(FtcalUnits, UndeclaredCountsApplyWithTheCalibrationsConverter) {
+  Tmp tmp;
+  const std::vector<Row> rows = Generate(9);
+  ASSERT_TRUE(FitDeclared(tmp, rows));
+  Write(tmp / "declared.csv", rows, true, true, 2);
+  Write(tmp / "undeclared.csv", rows, false, true, 2);
+  ASSERT_EQ(RunFtcal("apply --cal " + (tmp / "cal.json") + " --in " + (tmp / "declared.csv") +
+                         " --out " + (tmp / "declared_out.csv"),
+                     tmp / "declared.err"),
+            0)
+      << Slurp(tmp / "declared.err");
+  ASSERT_EQ(RunFtcal("apply --cal " + (tmp / "cal.json") + " --in " + (tmp / "undeclared.csv") +
+                         " --out " + (tmp / "undeclared_out.csv"),
+                     tmp / "undeclared.err"),
+            0)
+      << Slurp(tmp / "undeclared.err");
+  // The calibration's converter decided, and said so; the output is the declared one's.
+  const std::string said = Slurp(tmp / "undeclared.err");
+  EXPECT_NE(said.find("bridge unit counts of converter (bits=10, coding=unsigned, gain=200"),
+            std::string::npos)
+      << said;
+  EXPECT_NE(said.find("[calibration " + (tmp / "cal.json") + "]"), std::string::npos) << said;
+  EXPECT_NE(Slurp(tmp / "declared.err").find("[metadata]"), std::string::npos);
+  const std::string declared_out = DataLines(tmp / "declared_out.csv");
+  EXPECT_GT(declared_out.size(), 1000u);
+  EXPECT_EQ(DataLines(tmp / "undeclared_out.csv"), declared_out);
+}
+
+TEST(FtcalUnits, ApplyRefusesADeclarationOtherThanTheCalibrationsAndNonWholeCodes) {
+  Tmp tmp;
+  const std::vector<Row> rows = Generate(9);
+  ASSERT_TRUE(FitDeclared(tmp, rows));
+  const std::string body = "t,b0,b1,b2,b3,b4,b5,b6,b7\n0,500,500,500,500,500,500,500,500\n";
+  auto refused = [&](const std::string& name, const std::string& text, const std::string& opts) {
+    std::ofstream(tmp / name) << text;
+    const int rc = RunFtcal("apply --cal " + (tmp / "cal.json") + " --in " + (tmp / name) +
+                                " --out " + (tmp / "o.csv") + opts,
+                            tmp / "err");
+    EXPECT_EQ(rc, 1) << name;
+    EXPECT_FALSE(fs::exists(tmp / "o.csv")) << name;
+    const std::string err = Slurp(tmp / "err");
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    return err;
+  };
+  // Another converter declared in the file: refused at its metadata line.
+  std::string err = refused(
+      "twelve.csv", "# sensor: x\n# converter: bits=12, coding=unsigned, gain=200\n" + body, "");
+  EXPECT_NE(err.find("twelve.csv:2: declares bridge unit counts of converter (bits=12"),
+            std::string::npos)
+      << err;
+  EXPECT_NE(err.find("was fitted from counts of converter (bits=10"), std::string::npos) << err;
+  // mV/V declared in the file, or another converter on the command line.
+  err = refused("mvv.csv", "# bridge_unit: mV/V\n" + body, "");
+  EXPECT_NE(err.find("mvv.csv:1: declares bridge unit mV/V"), std::string::npos) << err;
+  err = refused("plain.csv", body, " --converter bits=10,coding=offset-binary,gain=200");
+  EXPECT_NE(err.find("--bridge-unit/--converter: declares bridge unit counts"), std::string::npos)
+      << err;
+  // Undeclared, so read as the calibration's counts: 500.5 is no code of any converter.
+  err = refused("half.csv", "t,b0,b1,b2,b3,b4,b5,b6,b7\n0,500,500,500.5,500,500,500,500,500\n", "");
+  EXPECT_NE(err.find("half.csv:2:11: b2 = 500.5 is not a whole code"), std::string::npos) << err;
+}
+
 }  // namespace
