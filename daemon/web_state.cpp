@@ -93,11 +93,22 @@ nlohmann::json HealthJson(const std::uint16_t* in) {
                         {"action", kCauses[cause].action},
                         {"error_n_nm", Six(in + fw::kInFindingError + 12 * k)}});
   }
+  // Coverage (input 196) tells "no finding" from "could not look" for each cause.
+  nlohmann::json coverage = nlohmann::json::array();
+  const std::uint16_t judged = in[fw::kInCoverage];
+  for (std::uint16_t cause = 1; cause <= fw::kHealthCauses; ++cause) {
+    coverage.push_back({{"cause", cause},
+                        {"code", kCauses[cause].code},
+                        {"words", kCauses[cause].words},
+                        {"judged_last_hour", (judged >> (cause - 1) & 1u) != 0}});
+  }
   const std::uint16_t reason = in[fw::kInRetareReason];
   return {{"watch_on", in[fw::kInHealthWatchOn] != 0},
           {"ne107", state},
           {"ne107_words", state < 5 ? kNe107[state] : "unknown"},
           {"findings", findings},
+          {"coverage_bits", judged},
+          {"coverage", coverage},
           {"retare_suggested", in[fw::kInRetareSuggested] != 0},
           {"retare_reason", reason <= fw::kHealthCauses ? kCauses[reason].code : "unknown"}};
 }

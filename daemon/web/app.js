@@ -101,6 +101,14 @@
       tb.append(tr);
     }
     if (!h.findings.length) { const tr = el('tr'); tr.append(el('td', 'no finding')); tb.append(tr); }
+    const cov = $('coverage');
+    cov.replaceChildren();
+    for (const c of h.coverage) {
+      const li = el('li', (c.judged_last_hour ? 'judged: ' : 'could not look: ') + c.words);
+      li.dataset.cause = c.code;
+      li.className = c.judged_last_hour ? 'judged' : 'not-judged';
+      cov.append(li);
+    }
   }
 
   function rainflow(rf) {

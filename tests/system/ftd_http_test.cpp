@@ -117,6 +117,35 @@ TEST(FtdHttp, WrenchMatchesAModbusReadOfTheSameSampleWithinOneLsb) {
   EXPECT_EQ(compared, 2) << "no API read hit the sample a Modbus read returned";
 }
 
+TEST(FtdHttp, CoverageIsInputRegister196CausePerCause) {
+  Ftd ftd({});
+  ASSERT_GT(ftd.http, 0) << ftd.proc.Stderr();
+  Modbus mb(ftd.proc.port());
+  ASSERT_TRUE(mb.ok());
+  // Under a held load the watch judges some causes within seconds (the tones and the noise floor);
+  // the coverage changes at most once a second, so two reads in a row agree between its updates.
+  int agreed = 0;
+  for (int attempt = 0; attempt < 40 && agreed < 2; ++attempt) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(250));
+    std::uint16_t before = 0;
+    std::uint16_t after = 0;
+    ASSERT_TRUE(mb.ReadInput(fw::kInCoverage, 1, &before));
+    std::string body;
+    ASSERT_EQ(Curl(ftd.Url("/api/v1/wrench"), &body), 200) << body;
+    ASSERT_TRUE(mb.ReadInput(fw::kInCoverage, 1, &after));
+    if (before != after || before == 0) continue;
+    const nlohmann::json h = nlohmann::json::parse(body)["health"];
+    EXPECT_EQ(h["coverage_bits"].get<int>(), before);
+    ASSERT_EQ(h["coverage"].size(), static_cast<std::size_t>(fw::kHealthCauses));
+    for (const auto& c : h["coverage"]) {
+      const int cause = c["cause"].get<int>();
+      EXPECT_EQ(c["judged_last_hour"].get<bool>(), (before >> (cause - 1) & 1) != 0) << cause;
+    }
+    ++agreed;
+  }
+  EXPECT_EQ(agreed, 2) << "the watch judged nothing, or the API never matched input 196";
+}
+
 TEST(FtdHttp, UnknownPathsWrongMethodsAndBadBodiesAreRefusedWithoutDisturbingSampling) {
   Ftd ftd({});
   ASSERT_GT(ftd.http, 0) << ftd.proc.Stderr();
