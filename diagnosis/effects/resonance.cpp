@@ -40,6 +40,15 @@ bool InRange(const Context& cx, double f_hz, double zeta) {
   return f_hz >= kMinFreqHz && f_hz <= MaxFreqHz(cx) && zeta >= kMinZeta && zeta <= kMaxZeta;
 }
 
+/// Resonance's physical ranges (those of its search): every mode below Nyquist, lightly damped.
+std::vector<ParamSpec> ResonanceSpecs(const Context& cx) {
+  const double f_hi = MaxFreqHz(cx);
+  return {{"freq_hz", kMinFreqHz, f_hi, "0.05 Hz", "0.98 × Nyquist", "Hz"},
+          {"damping_ratio", kMinZeta, kMaxZeta, "Q 500", "a step response that rings"},
+          {"freq2_hz", kMinFreqHz, f_hi, "0.05 Hz", "0.98 × Nyquist", "Hz"},
+          {"damping_ratio2", kMinZeta, kMaxZeta, "Q 500", "a step response that rings"}};
+}
+
 /// The coarse frequency grid: ±8 % around each of the 3 strongest lines of the residual spectrum
 /// and of the 3 lines standing most out of their neighbourhood (LocalLines: a light ringing under
 /// a red spectrum), or 12 log-spaced points from 1 Hz to 0.9 × Nyquist without any.
@@ -266,9 +275,9 @@ std::optional<EffectFit> LockedRingingSearch(const Context& cx, const Series& ta
     // The curvature step in log f stays inside the optimum's width (about ζ).
     const double step = std::min(0.002, 0.25 * z);
     e.sigma["freq_hz"] = JsonNum(
-        f * CurvatureSigma([&](double v) { return sse(std::exp(v), z, all); }, log_fz[0], step));
+        f * ProfileSigma([&](double v) { return sse(std::exp(v), z, all); }, log_fz[0], step));
     e.sigma["damping_ratio"] = JsonNum(
-        z * CurvatureSigma([&](double v) { return sse(f, std::exp(v), all); }, log_fz[1], 0.02));
+        z * ProfileSigma([&](double v) { return sse(f, std::exp(v), all); }, log_fz[1], kOnBound));
   }
   PutChannelCoef(cx, cf, 0, "participation", &e);
   sse.h = Mat();
@@ -289,8 +298,8 @@ namespace {
 
 /// Whether a mode at (log f, log ζ) ended within 2 % of its search's bounds (not resolved).
 bool OnBound(const Context& cx, double log_f, double log_z) {
-  return log_f < std::log(kMinFreqHz) + 0.02 || log_f > std::log(MaxFreqHz(cx)) - 0.02 ||
-         log_z < std::log(kMinZeta) + 0.02 || log_z > std::log(kMaxZeta) - 0.02;
+  return log_f < std::log(kMinFreqHz) + kOnBound || log_f > std::log(MaxFreqHz(cx)) - kOnBound ||
+         log_z < std::log(kMinZeta) + kOnBound || log_z > std::log(kMaxZeta) - kOnBound;
 }
 
 }  // namespace
@@ -412,10 +421,17 @@ bool SearchModes(const Context& cx, const Series& target, const std::vector<int>
         g1.push_back(log_freq[m] + 0.04 * j / (round + 1));
         g2.push_back(log_zeta[m] + 0.3 * j / (round + 1));
       }
-      log_freq[m] = MinimizeOnGrid(
-          [&](double v) { return sse(m, std::exp(v), std::exp(log_zeta[m])); }, g1, 7, nullptr);
-      log_zeta[m] = MinimizeOnGrid(
-          [&](double v) { return sse(m, std::exp(log_freq[m]), std::exp(v)); }, g2, 7, nullptr);
+      const std::vector<ParamSpec> specs = ResonanceSpecs(cx);
+      log_freq[m] =
+          SolveParameter(
+              specs[2 * m], [&](double v) { return sse(m, std::exp(v), std::exp(log_zeta[m])); },
+              GridOnly(g1, 7))
+              .coord;
+      log_zeta[m] =
+          SolveParameter(
+              specs[2 * m + 1],
+              [&](double v) { return sse(m, std::exp(log_freq[m]), std::exp(v)); }, GridOnly(g2, 7))
+              .coord;
     }
   }
   return true;
@@ -442,10 +458,10 @@ void ModeCurvatures(const Context& cx, const Series& target, const double* log_f
       });
       return sums.Solve(cx).sse_w;
     };
-    slf[m] = CurvatureSigma([&](double v) { return sse_all(std::exp(v), std::exp(log_zeta[m])); },
-                            log_freq[m], 0.002);
-    slz[m] = CurvatureSigma([&](double v) { return sse_all(std::exp(log_freq[m]), std::exp(v)); },
-                            log_zeta[m], 0.02);
+    slf[m] = ProfileSigma([&](double v) { return sse_all(std::exp(v), std::exp(log_zeta[m])); },
+                          log_freq[m], 0.002);
+    slz[m] = ProfileSigma([&](double v) { return sse_all(std::exp(log_freq[m]), std::exp(v)); },
+                          log_zeta[m], kOnBound);
   }
 }
 
@@ -524,25 +540,12 @@ std::string AddResonanceMode(const Context& cx, const Series& target, double f1_
 
 namespace ftstack::diag {
 
-namespace {
-
-/// Resonance's physical ranges (those of its search): every mode below Nyquist, lightly damped.
-std::vector<ParamRange> ResonanceRanges(const Context& cx) {
-  const double f_hi = fx::MaxFreqHz(cx);
-  return {{"freq_hz", fx::kMinFreqHz, f_hi, "0.05 Hz", "0.98 × Nyquist"},
-          {"damping_ratio", fx::kMinZeta, fx::kMaxZeta, "Q 500", "a step response that rings"},
-          {"freq2_hz", fx::kMinFreqHz, f_hi, "0.05 Hz", "0.98 × Nyquist"},
-          {"damping_ratio2", fx::kMinZeta, fx::kMaxZeta, "Q 500", "a step response that rings"}};
-}
-
-}  // namespace
-
 EffectSpec ResonancePlugin() {
   return {.kind = EffectKind::kResonance,
           .fit = &fx::FitBy<&fx::ResonanceSearch>,
           .refit = &fx::RefitBy<&fx::ResonanceSearch>,
           .cost = 8,
-          .ranges = &ResonanceRanges};
+          .ranges = &fx::ResonanceSpecs};
 }
 
 }  // namespace ftstack::diag

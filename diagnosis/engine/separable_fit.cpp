@@ -25,6 +25,12 @@ double ParamSigma(const Context& cx, const ChannelFit& f, int c, int j) {
 
 /// Uncertainty of a nonlinear parameter from the curvature of the profile SSE (whitened, so
 /// Δχ² = 1 at one σ): σ = sqrt(2 / f'').
+Vec CoefSigmas(const Context& cx, const ChannelFit& f, int j) {
+  Vec s(cx.nc);
+  for (int c = 0; c < cx.nc; ++c) s(c) = ParamSigma(cx, f, c, j);
+  return s;
+}
+
 double CurvatureSigma(const std::function<double(double)>& f, double x, double h) {
   const double f0 = f(x);
   const double fp = f(x + h);
@@ -80,8 +86,7 @@ nlohmann::json VecJson(const Vec& v) {
 /// Puts coefficient j of every channel and its σ into e.params[key] / e.sigma[key]; returns it.
 Vec PutChannelCoef(const Context& cx, const ChannelFit& f, int j, const char* key, EffectFit* e) {
   Vec v = f.beta.row(j).transpose();
-  Vec sg(cx.nc);
-  for (int c = 0; c < cx.nc; ++c) sg(c) = ParamSigma(cx, f, c, j);
+  const Vec sg = CoefSigmas(cx, f, j);
   e->params[key] = VecJson(v);
   e->sigma[key] = VecJson(sg);
   return v;
