@@ -192,14 +192,16 @@ bool SearchOneMode(const Context& cx, const Series& target, const EffectFit* nea
         points.push_back({std::log(f), std::log(z)});
     }
     sse->windowed = sse->w1 - sse->w0 < cx.n;  // the coarse grid and the first round
-    best_sse = BestPoint(on_coarse, points, &best);
+    best_sse = JointStart(on_coarse, points, &best);
   }
   if (!std::isfinite(best_sse)) return false;
   // A light damping has a narrow optimum in f: the frequency steps shrink with ζ.
   const double f_step = std::clamp(4.0 * std::exp(best[1]), 0.004, 0.04);
   const std::vector<LogBounds> bounds = {{std::log(kMinFreqHz), std::log(MaxFreqHz(cx))},
                                          {std::log(kMinZeta), std::log(kMaxZeta)}};
-  GoldenRounds(
+  // Statuses unused: a mode on a bound is judged by the variant choice (FirstModeOnBound) and by
+  // the declared range (NotResolved).
+  (void)JointRefine(
       on_coarse, bounds, {f_step, 0.3}, warm ? 1 : 0, 2,
       [&](int round) {
         if (round != 1) return;
@@ -296,10 +298,11 @@ std::optional<EffectFit> LockedRingingSearch(const Context& cx, const Series& ta
 
 namespace {
 
-/// Whether a mode at (log f, log ζ) ended within 2 % of its search's bounds (not resolved).
+/// Whether a mode at (log f, log ζ) ended on a bound of its declared range (the engine's rule).
 bool OnBound(const Context& cx, double log_f, double log_z) {
-  return log_f < std::log(kMinFreqHz) + kOnBound || log_f > std::log(MaxFreqHz(cx)) - kOnBound ||
-         log_z < std::log(kMinZeta) + kOnBound || log_z > std::log(kMaxZeta) - kOnBound;
+  const std::vector<ParamSpec> specs = ResonanceSpecs(cx);
+  return StatusOf(specs[0], std::exp(log_f)) != ParamStatus::kResolved ||
+         StatusOf(specs[1], std::exp(log_z)) != ParamStatus::kResolved;
 }
 
 }  // namespace

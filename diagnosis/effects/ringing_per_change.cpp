@@ -233,17 +233,15 @@ bool SearchNearLine(const Context& cx, const Series& detrended, const std::vecto
       for (double z : {0.001, 0.003, 0.01, 0.03})
         points.push_back({std::log(line_hz * m), std::log(z)});
     }
-    if (!std::isfinite(BestPoint(sse, points, best))) return false;
+    if (!std::isfinite(JointStart(sse, points, best))) return false;
   }
-  GoldenRounds(
+  const std::vector<ParamStatus> status = JointRefine(
       sse, bounds, {0.01, 0.4}, warm != nullptr ? 1 : 0, 2,
       [&](int round) {
         if (round == 1) row_step = 1;
       },
       best);
-  const auto& x = *best;
-  return x[0] > bounds[0].lo + kOnBound && x[0] < bounds[0].hi - kOnBound &&
-         x[1] > bounds[1].lo + kOnBound && x[1] < bounds[1].hi - kOnBound;
+  return status[0] == ParamStatus::kResolved && status[1] == ParamStatus::kResolved;
 }
 
 }  // namespace

@@ -82,22 +82,39 @@ SolvedParam SolveParameter(const ParamSpec& spec, const Profile& f, const SolveO
   return out;
 }
 
+double JointStart(const LogObjective& f, const std::vector<std::vector<double>>& points,
+                  std::vector<double>* x) {
+  return BestPoint(f, points, x);
+}
+
+std::vector<ParamStatus> JointRefine(const LogObjective& f, const std::vector<LogBounds>& bounds,
+                                     const std::vector<double>& step, int first, int last,
+                                     const std::function<void(int)>& before,
+                                     std::vector<double>* x) {
+  GoldenRounds(f, bounds, step, first, last, before, x);
+  std::vector<ParamStatus> status;
+  for (std::size_t j = 0; j < x->size(); ++j) {
+    const double v = (*x)[j];
+    const bool on = v <= bounds[j].lo + kOnBound || v >= bounds[j].hi - kOnBound;
+    status.push_back(on ? ParamStatus::kAtBound : ParamStatus::kResolved);
+  }
+  return status;
+}
+
 std::vector<SolvedParam> SolveJoint(const LogObjective& f,
                                     const std::vector<std::vector<double>>& points,
                                     const std::vector<LogBounds>& bounds,
                                     const std::vector<double>& step, int first, int last,
                                     const std::function<void(int)>& before, double sigma_step) {
   std::vector<double> x;
-  const double best = BestPoint(f, points, &x);
-  if (!std::isfinite(best)) return {};
-  GoldenRounds(f, bounds, step, first, last, before, &x);
+  if (!std::isfinite(JointStart(f, points, &x))) return {};
+  const std::vector<ParamStatus> status = JointRefine(f, bounds, step, first, last, before, &x);
   std::vector<SolvedParam> out(x.size());
   for (std::size_t j = 0; j < x.size(); ++j) {
     SolvedParam& s = out[j];
     s.coord = x[j];
     s.value = std::exp(x[j]);
-    const bool on = x[j] <= bounds[j].lo + kOnBound || x[j] >= bounds[j].hi - kOnBound;
-    s.status = on ? ParamStatus::kAtBound : ParamStatus::kResolved;
+    s.status = status[j];
     if (sigma_step > 0.0) {
       std::vector<double> at = x;
       const double cs = ProfileSigma(

@@ -84,6 +84,18 @@ struct SolveOptions {
                                                   int last, const std::function<void(int)>& before,
                                                   double sigma_step);
 
+/// The first stage of a joint solve, for a family that sets its refinement from where it starts
+/// (resonance's frequency step from ζ): the point of `points` with the least finite objective in
+/// *x; returns that objective (+inf, *x untouched, when none is finite).
+double JointStart(const LogObjective& f, const std::vector<std::vector<double>>& points,
+                  std::vector<double>* x);
+/// The second stage: golden rounds first … last − 1 from *x (GoldenRounds' contract) inside
+/// `bounds`, then each coordinate's status (kAtBound within kOnBound of a bound, else kResolved).
+std::vector<ParamStatus> JointRefine(const LogObjective& f, const std::vector<LogBounds>& bounds,
+                                     const std::vector<double>& step, int first, int last,
+                                     const std::function<void(int)>& before,
+                                     std::vector<double>* x);
+
 /// Curvature σ of a one-dimensional profile at x (Δχ² = 1): sqrt(2 / f''), NaN where f'' ≤ 0.
 [[nodiscard]] double ProfileSigma(const Profile& f, double x, double h);
 
