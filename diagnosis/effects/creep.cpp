@@ -71,15 +71,16 @@ double LogParam(const EffectFit* near, const char* key) {
 /// minimum is inside that window, else on `grid` (12 golden steps). [lo, hi] bounds the window.
 double WindowOrGrid(const std::function<double(double)>& f, double start,
                     const std::vector<double>& grid, double lo, double hi) {
+  const ParamSpec spec{.key = "tau_s", .lo = std::exp(lo), .hi = std::exp(hi), .unit = "s"};
   if (std::isfinite(start)) {
     std::vector<double> local;
     for (int j = -2; j <= 2; ++j) local.push_back(std::clamp(start + 0.25 * j, lo, hi));
-    const double x = MinimizeOnGrid(f, local, 8, nullptr);
+    const double x = SolveParameter(spec, f, GridOnly(local, 8)).coord;
     const bool edge = (x <= local.front() + 0.125 && local.front() > lo) ||
                       (x >= local.back() - 0.125 && local.back() < hi);
     if (!edge) return x;
   }
-  return MinimizeOnGrid(f, grid, 12, nullptr);
+  return SolveParameter(spec, f, GridOnly(grid, 12)).coord;
 }
 
 /// The standard's figures, channels and evidence of a finished creep fit (one or two τ).
@@ -129,7 +130,7 @@ double PickOneTau(const Context& cx, const Series& target, double lt,
     e.variant = gamma ? "first-order creep with a gain term" : "first-order creep";
     e.n_params = p;
     const double sl = uncertainty
-                          ? CurvatureSigma([&](double v) { return sse_for(v, gamma); }, lt, 0.02)
+                          ? ProfileSigma([&](double v) { return sse_for(v, gamma); }, lt, kOnBound)
                           : std::numeric_limits<double>::quiet_NaN();
     const ChannelFit f = sums[gamma ? 1 : 0].Solve(cx);
     e.train_sse_w = f.sse_w;
@@ -383,15 +384,16 @@ void SearchPair(const Context& cx, const Series& target, double log_tau1, double
     LowPassLoadRows(cx, std::exp(second ? l1 : l2), rows, second ? &lp1 : &lp2);
     const auto gr = around(second ? l2 : l1, second ? l1 : l2);
     if (gr.size() < 3) continue;
-    (second ? l2 : l1) = MinimizeOnGrid(
-        second ? std::function<double(double)>(sse2) : std::function<double(double)>(sse1), gr,
-        golden, nullptr);
+    const ParamSpec spec{
+        .key = second ? "tau2_s" : "tau1_s", .lo = std::exp(lo), .hi = std::exp(hi), .unit = "s"};
+    (second ? l2 : l1) =
+        SolveParameter(spec, second ? Profile(sse2) : Profile(sse1), GridOnly(gr, golden)).coord;
   }
   if (l2 < l1) std::swap(l1, l2);
   LowPassLoadRows(cx, std::exp(l1), rows, &lp1);
-  *sl2 = uncertainty ? CurvatureSigma(sse2, l2, 0.02) : std::numeric_limits<double>::quiet_NaN();
+  *sl2 = uncertainty ? ProfileSigma(sse2, l2, kOnBound) : std::numeric_limits<double>::quiet_NaN();
   LowPassLoadRows(cx, std::exp(l2), rows, &lp2);
-  *sl1 = uncertainty ? CurvatureSigma(sse1, l1, 0.02) : std::numeric_limits<double>::quiet_NaN();
+  *sl1 = uncertainty ? ProfileSigma(sse1, l1, kOnBound) : std::numeric_limits<double>::quiet_NaN();
 }
 
 }  // namespace
@@ -551,18 +553,19 @@ namespace {
 /// load changes' settling: the search's lower bound) to a third of the record (a slower one is a
 /// drift the record cannot tell from creep), fractions of the load up to 5 % (a load cell creeping
 /// more is broken, or the fit is absorbing another mismatch).
-std::vector<ParamRange> CreepRanges(const Context& cx) {
+std::vector<ParamSpec> CreepRanges(const Context& cx) {
   const auto& t = cx.data->t_s;
   const double lo = fx::CreepTauFloor(cx);
   const double hi = std::max((t.back() - t.front()) / 3.0, 1.0);
   const char* lo_what = "3 samples, 0.2 s or 3 times the load changes' settling";
   const char* hi_what = "a third of the record";
-  return {{"tau_s", lo, hi, lo_what, hi_what},
-          {"tau1_s", lo, hi, lo_what, hi_what},
-          {"tau2_s", lo, hi, lo_what, hi_what},
-          {"fraction", 0.0, 0.05, "", "5 % of the load"},
-          {"fraction1", 0.0, 0.05, "", "5 % of the load"},
-          {"fraction2", 0.0, 0.05, "", "5 % of the load"}};
+  const ParamScale lin = ParamScale::kLinear;
+  return {{"tau_s", lo, hi, lo_what, hi_what, "s"},
+          {"tau1_s", lo, hi, lo_what, hi_what, "s"},
+          {"tau2_s", lo, hi, lo_what, hi_what, "s"},
+          {"fraction", 0.0, 0.05, "", "5 % of the load", "", lin},
+          {"fraction1", 0.0, 0.05, "", "5 % of the load", "", lin},
+          {"fraction2", 0.0, 0.05, "", "5 % of the load", "", lin}};
 }
 
 }  // namespace

@@ -8,19 +8,22 @@
 
 #include "diagnosis/engine/effect.hpp"
 #include "diagnosis/engine/separable_fit.hpp"
+#include "diagnosis/engine/solve.hpp"
 
 namespace ftstack::diag {
 
 /// thermal_zero_drift against a given temperature history dtemp (°C from 20 °C, one per row):
-/// r_c = a_c + k_c·dtemp (effects.cpp).
+/// r_c = a_c + k_c·dtemp (effects/thermal_zero_drift.cpp).
 [[nodiscard]] std::optional<EffectFit> FitThermalZeroOn(const Context& cx, const Series& target,
                                                         const std::vector<double>& dtemp);
 /// thermal_zero_drift with a first-order lag τ ≥ 0 between the thermometer and the gauges:
 /// dtemp is replaced by LP_τ[dtemp] (restarting per segment), τ found by grid + golden search on
-/// the training rows (effects/thermal_lag.cpp).
+/// the training rows (effects/thermal_zero_drift.cpp).
 [[nodiscard]] std::optional<EffectFit> FitThermalZeroLagged(const Context& cx,
                                                             const Series& target);
 
+/// The thermometer lag's declared range: 2 samples to a sixth of the record.
+[[nodiscard]] std::vector<ParamSpec> ThermalLagSpecs(const Context& cx);
 /// A claimed thermal_zero_drift or zero_drift refined to thermal_zero_drift with a thermometer lag
 /// (FitThermalZeroLagged), or nullopt when the data has no temperature or the lag does not pay for
 /// itself (the plain model wins): the RefineFn of both.
@@ -32,12 +35,12 @@ namespace ftstack::diag {
                                                              const Series& target);
 /// hysteresis in the load path: one operator (Dahl or play, width searched) or a
 /// Prandtl–Ishlinskii sum of plays of fixed widths on each reference wrench axis, mapped to the
-/// bridges by the sensitivity cx.sens (effects/hysteresis_axes.cpp).
+/// bridges by the sensitivity cx.sens (effects/hysteresis_load_path.cpp).
 [[nodiscard]] std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Series& target);
 /// hysteresis of general rate-independent shape: the one-operator fit or a Preisach superposition
 /// of relays (thresholds on 8 quantiles of each bridge's load, weights fitted per bridge; this
 /// class contains Prandtl–Ishlinskii sums of play operators), whichever has the lower training
-/// BIC (effects/hysteresis_pi.cpp).
+/// BIC (effects/hysteresis.cpp).
 [[nodiscard]] std::optional<EffectFit> FitHysteresisFamily(const Context& cx, const Series& target);
 /// hysteresis refitted near an earlier fit (RefitFn): only the sub-family (load-path operators,
 /// one operator per bridge, or Preisach per bridge) that fit came from.
@@ -51,6 +54,9 @@ namespace ftstack::diag::fx {
 /// The shortest creep time constant the data can show (3 samples, 0.2 s, 3 times the typical
 /// excluded window of a lagging load change): the search's lower bound and the range's.
 double CreepTauFloor(const Context& cx);
+
+/// hysteresis' declared parameter: the operator width as a fraction of the load's travel.
+std::vector<ParamSpec> HysteresisSpecs(const Context& cx);
 
 std::optional<EffectFit> FitZeroOffset(const Context& cx, const Series& target);
 std::optional<EffectFit> FitZeroDrift(const Context& cx, const Series& target);
@@ -66,7 +72,7 @@ std::optional<EffectFit> RefitExcitation(const Context& cx, const Series& target
 /// not at all when near is one-τ (effects/creep.cpp).
 std::optional<EffectFit> CreepSearch(const Context& cx, const Series& target, const EffectFit* near,
                                      bool uncertainty);
-/// creep with two time constants τ1 < τ2 (effects/creep_family.cpp): τ2 searched with τ1 at the
+/// creep with two time constants τ1 < τ2 (effects/creep.cpp): τ2 searched with τ1 at the
 /// one-τ optimum `log_tau1`, then τ1 and τ2 refined in turn; replaces *best (and fills tau,
 /// tau_sigma, the channel fit and whether a gain term is in it) only when its training BIC is
 /// below `best_bic`. Returns whether it did.
@@ -90,9 +96,11 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Series& target);
 std::optional<EffectFit> FitSaturation(const Context& cx, const Series& target);
 std::optional<EffectFit> FitOverloadShift(const Context& cx, const Series& target);
 std::optional<EffectFit> FitMains(const Context& cx, const Series& target);
-/// Adds harmonics 2..5 of the fitted mains fundamental f0 to *e (effects/mains_family.cpp): each
-/// at h·f0 or, above Nyquist, at its alias, kept when it lowers the training SSE by more than the
-/// BIC penalty of its 2 coefficients per channel; refits pred jointly with the fundamental and
+/// mains_interference's declared parameter: the line's frequency.
+std::vector<ParamSpec> MainsSpecs(const Context& cx);
+/// Adds harmonics 2..5 of the fitted mains fundamental f0 to *e (effects/mains_interference.cpp):
+/// each at h·f0 or, above Nyquist, at its alias, kept when it lowers the training SSE by more than
+/// the BIC penalty of its 2 coefficients per channel; refits pred jointly with the fundamental and
 /// puts h<k>_amplitude_mvv (σ) and h<k>_seen_at_hz. Returns a clause for the evidence.
 std::string AddMainsHarmonics(const Context& cx, const Series& target, double f0, EffectFit* e);
 /// resonance: LockedRingingSearch and RingingPerChange, the better kept (a mode on its search bound
@@ -120,8 +128,8 @@ inline constexpr const char* kRingingPerChange = "ringing per load change";
 /// load changes or lines, or when the search ends on its bounds.
 std::optional<EffectFit> RingingPerChange(const Context& cx, const Series& target,
                                           const EffectFit* near, bool uncertainty);
-/// The two-mode variant of a one-mode resonance fit *e at (f1_hz, zeta1) (effects/
-/// resonance_family.cpp): mode 2 searched at the lines of the residual spectrum, both refined in
+/// The two-mode variant of a one-mode resonance fit *e at (f1_hz, zeta1) (effects/resonance.cpp):
+/// mode 2 searched at the lines of the residual spectrum, both refined in
 /// turn and fitted jointly (a participation per channel and mode); replaces *e (variant "two
 /// modes", mode 1 the lower frequency) only when the training BIC is lower and the weaker mode
 /// carries ≥ 1 % of the ringing's whitened energy. Returns a clause for the evidence.

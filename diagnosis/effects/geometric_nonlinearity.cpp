@@ -68,8 +68,7 @@ std::optional<EffectFit> FitGeometric(const Context& cx, const Series& target) {
     e.n_params = cx.nc;
     e.train_sse_w = fa.sse_w;
     Vec g = fa.beta.row(0).transpose();
-    Vec gs(cx.nc);
-    for (int c = 0; c < cx.nc; ++c) gs(c) = ParamSigma(cx, fa, c, 0);
+    const Vec gs = CoefSigmas(cx, fa, 0);
     e.params["cubic_per_mvv2"] = VecJson(g);
     e.sigma["cubic_per_mvv2"] = VecJson(gs);
   } else {

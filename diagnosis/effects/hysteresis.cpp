@@ -16,6 +16,17 @@ namespace ftstack::diag {
 
 using namespace fx;  // NOLINT(google-build-using-namespace): the effects' private helpers
 
+std::vector<ParamSpec> fx::HysteresisSpecs(const Context& /*cx*/) {
+  return {{.key = "travel_fraction",
+           .lo = 0.002,
+           .hi = 2.0,
+           .lo_what = "0.2 % of the load's travel (below the noise of a loop)",
+           .hi_what = "twice the load's travel (a wider operator never reverses)",
+           .unit = "",
+           .grid_points = 11,
+           .golden_steps = 10}};
+}
+
 std::optional<EffectFit> FitHysteresisOperator(const Context& cx, const Series& target) {
   // Two rate-independent operators on each bridge's own load history: Dahl (exponential approach
   // after a reversal) and play/backlash (linear approach, then flat); width searched for each.
@@ -34,19 +45,16 @@ std::optional<EffectFit> FitHysteresisOperator(const Context& cx, const Series& 
     build(log_w, play);
     return SearchSse(cx, target, z);
   };
-  std::vector<double> grid;
-  for (int j = 0; j <= 10; ++j)
-    grid.push_back(std::log(0.002) + (std::log(2.0) - std::log(0.002)) * j / 10.0);
   EffectFit best;
   for (bool play : {false, true}) {
-    auto f1 = [&](double v) { return sse_for(v, play); };
-    const double lw = MinimizeOnGrid(f1, grid, 10, nullptr);
+    const SolvedParam s =
+        SolveParameter(HysteresisSpecs(cx)[0], [&](double v) { return sse_for(v, play); });
+    const double lw = s.coord;
     EffectFit e;
     e.name = "hysteresis";
     e.variant = play ? "rate-independent play (backlash) operator on each bridge's load"
                      : "rate-independent Dahl operator on each bridge's load";
     e.n_params = cx.nc + 1;
-    const double sl = CurvatureSigma(f1, lw, 0.02);
     build(lw, play);
     const auto f = FitChannels(
         cx, target, 1, [&](int i, int c, double* x) { x[0] = z(i, c); }, &e.pred);
@@ -54,7 +62,7 @@ std::optional<EffectFit> FitHysteresisOperator(const Context& cx, const Series& 
     if (!best.name.empty() && best.train_sse_w <= e.train_sse_w) continue;
     PutChannelCoef(cx, f, 0, "half_width_mvv", &e);
     e.params["travel_fraction"] = std::exp(lw);
-    e.sigma["travel_fraction"] = JsonNum(std::exp(lw) * sl);
+    e.sigma["travel_fraction"] = JsonNum(s.sigma);
     best = std::move(e);
   }
   best.channels = ActiveChannels(cx, best.pred);
@@ -250,7 +258,8 @@ EffectSpec HysteresisPlugin() {
           .traits = kLoadHistory,
           .fit = &FitHysteresisFamily,
           .refit = &RefitHysteresis,
-          .cost = 2};
+          .cost = 2,
+          .ranges = &HysteresisSpecs};
 }
 
 }  // namespace ftstack::diag

@@ -225,15 +225,14 @@ struct OperatorChoice {
 /// family with the lowest penalised cost wins.
 OperatorChoice ChooseOperators(const Context& cx, const Runs& runs, const std::vector<int>& axes,
                                const Eigen::VectorXd& range, double pen) {
-  std::vector<double> grid;
-  for (int j = 0; j <= 10; ++j) grid.push_back(std::log(0.002) + std::log(1000.0) * j / 10.0);
+  const ParamSpec width = fx::HysteresisSpecs(cx)[0];
   OperatorChoice best;
   double best_cost = std::numeric_limits<double>::infinity();
   for (bool play : {false, true}) {
     const auto f = [&](double v) {
       return Solve(cx, runs, OneOperator(axes, range, std::exp(v), play)).sse_w;
     };
-    const double lw = MinimizeOnGrid(f, grid, 10, nullptr);
+    const double lw = SolveParameter(width, f, {.sigma_step = 0.0}).coord;
     AxisOperators o = OneOperator(axes, range, std::exp(lw), play);
     const double cost = Solve(cx, runs, o).sse_w + (o.p() + 1) * pen;
     if (cost < best_cost) {

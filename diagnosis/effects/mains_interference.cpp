@@ -12,6 +12,18 @@
 
 namespace ftstack::diag::fx {
 
+/// The line's frequency: one cycle in the record to Nyquist (an alias above it shows below).
+std::vector<ParamSpec> MainsSpecs(const Context& cx) {
+  const auto& t = cx.data->t_s;
+  return {{.key = "freq_hz",
+           .lo = 1.0 / std::max(t.back() - t.front(), 1e-9),
+           .hi = cx.rate_hz / 2.0,
+           .lo_what = "one cycle in the record",
+           .hi_what = "Nyquist",
+           .unit = "Hz",
+           .scale = ParamScale::kLinear}};  // searched in Hz: a line's width is 1/duration
+}
+
 std::optional<EffectFit> FitMains(const Context& cx, const Series& target) {
   if (cx.peak_hz.empty()) return std::nullopt;
   const auto& d = *cx.data;
@@ -40,20 +52,23 @@ std::optional<EffectFit> FitMains(const Context& cx, const Series& target) {
   double best_sse = std::numeric_limits<double>::infinity();
   const double duration = d.t_s.back() - d.t_s.front();
   const double bin = cx.rate_hz / static_cast<double>(WelchSegment(static_cast<std::size_t>(cx.n)));
+  const ParamSpec spec = MainsSpecs(cx)[0];
+  const Profile profile = [&](double v) { return fit_at(v, nullptr, nullptr); };
   for (std::size_t p = 0; p < std::min<std::size_t>(cx.peak_hz.size(), 3); ++p) {
-    std::vector<double> grid;
-    for (int j = -8; j <= 8; ++j) grid.push_back(cx.peak_hz[p] + bin * j / 8.0);
-    double fmin = 0.0;
-    const double f =
-        MinimizeOnGrid([&](double v) { return fit_at(v, nullptr, nullptr); }, grid, 0, &fmin);
-    // Final refinement to a fraction of 1/duration.
-    std::vector<double> fine;
-    for (int j = -4; j <= 4; ++j) fine.push_back(f + bin / 8.0 * j / 4.0);
-    const double f2 =
-        MinimizeOnGrid([&](double v) { return fit_at(v, nullptr, nullptr); }, fine, 30, &fmin);
-    if (fmin < best_sse) {
-      best_sse = fmin;
-      best_f = f2;
+    // A grid over the line's Welch bin, then a golden refinement to a fraction of 1/duration.
+    SolveOptions coarse;
+    coarse.golden_steps = 0;
+    coarse.sigma_step = 0.0;
+    for (int j = -8; j <= 8; ++j) coarse.start.push_back(cx.peak_hz[p] + bin * j / 8.0);
+    const double f = SolveParameter(spec, profile, coarse).value;
+    SolveOptions fine;
+    fine.golden_steps = 30;
+    fine.sigma_step = 0.0;
+    for (int j = -4; j <= 4; ++j) fine.start.push_back(f + bin / 8.0 * j / 4.0);
+    const SolvedParam s = SolveParameter(spec, profile, fine);
+    if (s.objective < best_sse) {
+      best_sse = s.objective;
+      best_f = s.value;
     }
   }
   EffectFit e;
@@ -62,8 +77,7 @@ std::optional<EffectFit> FitMains(const Context& cx, const Series& target) {
   ChannelFit cf;
   e.train_sse_w = fit_at(best_f, &e.pred, &cf);
   e.params["freq_hz"] = best_f;
-  e.sigma["freq_hz"] = JsonNum(CurvatureSigma([&](double v) { return fit_at(v, nullptr, nullptr); },
-                                              best_f, 0.05 / std::max(duration, 1.0)));
+  e.sigma["freq_hz"] = JsonNum(ProfileSigma(profile, best_f, 0.05 / std::max(duration, 1.0)));
   Vec amp(cx.nc);
   for (int c = 0; c < cx.nc; ++c) amp(c) = std::hypot(cf.beta(0, c), cf.beta(1, c));
   e.params["amplitude_mvv"] = VecJson(amp);
@@ -141,12 +155,14 @@ std::string AddMainsHarmonics(const Context& cx, const Series& target, double f0
     Vec amp(cx.nc);
     Vec sg(cx.nc);
     const int j = 2 * static_cast<int>(k);
+    const Vec cs_a = CoefSigmas(cx, cf, j);
+    const Vec cs_b = CoefSigmas(cx, cf, j + 1);
     for (int c = 0; c < cx.nc; ++c) {
       const double a = cf.beta(j, c);
       const double b = cf.beta(j + 1, c);
       amp(c) = std::hypot(a, b);
-      const double sa = ParamSigma(cx, cf, c, j);
-      const double sb = ParamSigma(cx, cf, c, j + 1);
+      const double sa = cs_a(c);
+      const double sb = cs_b(c);
       sg(c) = amp(c) > 0 ? std::sqrt(a * a * sa * sa + b * b * sb * sb) / amp(c) : sa;
     }
     const std::string key =
@@ -166,7 +182,7 @@ std::string AddMainsHarmonics(const Context& cx, const Series& target, double f0
 namespace ftstack::diag {
 
 EffectSpec MainsInterferencePlugin() {
-  return {.kind = EffectKind::kMainsInterference, .fit = &fx::FitMains};
+  return {.kind = EffectKind::kMainsInterference, .fit = &fx::FitMains, .ranges = &fx::MainsSpecs};
 }
 
 }  // namespace ftstack::diag

@@ -10,6 +10,25 @@
 
 namespace ftstack::diag::fx {
 
+namespace {
+
+/// The largest rotation searched: a sensor mounted 20° off is a wrong axis, not a misalignment.
+constexpr double kMaxAngleDeg = 20.0;
+
+std::vector<ParamSpec> MisalignmentSpecs(const Context& /*cx*/) {
+  return {{.key = "angle_deg",
+           .lo = -kMaxAngleDeg,
+           .hi = kMaxAngleDeg,
+           .lo_what = "20° (a wrong axis, not a misalignment)",
+           .hi_what = "20° (a wrong axis, not a misalignment)",
+           .unit = "deg",
+           .scale = ParamScale::kLinear,
+           .grid_points = 81,
+           .golden_steps = 40}};
+}
+
+}  // namespace
+
 std::optional<EffectFit> FitMisalignment(const Context& cx, const Series& target) {
   if (!cx.data->has_wrench()) return std::nullopt;
   const auto& w = cx.data->wrench;
@@ -30,7 +49,7 @@ std::optional<EffectFit> FitMisalignment(const Context& cx, const Series& target
   };
   EffectFit best;
   double best_sse = std::numeric_limits<double>::infinity();
-  const double lim = 20.0 * M_PI / 180.0;
+  const double lim = kMaxAngleDeg * M_PI / 180.0;
   const char* names[3] = {"x", "y", "z"};
   for (int axis = 0; axis < 3; ++axis) {
     double rr = 0, r1 = 0, r2 = 0, q11 = 0, q22 = 0, q12 = 0;
@@ -57,10 +76,15 @@ std::optional<EffectFit> FitMisalignment(const Context& cx, const Series& target
       const double sn = std::sin(th);
       return rr - 2 * cm * r1 - 2 * sn * r2 + cm * cm * q11 + sn * sn * q22 + 2 * cm * sn * q12;
     };
-    std::vector<double> grid;
-    for (int j = -40; j <= 40; ++j) grid.push_back(lim * j / 40.0);
-    double fmin = 0.0;
-    const double th = MinimizeOnGrid(sse, grid, 40, &fmin);
+    // The engine searches in radians (the profile's own coordinate), the spec says degrees.
+    ParamSpec rad = MisalignmentSpecs(cx)[0];
+    rad.lo = -lim;
+    rad.hi = lim;
+    SolveOptions opt{.sigma_step = 1e-5};
+    for (int j = -40; j <= 40; ++j) opt.start.push_back(lim * j / 40.0);
+    const SolvedParam s = SolveParameter(rad, sse, opt);
+    const double th = s.value;
+    const double fmin = s.objective;
     if (fmin < best_sse) {
       best_sse = fmin;
       EffectFit e;
@@ -77,7 +101,7 @@ std::optional<EffectFit> FitMisalignment(const Context& cx, const Series& target
       }
       e.params["axis"] = names[axis];
       e.params["angle_deg"] = th * 180.0 / M_PI;
-      e.sigma["angle_deg"] = JsonNum(CurvatureSigma(sse, th, 1e-5) * 180.0 / M_PI);
+      e.sigma["angle_deg"] = JsonNum(s.sigma * 180.0 / M_PI);
       best = std::move(e);
     }
   }
@@ -96,7 +120,9 @@ std::optional<EffectFit> FitMisalignment(const Context& cx, const Series& target
 namespace ftstack::diag {
 
 EffectSpec MisalignmentPlugin() {
-  return {.kind = EffectKind::kMisalignment, .fit = &fx::FitMisalignment};
+  return {.kind = EffectKind::kMisalignment,
+          .fit = &fx::FitMisalignment,
+          .ranges = &fx::MisalignmentSpecs};
 }
 
 }  // namespace ftstack::diag

@@ -77,6 +77,20 @@ LogBounds RecoveryBounds(const Context& cx, double onset) {
   return {std::log(lo), std::log(hi)};
 }
 
+/// The declared recovery time constant: RecoveryBounds' ends for an onset at the record's start
+/// (the search of a later onset stays inside it).
+std::vector<ParamSpec> OverloadShiftSpecs(const Context& cx) {
+  const LogBounds b = RecoveryBounds(cx, cx.data->t_s.front());
+  return {{.key = "recovery_tau_s",
+           .lo = std::exp(b.lo),
+           .hi = std::exp(b.hi),
+           .lo_what = "3 samples and 0.2 s",
+           .hi_what = "a third of the record after the onset",
+           .unit = "s",
+           .grid_points = 13,
+           .golden_steps = 7}};
+}
+
 /// The whitened training SSE of the partly recovering shift with time constant tau_s, up to a
 /// constant (what the step and the recovery explain, negated): per channel a 2 × 2 solve on sums
 /// over the training rows after the onset, one exponential per row for all channels.
@@ -126,14 +140,11 @@ std::optional<double> RecoveryTau(const Context& cx, const Series& target, doubl
   };
   std::vector<std::vector<double>> grid;
   for (int k = 0; k <= 12; ++k) grid.push_back({b.lo + (b.hi - b.lo) * k / 12.0});
-  std::vector<double> x;
-  if (!std::isfinite(BestPoint(sse, grid, &x))) return std::nullopt;
-  GoldenRounds(
-      sse, {b}, {(b.hi - b.lo) / 12.0}, 0, 2, [](int) {}, &x);
-  const double margin = 0.02;  // 2 % in log, as EffectSpec::ranges
-  if (x[0] <= b.lo + margin || x[0] >= b.hi - margin) return std::nullopt;
-  *log_sigma = CurvatureSigma([&](double v) { return sse({v}); }, x[0], 0.02);
-  return std::exp(x[0]);
+  const std::vector<SolvedParam> s = SolveJoint(
+      sse, grid, {b}, {(b.hi - b.lo) / 12.0}, 0, 2, [](int) {}, kOnBound);
+  if (s.empty() || s[0].status != ParamStatus::kResolved) return std::nullopt;
+  *log_sigma = s[0].sigma / s[0].value;
+  return s[0].value;
 }
 
 /// The load peak nearest before the onset (an overload is the physical cause), in words.
@@ -213,7 +224,10 @@ std::optional<EffectFit> FitOverloadShift(const Context& cx, const Series& targe
 namespace ftstack::diag {
 
 EffectSpec OverloadShiftPlugin() {
-  return {.kind = EffectKind::kOverloadShift, .traits = kTimeBased, .fit = &fx::FitOverloadShift};
+  return {.kind = EffectKind::kOverloadShift,
+          .traits = kTimeBased,
+          .fit = &fx::FitOverloadShift,
+          .ranges = &fx::OverloadShiftSpecs};
 }
 
 }  // namespace ftstack::diag

@@ -1,6 +1,7 @@
 // The effect plug-ins, in the vocabulary's order: one line per family, X(Family) for the plug-in
-// `EffectSpec FamilyPlugin()` defined at the end of effects/family.cpp (its kind, traits and fit
-// functions). A new family is one new file and one line here.
+// `EffectSpec FamilyPlugin()` defined at the end of its family's file (effects/zero_offset.cpp, …:
+// its kind, traits, fit functions and declared parameters). A new family is one new file and one
+// line here.
 #include <vector>
 
 #include "diagnosis/engine/effect.hpp"

@@ -40,6 +40,15 @@ bool InRange(const Context& cx, double f_hz, double zeta) {
   return f_hz >= kMinFreqHz && f_hz <= MaxFreqHz(cx) && zeta >= kMinZeta && zeta <= kMaxZeta;
 }
 
+/// Resonance's physical ranges (those of its search): every mode below Nyquist, lightly damped.
+std::vector<ParamSpec> ResonanceSpecs(const Context& cx) {
+  const double f_hi = MaxFreqHz(cx);
+  return {{"freq_hz", kMinFreqHz, f_hi, "0.05 Hz", "0.98 × Nyquist", "Hz"},
+          {"damping_ratio", kMinZeta, kMaxZeta, "Q 500", "a step response that rings"},
+          {"freq2_hz", kMinFreqHz, f_hi, "0.05 Hz", "0.98 × Nyquist", "Hz"},
+          {"damping_ratio2", kMinZeta, kMaxZeta, "Q 500", "a step response that rings"}};
+}
+
 /// The coarse frequency grid: ±8 % around each of the 3 strongest lines of the residual spectrum
 /// and of the 3 lines standing most out of their neighbourhood (LocalLines: a light ringing under
 /// a red spectrum), or 12 log-spaced points from 1 Hz to 0.9 × Nyquist without any.
@@ -183,14 +192,16 @@ bool SearchOneMode(const Context& cx, const Series& target, const EffectFit* nea
         points.push_back({std::log(f), std::log(z)});
     }
     sse->windowed = sse->w1 - sse->w0 < cx.n;  // the coarse grid and the first round
-    best_sse = BestPoint(on_coarse, points, &best);
+    best_sse = JointStart(on_coarse, points, &best);
   }
   if (!std::isfinite(best_sse)) return false;
   // A light damping has a narrow optimum in f: the frequency steps shrink with ζ.
   const double f_step = std::clamp(4.0 * std::exp(best[1]), 0.004, 0.04);
   const std::vector<LogBounds> bounds = {{std::log(kMinFreqHz), std::log(MaxFreqHz(cx))},
                                          {std::log(kMinZeta), std::log(kMaxZeta)}};
-  GoldenRounds(
+  // Statuses unused: a mode on a bound is judged by the variant choice (FirstModeOnBound) and by
+  // the declared range (NotResolved).
+  (void)JointRefine(
       on_coarse, bounds, {f_step, 0.3}, warm ? 1 : 0, 2,
       [&](int round) {
         if (round != 1) return;
@@ -266,9 +277,9 @@ std::optional<EffectFit> LockedRingingSearch(const Context& cx, const Series& ta
     // The curvature step in log f stays inside the optimum's width (about ζ).
     const double step = std::min(0.002, 0.25 * z);
     e.sigma["freq_hz"] = JsonNum(
-        f * CurvatureSigma([&](double v) { return sse(std::exp(v), z, all); }, log_fz[0], step));
+        f * ProfileSigma([&](double v) { return sse(std::exp(v), z, all); }, log_fz[0], step));
     e.sigma["damping_ratio"] = JsonNum(
-        z * CurvatureSigma([&](double v) { return sse(f, std::exp(v), all); }, log_fz[1], 0.02));
+        z * ProfileSigma([&](double v) { return sse(f, std::exp(v), all); }, log_fz[1], kOnBound));
   }
   PutChannelCoef(cx, cf, 0, "participation", &e);
   sse.h = Mat();
@@ -287,10 +298,11 @@ std::optional<EffectFit> LockedRingingSearch(const Context& cx, const Series& ta
 
 namespace {
 
-/// Whether a mode at (log f, log ζ) ended within 2 % of its search's bounds (not resolved).
+/// Whether a mode at (log f, log ζ) ended on a bound of its declared range (the engine's rule).
 bool OnBound(const Context& cx, double log_f, double log_z) {
-  return log_f < std::log(kMinFreqHz) + 0.02 || log_f > std::log(MaxFreqHz(cx)) - 0.02 ||
-         log_z < std::log(kMinZeta) + 0.02 || log_z > std::log(kMaxZeta) - 0.02;
+  const std::vector<ParamSpec> specs = ResonanceSpecs(cx);
+  return StatusOf(specs[0], std::exp(log_f)) != ParamStatus::kResolved ||
+         StatusOf(specs[1], std::exp(log_z)) != ParamStatus::kResolved;
 }
 
 }  // namespace
@@ -412,10 +424,17 @@ bool SearchModes(const Context& cx, const Series& target, const std::vector<int>
         g1.push_back(log_freq[m] + 0.04 * j / (round + 1));
         g2.push_back(log_zeta[m] + 0.3 * j / (round + 1));
       }
-      log_freq[m] = MinimizeOnGrid(
-          [&](double v) { return sse(m, std::exp(v), std::exp(log_zeta[m])); }, g1, 7, nullptr);
-      log_zeta[m] = MinimizeOnGrid(
-          [&](double v) { return sse(m, std::exp(log_freq[m]), std::exp(v)); }, g2, 7, nullptr);
+      const std::vector<ParamSpec> specs = ResonanceSpecs(cx);
+      log_freq[m] =
+          SolveParameter(
+              specs[2 * m], [&](double v) { return sse(m, std::exp(v), std::exp(log_zeta[m])); },
+              GridOnly(g1, 7))
+              .coord;
+      log_zeta[m] =
+          SolveParameter(
+              specs[2 * m + 1],
+              [&](double v) { return sse(m, std::exp(log_freq[m]), std::exp(v)); }, GridOnly(g2, 7))
+              .coord;
     }
   }
   return true;
@@ -442,10 +461,10 @@ void ModeCurvatures(const Context& cx, const Series& target, const double* log_f
       });
       return sums.Solve(cx).sse_w;
     };
-    slf[m] = CurvatureSigma([&](double v) { return sse_all(std::exp(v), std::exp(log_zeta[m])); },
-                            log_freq[m], 0.002);
-    slz[m] = CurvatureSigma([&](double v) { return sse_all(std::exp(log_freq[m]), std::exp(v)); },
-                            log_zeta[m], 0.02);
+    slf[m] = ProfileSigma([&](double v) { return sse_all(std::exp(v), std::exp(log_zeta[m])); },
+                          log_freq[m], 0.002);
+    slz[m] = ProfileSigma([&](double v) { return sse_all(std::exp(log_freq[m]), std::exp(v)); },
+                          log_zeta[m], kOnBound);
   }
 }
 
@@ -524,25 +543,12 @@ std::string AddResonanceMode(const Context& cx, const Series& target, double f1_
 
 namespace ftstack::diag {
 
-namespace {
-
-/// Resonance's physical ranges (those of its search): every mode below Nyquist, lightly damped.
-std::vector<ParamRange> ResonanceRanges(const Context& cx) {
-  const double f_hi = fx::MaxFreqHz(cx);
-  return {{"freq_hz", fx::kMinFreqHz, f_hi, "0.05 Hz", "0.98 × Nyquist"},
-          {"damping_ratio", fx::kMinZeta, fx::kMaxZeta, "Q 500", "a step response that rings"},
-          {"freq2_hz", fx::kMinFreqHz, f_hi, "0.05 Hz", "0.98 × Nyquist"},
-          {"damping_ratio2", fx::kMinZeta, fx::kMaxZeta, "Q 500", "a step response that rings"}};
-}
-
-}  // namespace
-
 EffectSpec ResonancePlugin() {
   return {.kind = EffectKind::kResonance,
           .fit = &fx::FitBy<&fx::ResonanceSearch>,
           .refit = &fx::RefitBy<&fx::ResonanceSearch>,
           .cost = 8,
-          .ranges = &ResonanceRanges};
+          .ranges = &fx::ResonanceSpecs};
 }
 
 }  // namespace ftstack::diag

@@ -17,7 +17,7 @@ namespace ftstack::diag::fx {
 
 namespace {
 
-/// Search bounds of the variant (inside resonance's stated range, ParamRange): light damping only
+/// Search bounds of the variant (inside resonance's stated range, ParamSpec): light damping only
 /// (heavier "ringing" with a free start per change would mimic per-hold offsets and creep), and at
 /// least kMinPeriods periods in the median stretch between changes.
 constexpr double kMinZeta = 1e-3;
@@ -233,17 +233,15 @@ bool SearchNearLine(const Context& cx, const Series& detrended, const std::vecto
       for (double z : {0.001, 0.003, 0.01, 0.03})
         points.push_back({std::log(line_hz * m), std::log(z)});
     }
-    if (!std::isfinite(BestPoint(sse, points, best))) return false;
+    if (!std::isfinite(JointStart(sse, points, best))) return false;
   }
-  GoldenRounds(
+  const std::vector<ParamStatus> status = JointRefine(
       sse, bounds, {0.01, 0.4}, warm != nullptr ? 1 : 0, 2,
       [&](int round) {
         if (round == 1) row_step = 1;
       },
       best);
-  const auto& x = *best;
-  return x[0] > bounds[0].lo + 0.02 && x[0] < bounds[0].hi - 0.02 && x[1] > bounds[1].lo + 0.02 &&
-         x[1] < bounds[1].hi - 0.02;
+  return status[0] == ParamStatus::kResolved && status[1] == ParamStatus::kResolved;
 }
 
 }  // namespace
@@ -310,10 +308,10 @@ std::optional<EffectFit> RingingPerChange(const Context& cx, const Series& targe
     const auto at = [&](double lf, double lz) {
       return FitRing(cx, detrended, starts, std::exp(lf), std::exp(lz), settle_s, all, 1).sse_w;
     };
-    e.sigma["freq_hz"] = JsonNum(f * CurvatureSigma([&](double v) { return at(v, best[1]); },
-                                                    best[0], std::min(0.002, 0.25 * z)));
+    e.sigma["freq_hz"] = JsonNum(f * ProfileSigma([&](double v) { return at(v, best[1]); }, best[0],
+                                                  std::min(0.002, 0.25 * z)));
     e.sigma["damping_ratio"] =
-        JsonNum(z * CurvatureSigma([&](double v) { return at(best[0], v); }, best[1], 0.02));
+        JsonNum(z * ProfileSigma([&](double v) { return at(best[0], v); }, best[1], kOnBound));
   }
   e.search_state = best;
   e.channels = ActiveChannels(cx, e.pred);

@@ -43,12 +43,25 @@ std::optional<EffectFit> FitSaturation(const Context& cx, const Series& target) 
     return sse;
   };
   const double range = std::max(sim_hi - sim_lo, 1e-9);
+  // Each limit searched within 4 % of the load's range around the real file's extreme.
   auto refine = [&](double start, bool upper, double other) {
-    std::vector<double> grid;
-    for (int j = -4; j <= 4; ++j) grid.push_back(start + 0.01 * range * j);
-    return MinimizeOnGrid(
-        [&](double v) { return upper ? predict(other, v, nullptr) : predict(v, other, nullptr); },
-        grid, 12, nullptr);
+    const ParamSpec spec{.key = upper ? "limit_high" : "limit_low",
+                         .lo = start - 0.04 * range,
+                         .hi = start + 0.04 * range,
+                         .unit = "mV/V",
+                         .scale = ParamScale::kLinear,
+                         .grid_points = 9,
+                         .golden_steps = 12};
+    SolveOptions opt;
+    opt.sigma_step = 0.0;
+    for (int j = -4; j <= 4; ++j) opt.start.push_back(start + 0.01 * range * j);
+    return SolveParameter(
+               spec,
+               [&](double v) {
+                 return upper ? predict(other, v, nullptr) : predict(v, other, nullptr);
+               },
+               opt)
+        .value;
   };
   const double h1 = refine(hi, true, -std::numeric_limits<double>::infinity());
   const double l1 = refine(lo, false, h1);
@@ -90,8 +103,28 @@ std::optional<EffectFit> FitSaturation(const Context& cx, const Series& target) 
 
 namespace ftstack::diag {
 
+namespace {
+
+/// The clipping level: above zero, below the sim's largest reading (a limit above it clips
+/// nothing).
+std::vector<ParamSpec> SaturationSpecs(const Context& cx) {
+  double peak = 1e-9;
+  for (int c = 0; c < cx.nc; ++c) {
+    for (int i = 0; i < cx.n; ++i) peak = std::max(peak, std::fabs(cx.sim_mvv(i, c)));
+  }
+  return {{.key = "limit",
+           .lo = 0.0,
+           .hi = peak,
+           .lo_what = "zero",
+           .hi_what = "the sim's largest reading",
+           .unit = "mV/V",
+           .scale = ParamScale::kLinear}};
+}
+
+}  // namespace
+
 EffectSpec SaturationPlugin() {
-  return {.kind = EffectKind::kSaturation, .fit = &fx::FitSaturation};
+  return {.kind = EffectKind::kSaturation, .fit = &fx::FitSaturation, .ranges = &SaturationSpecs};
 }
 
 }  // namespace ftstack::diag

@@ -28,9 +28,10 @@ std::optional<EffectFit> SelectedChannelFit(const Context& cx, const Series& tar
   e.channels = sel;
   auto coefs = nlohmann::json::array();
   auto sig = nlohmann::json::array();
+  const Vec s = CoefSigmas(cx, *fit, 0);
   for (int c : sel) {
     coefs.push_back(fit->beta(0, c));
-    sig.push_back(ParamSigma(cx, *fit, c, 0));
+    sig.push_back(s(c));
   }
   e.params["channels"] = IntList(sel);
   e.params[coef_name] = coefs;

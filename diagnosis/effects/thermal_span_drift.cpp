@@ -44,8 +44,7 @@ std::optional<EffectFit> FitThermalSpan(const Context& cx, const Series& target)
   const double bic_a = rc.sse + 2 * Penalty(cx);
   const double bic_b = fb.sse_w + 2 * cx.nc * Penalty(cx);
   Vec kb = fb.beta.row(0).transpose();
-  Vec kbs(cx.nc);
-  for (int c = 0; c < cx.nc; ++c) kbs(c) = ParamSigma(cx, fb, c, 0);
+  const Vec kbs = CoefSigmas(cx, fb, 0);
   if (bic_a <= bic_b) {
     e.variant = "common coefficient";
     e.pred = std::move(pa);

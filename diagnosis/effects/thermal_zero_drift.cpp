@@ -59,10 +59,21 @@ std::optional<EffectFit> FitThermalZeroOn(const Context& cx, const Series& targe
 
 namespace ftstack::diag {
 
+std::vector<ParamSpec> ThermalLagSpecs(const Context& cx) {
+  const auto& t = cx.data->t_s;
+  return {{.key = "lag_s",
+           .lo = std::max(2.0 * cx.dt, 1e-3),
+           .hi = std::max((t.back() - t.front()) / 6.0, 4.0 * cx.dt),
+           .lo_what = "2 samples",
+           .hi_what = "a sixth of the record",
+           .unit = "s",
+           .grid_points = 14,
+           .golden_steps = 12}};
+}
+
 std::optional<EffectFit> FitThermalZeroLagged(const Context& cx, const Series& target) {
   if (cx.dtemp.empty()) return std::nullopt;
   const auto& t = cx.data->t_s;
-  const double duration = t.back() - t.front();
   const std::uint8_t* restart = cx.restart.empty() ? nullptr : cx.restart.data();
   std::vector<double> lagged(cx.dtemp.size());
   auto at = [&](double tau) {
@@ -78,26 +89,16 @@ std::optional<EffectFit> FitThermalZeroLagged(const Context& cx, const Series& t
   };
   const auto none = at(0.0);
   if (!none) return std::nullopt;
-  // Lags from 2 sample periods to a sixth of the record, log-spaced.
-  const double lo = std::log(std::max(2.0 * cx.dt, 1e-3));
-  const double hi = std::log(std::max(duration / 6.0, 4.0 * cx.dt));
-  std::vector<double> grid;
-  for (int j = 0; j < 14; ++j) grid.push_back(lo + (hi - lo) * j / 13.0);
-  double best_sse = 0.0;
-  const double best_log = MinimizeOnGrid(sse, grid, 12, &best_sse);
+  const SolvedParam s = SolveParameter(ThermalLagSpecs(cx)[0], sse, {.sigma_step = 0.05});
+  const double best_sse = s.objective;
   // The lag must pay for itself clearly (as a whole extra effect would): else the plain model.
   const double margin = 10.0 * std::log(std::max<double>(2.0, static_cast<double>(cx.n_train)));
   if (!(best_sse < none->train_sse_w - margin)) return none;
-  const double tau = std::exp(best_log);
+  const double tau = s.value;
   auto fit = at(tau);
   if (!fit) return none;
-  // 1-σ of τ from the curvature of the whitened training χ² in log τ (Δχ² = 1).
-  const double h = 0.05;
-  const double curv = (sse(best_log + h) - 2.0 * best_sse + sse(best_log - h)) / (h * h);
-  const double sigma_log =
-      curv > 0 ? std::sqrt(2.0 / curv) : std::numeric_limits<double>::infinity();
   fit->params["lag_s"] = tau;
-  fit->sigma["lag_s"] = std::isfinite(sigma_log) ? tau * sigma_log : -1.0;
+  fit->sigma["lag_s"] = fx::JsonNum(s.sigma);
   fit->variant = "offset + k·LP_τ[ΔT] (the gauges' temperature lags the thermometer by τ)";
   fit->n_params += 1;
   char buf[96];
@@ -120,7 +121,8 @@ EffectSpec ThermalZeroDriftPlugin() {
   return {.kind = EffectKind::kThermalZeroDrift,
           .traits = kTimeBased | kNeedsTemperature,
           .fit = &fx::FitThermalZeroPlain,
-          .refine_claim = &RefineWithThermalLag};
+          .refine_claim = &RefineWithThermalLag,
+          .ranges = &ThermalLagSpecs};
 }
 
 }  // namespace ftstack::diag

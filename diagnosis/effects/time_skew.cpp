@@ -10,6 +10,24 @@
 
 namespace ftstack::diag::fx {
 
+namespace {
+
+/// The delay: a tenth of the record either way (a longer one is a misaligned file, not a skew);
+/// searched around the closed-form estimate from the sim's slope.
+std::vector<ParamSpec> TimeSkewSpecs(const Context& cx) {
+  const auto& t = cx.data->t_s;
+  const double d = std::max((t.back() - t.front()) / 10.0, 10.0 * cx.dt);
+  return {{.key = "delay_s",
+           .lo = -d,
+           .hi = d,
+           .lo_what = "a tenth of the record (real leads)",
+           .hi_what = "a tenth of the record (real lags)",
+           .unit = "s",
+           .scale = ParamScale::kLinear}};
+}
+
+}  // namespace
+
 std::optional<EffectFit> FitTimeSkew(const Context& cx, const Series& target) {
   const auto& d = *cx.data;
   auto predict = [&](double delay, Series* out) {
@@ -48,18 +66,18 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Series& target) {
   if (den <= 0) return std::nullopt;
   const double d0 = num / den;
   const double span = std::max(2.0 * cx.dt, std::fabs(d0));
-  std::vector<double> grid;
-  for (int j = -6; j <= 6; ++j) grid.push_back(d0 + span * j / 6.0);
-  double fmin = 0.0;
-  auto f = [&](double v) { return predict(v, nullptr); };
-  const double delay = MinimizeOnGrid(f, grid, 16, &fmin);
+  SolveOptions opt{.golden_steps = 16, .sigma_step = 0.02 * cx.dt};
+  for (int j = -6; j <= 6; ++j) opt.start.push_back(d0 + span * j / 6.0);
+  const SolvedParam s = SolveParameter(
+      TimeSkewSpecs(cx)[0], [&](double v) { return predict(v, nullptr); }, opt);
+  const double delay = s.value;
   EffectFit e;
   e.name = "time_skew";
   e.n_params = 1;
   e.pred.resize(cx.n, cx.nc);
   e.train_sse_w = predict(delay, &e.pred);
   e.params["delay_s"] = delay;
-  e.sigma["delay_s"] = JsonNum(CurvatureSigma(f, delay, 0.02 * cx.dt));
+  e.sigma["delay_s"] = JsonNum(s.sigma);
   e.channels = ActiveChannels(cx, e.pred);
   const int c = DominantChannel(cx, e.pred);
   e.evidence =
@@ -74,6 +92,8 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Series& target) {
 
 namespace ftstack::diag {
 
-EffectSpec TimeSkewPlugin() { return {.kind = EffectKind::kTimeSkew, .fit = &fx::FitTimeSkew}; }
+EffectSpec TimeSkewPlugin() {
+  return {.kind = EffectKind::kTimeSkew, .fit = &fx::FitTimeSkew, .ranges = &fx::TimeSkewSpecs};
+}
 
 }  // namespace ftstack::diag

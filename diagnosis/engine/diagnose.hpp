@@ -31,6 +31,7 @@ struct CandidateScore {
   double score = 0.0;           ///< held-out Δχ² minus the parameter penalty
   bool eligible = false;        ///< passed the claim thresholds
   std::string not_resolved;     ///< why the fit is not resolved (NotResolved), or ""
+  nlohmann::json parameters = nlohmann::json::array();  ///< TypedParameters of its fit
 };
 
 /// A claimed effect with its fitted model and held-out figures.

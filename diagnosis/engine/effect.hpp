@@ -26,7 +26,7 @@ struct EffectFit {
   double train_sse_w = 0.0;  ///< whitened training SSE after the fit
   /// The nonlinear parameters as the search left them (a RefitFn's start; not reported).
   std::vector<double> search_state;
-  /// Empty when every ranged parameter (EffectSpec::ranges) ended inside its range; else why the
+  /// Empty when every declared parameter (EffectSpec::ranges) ended inside its range; else why the
   /// fit is not resolved (a parameter on a search bound or outside its physical range): such a
   /// fit is never claimed.
   std::string not_resolved;
@@ -34,17 +34,28 @@ struct EffectFit {
   nlohmann::json spread = nlohmann::json::object();
 };
 
-/// A parameter's physical range, which is also its search's bounds: a fit ending within 2 % of a
-/// bound (in log, for positive ranges) or outside it is not resolved.
-struct ParamRange {
+/// How the engine searches a nonlinear parameter: in log of its value (a scale, > 0) or linearly
+/// (a location or a signed quantity).
+enum class ParamScale { kLog, kLinear };
+
+/// A parameter an effect declares to the engine: its key and unit, its physical range (which is
+/// also its search's bounds) with the reason for each end, its search scale and its start grid. A
+/// fit ending within kOnBound of a bound (in log, for positive ranges; of the range, else) or
+/// outside it is not resolved and never claimed.
+struct ParamSpec {
   const char* key = "";  ///< params key: a number, or per-channel numbers (their largest |value|)
   double lo = 0.0;  ///< lower bound; 0 for per-channel numbers (only |value| ≤ hi is checked)
   double hi = 0.0;  ///< upper bound
   const char* lo_what = "";  ///< the lower bound's meaning in words ("3 samples")
   const char* hi_what = "";  ///< the upper bound's ("a third of the record")
+  /// Unit of the value; the vocabulary's (measurement/effect_vocabulary) wins where it has the key.
+  const char* unit = "";
+  ParamScale scale = ParamScale::kLog;
+  int grid_points = 11;   ///< the start grid: this many points evenly over [lo, hi] in `scale`
+  int golden_steps = 10;  ///< golden-section steps refining the best grid point
 };
-/// The ranges of an effect's parameters on a context (sample interval, record length, Nyquist).
-using RangesFn = std::vector<ParamRange> (*)(const Context&);
+/// The declared parameters of an effect on a context (sample interval, record length, Nyquist).
+using ParamSpecsFn = std::vector<ParamSpec> (*)(const Context&);
 
 using FitFn = std::optional<EffectFit> (*)(const Context&, const Series& target);
 /// Refits an effect near an earlier fit of the same effect: `near`'s nonlinear parameters start a
@@ -90,7 +101,8 @@ struct EffectSpec {
   RefitFn refit = nullptr;  ///< nullptr: the effect has no costly search; fit() is used
   int cost = 1;  ///< relative cost of a fit: when fits run in parallel, costlier ones start first
   RefineFn refine_claim = nullptr;  ///< nullptr: a claim is reported as ranked
-  RangesFn ranges = nullptr;        ///< nullptr: no stated range (linear parameters only)
+  /// Its nonlinear parameters (and scales with a physical range); nullptr: linear parameters only.
+  ParamSpecsFn ranges = nullptr;
   /// The vocabulary's name of `kind` (the report's and the confounders' key).
   const char* name = EffectOf(kind).name.data();
 

@@ -18,20 +18,18 @@ using fx::Fmt;
 namespace {
 
 /// Why one scalar value is not resolved against range r, or "".
-std::string ScalarWords(const ParamRange& r, double v) {
+std::string ScalarWords(const ParamSpec& r, double v) {
   if (!std::isfinite(v)) return Fmt("%s is not finite", r.key);
+  if (StatusOf(r, v) == ParamStatus::kResolved) return "";  // the engine's rule; below, its words
   const bool log_scale = r.lo > 0.0 && v > 0.0;
   const double below = log_scale ? std::log(v / r.lo) : (v - r.lo) / (r.hi - r.lo);
   const double above = log_scale ? std::log(r.hi / v) : (r.hi - v) / (r.hi - r.lo);
   if (below < 0.0) return Fmt("%s = %.4g below its range (%s, %.4g)", r.key, v, r.lo_what, r.lo);
   if (above < 0.0) return Fmt("%s = %.4g above its range (%s, %.4g)", r.key, v, r.hi_what, r.hi);
-  if (below < kOnBound) {
+  if (below < above) {
     return Fmt("%s = %.4g at its lower bound (%s, %.4g)", r.key, v, r.lo_what, r.lo);
   }
-  if (above < kOnBound) {
-    return Fmt("%s = %.4g at its upper bound (%s, %.4g)", r.key, v, r.hi_what, r.hi);
-  }
-  return "";
+  return Fmt("%s = %.4g at its upper bound (%s, %.4g)", r.key, v, r.hi_what, r.hi);
 }
 
 /// The values of a parameter (one, or one per channel) as doubles; empty when not numbers.
@@ -99,8 +97,12 @@ nlohmann::json OneSpread(const std::vector<std::vector<double>>& pieces,
 
 std::string NotResolved(const Context& cx, const EffectFit& fit) {
   const EffectSpec* spec = FindEffect(fit.name);
-  if (spec == nullptr || spec->ranges == nullptr) return "";
-  for (const ParamRange& r : spec->ranges(cx)) {
+  return spec == nullptr ? "" : NotResolved(cx, fit, *spec);
+}
+
+std::string NotResolved(const Context& cx, const EffectFit& fit, const EffectSpec& spec) {
+  if (spec.ranges == nullptr) return "";
+  for (const ParamSpec& r : spec.ranges(cx)) {
     if (!fit.params.contains(r.key)) continue;
     const std::vector<double> v = Values(fit.params[r.key]);
     if (v.size() == 1 && fit.params[r.key].is_number()) {
@@ -115,6 +117,76 @@ std::string NotResolved(const Context& cx, const EffectFit& fit) {
     }
   }
   return "";
+}
+
+nlohmann::json TypedParameters(const Context& cx, const EffectFit& fit) {
+  const EffectSpec* spec = FindEffect(fit.name);
+  if (spec != nullptr) return TypedParameters(cx, fit, *spec);
+  const EffectSpec none{};
+  return TypedParameters(cx, fit, none);
+}
+
+nlohmann::json TypedParameters(const Context& cx, const EffectFit& fit, const EffectSpec& plugin) {
+  const EffectSpec* spec = plugin.kind == EffectKind::kNone ? nullptr : &plugin;
+  std::vector<ParamSpec> declared;
+  if (plugin.ranges != nullptr) declared = plugin.ranges(cx);
+  auto out = nlohmann::json::array();
+  for (auto it = fit.params.begin(); it != fit.params.end(); ++it) {
+    const std::string& key = it.key();
+    const nlohmann::json& v = it.value();
+    if (v.is_number_integer() || v.is_boolean()) continue;  // a count: a model order, not fitted
+    const std::vector<double> values = Values(v);
+    if (values.empty()) continue;
+    const ParamSpec* d = nullptr;
+    for (const ParamSpec& p : declared) {
+      if (key == p.key) d = &p;
+    }
+    nlohmann::json unit = nullptr;
+    const EffectParam* vocab =
+        spec != nullptr ? FindParam(EffectOf(spec->kind), key, false) : nullptr;
+    if (vocab != nullptr) {
+      unit = std::string(vocab->unit);
+    } else if (d != nullptr) {
+      unit = d->unit;
+    }
+    const nlohmann::json sigma = fit.sigma.contains(key) ? fit.sigma[key] : nlohmann::json();
+    double largest = 0.0;
+    for (double x : values) largest = std::max(largest, std::fabs(x));
+    ParamStatus status = ParamStatus::kResolved;
+    if (d != nullptr) {
+      const bool scalar = v.is_number();
+      status = scalar ? StatusOf(*d, values[0])
+                      : (largest > d->hi ? ParamStatus::kAtBound : ParamStatus::kResolved);
+    }
+    const std::vector<double> sig = Values(sigma);
+    bool sigma_finite = !sig.empty();
+    for (double s : sig) sigma_finite = sigma_finite && std::isfinite(s);
+    if (status == ParamStatus::kResolved && !sigma_finite) status = ParamStatus::kNotIdentified;
+    nlohmann::json spread = nullptr;
+    std::string spread_why;
+    if (fit.spread.contains(key) && fit.spread[key].contains("sigma")) {
+      spread = fit.spread[key]["sigma"];
+      const auto& agree = fit.spread[key]["agree"];
+      if (status == ParamStatus::kResolved && agree.is_boolean() && !agree.get<bool>()) {
+        status = ParamStatus::kPiecesDisagree;
+      }
+    } else if (fit.spread.contains(key)) {
+      spread_why = "fewer than two pieces resolved it";
+    } else {
+      spread_why = fit.spread.empty() ? "not refitted on pieces (only claimed effects are)"
+                                      : "no σ to compare pieces with";
+    }
+    nlohmann::json p = {{"key", key},
+                        {"unit", unit},
+                        {"value", v},
+                        {"sigma", sigma},
+                        {"range", d != nullptr ? nlohmann::json{d->lo, d->hi} : nlohmann::json()},
+                        {"spread", spread},
+                        {"status", StatusName(status)}};
+    if (spread.is_null()) p["spread_why"] = spread_why;
+    out.push_back(p);
+  }
+  return out;
 }
 
 void PieceSpreads(Context* cx, const Series& target, EffectFit* fit) {
@@ -197,7 +269,11 @@ std::string PiecesContradict(const Context& cx, const EffectFit& fit) {
   const EffectSpec* spec = FindEffect(fit.name);
   if (spec == nullptr || spec->ranges == nullptr) return "";
   std::vector<std::string> ranged;
-  for (const ParamRange& r : spec->ranges(cx)) ranged.emplace_back(r.key);
+  // Parameters of one sign by their physics (lo ≥ 0): pieces of both signs contradict them. A
+  // signed parameter (a delay, an angle) near zero may take either sign in a piece.
+  for (const ParamSpec& r : spec->ranges(cx)) {
+    if (r.lo >= 0.0) ranged.emplace_back(r.key);
+  }
   for (auto it = fit.spread.begin(); it != fit.spread.end(); ++it) {
     const auto& s = it.value();
     if (!s.contains("min") || !fit.params.contains(it.key())) continue;

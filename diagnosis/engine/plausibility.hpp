@@ -2,19 +2,21 @@
 // off the search bounds) and how far they move across independent pieces of the record.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "diagnosis/engine/context.hpp"
 #include "diagnosis/engine/effect.hpp"
+#include "diagnosis/engine/solve.hpp"
 
 namespace ftstack::diag {
-
-/// Closeness to a bound that counts as "on" it: 2 % in log (positive ranges) or of the range.
-inline constexpr double kOnBound = 0.02;
 
 /// Why `fit` is not resolved ("tau_s = 0.30 s at its lower bound (3 samples)"), or "" when every
 /// ranged parameter of its plug-in lies inside its range, more than 2 % (in log) from each bound.
 [[nodiscard]] std::string NotResolved(const Context& cx, const EffectFit& fit);
+/// The same against a given plug-in (one the registry need not hold).
+[[nodiscard]] std::string NotResolved(const Context& cx, const EffectFit& fit,
+                                      const EffectSpec& spec);
 
 /// Number of independent pieces PieceSpreads refits on.
 inline constexpr int kSpreadPieces = 4;
@@ -36,5 +38,17 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit);
 /// time, nor a load-dependent coefficient the pieces' load coverage moves) and a spread, the
 /// pieces' values (of its largest-|value| element) straddle zero. Empty when none does.
 [[nodiscard]] std::string PiecesContradict(const Context& cx, const EffectFit& fit);
+
+/// The report's typed `parameters` of a fit (docs/spec/diagnosis.md): one object per fitted
+/// numeric parameter of fit.params (counts, integers, are model orders and left out) with "key",
+/// "unit" (the vocabulary's, else the effect's declaration, else null), "value", "sigma" (null
+/// without one), "range" ([lo, hi] from the declaration, else null), "spread" (the pieces' σ, or
+/// null) with "spread_why" when null, and "status": at_bound or not_identified by the declared
+/// range and σ (StatusOf), pieces_disagree when the spread says so, else resolved; a parameter
+/// without a declaration and without a σ is not_identified.
+[[nodiscard]] nlohmann::json TypedParameters(const Context& cx, const EffectFit& fit);
+/// The same against a given plug-in (one the registry need not hold).
+[[nodiscard]] nlohmann::json TypedParameters(const Context& cx, const EffectFit& fit,
+                                             const EffectSpec& spec);
 
 }  // namespace ftstack::diag

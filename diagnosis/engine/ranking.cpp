@@ -284,6 +284,7 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
     c.score = s.score;
     c.eligible = s.eligible;
     c.not_resolved = s.fit.not_resolved;
+    c.parameters = TypedParameters(r.cx, s.fit);
     r.candidates.push_back(c);
   }
   return singles;

@@ -23,14 +23,10 @@ double ParamSigma(const Context& cx, const ChannelFit& f, int c, int j) {
   return std::sqrt(std::max(0.0, f.cov[static_cast<std::size_t>(c)](j, j) * f.sse(c) / dof));
 }
 
-/// Uncertainty of a nonlinear parameter from the curvature of the profile SSE (whitened, so
-/// Δχ² = 1 at one σ): σ = sqrt(2 / f'').
-double CurvatureSigma(const std::function<double(double)>& f, double x, double h) {
-  const double f0 = f(x);
-  const double fp = f(x + h);
-  const double fm = f(x - h);
-  const double d2 = (fp - 2.0 * f0 + fm) / (h * h);
-  return d2 > 0 ? std::sqrt(2.0 / d2) : std::numeric_limits<double>::quiet_NaN();
+Vec CoefSigmas(const Context& cx, const ChannelFit& f, int j) {
+  Vec s(cx.nc);
+  for (int c = 0; c < cx.nc; ++c) s(c) = ParamSigma(cx, f, c, j);
+  return s;
 }
 
 void RingingAt(const Context& cx, double f_hz, double zeta, const std::vector<int>& chans, int i0,
@@ -80,8 +76,7 @@ nlohmann::json VecJson(const Vec& v) {
 /// Puts coefficient j of every channel and its σ into e.params[key] / e.sigma[key]; returns it.
 Vec PutChannelCoef(const Context& cx, const ChannelFit& f, int j, const char* key, EffectFit* e) {
   Vec v = f.beta.row(j).transpose();
-  Vec sg(cx.nc);
-  for (int c = 0; c < cx.nc; ++c) sg(c) = ParamSigma(cx, f, c, j);
+  const Vec sg = CoefSigmas(cx, f, j);
   e->params[key] = VecJson(v);
   e->sigma[key] = VecJson(sg);
   return v;

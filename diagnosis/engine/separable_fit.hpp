@@ -121,9 +121,8 @@ void PredictStreamed(const Context& cx, const ChannelFit& f, int p, Rows rows, F
 
 /// σ of parameter j of channel c from its unit covariance and the channel's residual variance.
 double ParamSigma(const Context& cx, const ChannelFit& f, int c, int j);
-/// Uncertainty of a nonlinear parameter from the curvature of the profile SSE (whitened, so
-/// Δχ² = 1 at one σ): σ = sqrt(2 / f'').
-double CurvatureSigma(const std::function<double(double)>& f, double x, double h);
+/// ParamSigma of linear coefficient j on every channel: the σ the engine reports for it.
+Vec CoefSigmas(const Context& cx, const ChannelFit& f, int j);
 nlohmann::json JsonNum(double v);
 nlohmann::json VecJson(const Vec& v);
 /// Puts coefficient j of every channel and its σ into e.params[key] / e.sigma[key]; returns it.

@@ -1,4 +1,5 @@
 #include "diagnosis/report/html_report.hpp"
+#include "diagnosis/engine/plausibility.hpp"
 #include "measurement/effect_vocabulary.hpp"
 #include "measurement/wrench.hpp"
 
@@ -42,23 +43,6 @@ std::string Num(double v, const char* f = "%.4g") {
   return b;
 }
 
-/// Unit of a fitted parameter, from its key (diagnosis.md names them with units).
-std::string UnitOf(const std::string& key, const std::string& effect) {
-  auto ends = [&](const char* suf) {
-    const std::string x(suf);
-    return key.size() >= x.size() && key.compare(key.size() - x.size(), x.size(), x) == 0;
-  };
-  if (ends("_s")) return "s";
-  if (ends("_hz")) return "Hz";
-  if (ends("_deg")) return "°";
-  if (ends("_mvv") || key == "offset" || key == "limit") return "mV/V";
-  if (key == "coef_per_K") return effect == "thermal_span_drift" ? "1/K" : "mV/V per K";
-  if (effect == "creep" && (key == "amplitude" || key.rfind("fraction", 0) == 0))
-    return "1 (of the load output)";
-  if (effect == "resonance" && key.rfind("participation", 0) == 0) return "1 (of the output)";
-  return "";
-}
-
 /// One value, a list of per-channel values, or per channel a list ("b0: …; b1: …").
 std::string Cell(const nlohmann::json& v) {
   if (v.is_number()) return Num(v.get<double>());
@@ -88,16 +72,26 @@ std::string SpreadCell(const EffectFit& f, const std::string& key) {
 }
 
 /// The fitted parameters as a table: name, value, 1-σ uncertainty (curvature), the spread across
-/// pieces of the record, unit.
-std::string ParamTable(const EffectFit& f) {
+/// pieces of the record, unit and status as the engine typed them (`typed`: TypedParameters).
+std::string ParamTable(const EffectFit& f, const nlohmann::json& typed) {
   if (f.params.empty()) return "";
   std::string h =
       "<table><tr><th>parameter</th><th>value</th><th>± 1σ (curvature)</th><th>across pieces of "
-      "the record: min … max (± σ)</th><th>unit</th></tr>";
+      "the record: min … max (± σ)</th><th>unit</th><th>range</th><th>status</th></tr>";
   for (const auto& [key, value] : f.params.items()) {
     const std::string sigma = f.sigma.contains(key) ? Cell(f.sigma[key]) : "—";
+    std::string unit;
+    std::string range = "—";
+    std::string status = "—";
+    for (const auto& p : typed) {
+      if (p["key"] != key) continue;
+      if (p["unit"].is_string()) unit = p["unit"].get<std::string>();
+      if (p["range"].is_array()) range = Cell(p["range"][0]) + " … " + Cell(p["range"][1]);
+      status = p["status"].get<std::string>();
+    }
     h += "<tr><td>" + Esc(key) + "</td><td>" + Cell(value) + "</td><td>" + sigma + "</td><td>" +
-         SpreadCell(f, key) + "</td><td>" + Esc(UnitOf(key, f.name)) + "</td></tr>";
+         SpreadCell(f, key) + "</td><td>" + Esc(unit) + "</td><td>" + range + "</td><td>" +
+         Esc(status) + "</td></tr>";
   }
   return h + "</table>";
 }
@@ -527,7 +521,7 @@ std::string HtmlReport(const DiagData& data, const Report& r) {
     h += "<h2>" + Esc(e.fit.name) + "</h2><p class=\"ev\">" + Esc(e.fit.evidence) +
          "</p><p>Model: " + Esc(e.fit.variant) + " (" + std::to_string(e.fit.n_params) +
          " parameters). Held-out RMS " + Num(e.hold_rms_before) + " → " + Num(e.hold_rms_after) +
-         " mV/V.</p>" + ParamTable(e.fit) + StandardTable(e.fit);
+         " mV/V.</p>" + ParamTable(e.fit, TypedParameters(r.cx, e.fit)) + StandardTable(e.fit);
     if (!e.confounded_with.empty()) {
       h += "<p class=\"conf\"><b>Not identified.</b> " + Esc(e.confounding) +
            " The verdict does not name it.</p>";

@@ -1,4 +1,5 @@
 #include "diagnosis/report/json_report.hpp"
+#include "diagnosis/engine/plausibility.hpp"
 
 #include <algorithm>
 #include <string>
@@ -78,6 +79,7 @@ nlohmann::json FindingsJson(const Report& r) {
   out.push_back({{"name", EffectOf(EffectKind::kConverterGlitch).name},
                  {"channels", channels},
                  {"params", {{"count", g.size()}, {"times_s", times}}},
+                 {"parameters", nlohmann::json::array()},  // located, not fitted
                  {"glitches", list},
                  {"handling",
                   "each sample replaced by the line through its neighbours in the residual and "
@@ -114,6 +116,7 @@ nlohmann::json ToJson(const Report& r) {
     ej["name"] = e.fit.name;
     ej["channels"] = e.fit.channels;
     ej["params"] = e.fit.params;
+    ej["parameters"] = TypedParameters(r.cx, e.fit);
     ej["uncertainty"] = e.fit.sigma;
     if (!e.fit.spread.empty()) ej["spread"] = e.fit.spread;
     if (!e.fit.standard.empty()) ej["standard"] = e.fit.standard;
@@ -147,7 +150,8 @@ nlohmann::json ToJson(const Report& r) {
                      {"holdout_rms_after", c.hold_rms_after},
                      {"z", c.z},
                      {"score", c.score},
-                     {"eligible", c.eligible}});
+                     {"eligible", c.eligible},
+                     {"parameters", c.parameters}});
     if (!c.not_resolved.empty()) cands.back()["not_resolved"] = c.not_resolved;
   }
   j["candidates"] = cands;
