@@ -121,6 +121,9 @@ struct ChoiceMargin {
   [[nodiscard]] bool Significant() const { return margin > se; }
 };
 
+/// A candidate as the choice prints it: "linear lambda=0.03".
+[[nodiscard]] std::string CandidateName(const CandidateScore& c);
+
 /// The paired comparison of two candidates' per-fold scores (equal fold counts).
 [[nodiscard]] ChoiceMargin CompareCandidates(const CandidateScore& simpler,
                                              const CandidateScore& complex);

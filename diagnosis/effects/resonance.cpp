@@ -355,6 +355,15 @@ bool ModeInRange(const Context& cx, double f_hz, double zeta, double other_hz) {
   return InRange(cx, f_hz, zeta) && Apart(f_hz, other_hz);
 }
 
+/// Each channel's column among `coarse` (0 for a channel not in it).
+std::vector<int> ColumnOfChannel(const Context& cx, const std::vector<int>& coarse) {
+  std::vector<int> col(static_cast<std::size_t>(cx.nc), 0);
+  for (std::size_t k = 0; k < coarse.size(); ++k) {
+    col[static_cast<std::size_t>(coarse[k])] = static_cast<int>(k);
+  }
+  return col;
+}
+
 /// The two modes' (log f, log ζ) in log_freq, log_zeta (mode 1 given in log_freq[0], log_zeta[0]):
 /// mode 2 on a grid at the residual's `lines` (or from `start`), then golden refinements of each
 /// with the other held, on the `coarse` channels. False when no mode 2 is in range.
@@ -366,10 +375,7 @@ bool SearchModes(const Context& cx, const Series& target, const std::vector<int>
   // in single precision; the joint fit and the prediction stream both (memory: no n × N double).
   Mat h[2];
   int row_step = cx.search_stride;
-  std::vector<int> col(static_cast<std::size_t>(cx.nc), 0);  // channel → column of h[m]
-  for (std::size_t k = 0; k < coarse.size(); ++k) {
-    col[static_cast<std::size_t>(coarse[k])] = static_cast<int>(k);
-  }
+  const std::vector<int> col = ColumnOfChannel(cx, coarse);  // channel → column of h[m]
   // Whitened training SSE on the coarse channels with mode m at (f, ζ) and the other mode's
   // ringing held in h[1 − m] (every row_step-th row).
   auto sse = [&](int m, double f_hz, double zeta) {

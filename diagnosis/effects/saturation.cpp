@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "diagnosis/effects/families.hpp"
@@ -10,22 +11,53 @@
 
 namespace ftstack::diag::fx {
 
-std::optional<EffectFit> FitSaturation(const Context& cx, const Series& target) {
-  // Real = sim + residual; a clipping limit shows up as the extremes of the real outputs.
-  double hi = -std::numeric_limits<double>::infinity();
+namespace {
+
+/// The extremes of the real (sim + residual) and the simulated outputs over every channel.
+struct Extremes {
   double lo = std::numeric_limits<double>::infinity();
-  double sim_hi = hi;
-  double sim_lo = lo;
+  double hi = -std::numeric_limits<double>::infinity();
+  double sim_lo = std::numeric_limits<double>::infinity();
+  double sim_hi = -std::numeric_limits<double>::infinity();
+};
+
+Extremes FindExtremes(const Context& cx, const Series& target) {
+  Extremes x;
   for (int c = 0; c < cx.nc; ++c) {
     for (int i = 0; i < cx.n; ++i) {
       const double s = cx.sim_mvv(i, c);
       const double r = s + target(i, c);
-      hi = std::max(hi, r);
-      lo = std::min(lo, r);
-      sim_hi = std::max(sim_hi, s);
-      sim_lo = std::min(sim_lo, s);
+      x.hi = std::max(x.hi, r);
+      x.lo = std::min(x.lo, r);
+      x.sim_hi = std::max(x.sim_hi, s);
+      x.sim_lo = std::min(x.sim_lo, s);
     }
   }
+  return x;
+}
+
+/// The evidence: how many samples where the sim goes beyond the limit read back pinned at it.
+std::string PinnedEvidence(const Context& cx, double limit, const Extremes& x) {
+  int pinned = 0;
+  for (int c = 0; c < cx.nc; ++c) {
+    for (int i = 0; i < cx.n; ++i) {
+      if (std::fabs(cx.sim_mvv(i, c)) > limit) ++pinned;
+    }
+  }
+  return Fmt(
+      "%d samples where the sim exceeds %.4g mV/V read back pinned at the limit (sim reaches %.4g)",
+      pinned, limit, std::max(std::fabs(x.sim_lo), std::fabs(x.sim_hi)));
+}
+
+}  // namespace
+
+std::optional<EffectFit> FitSaturation(const Context& cx, const Series& target) {
+  // Real = sim + residual; a clipping limit shows up as the extremes of the real outputs.
+  const Extremes x = FindExtremes(cx, target);
+  const double hi = x.hi;
+  const double lo = x.lo;
+  const double sim_hi = x.sim_hi;
+  const double sim_lo = x.sim_lo;
   // Clipping needs the sim to go beyond what the real file ever reads.
   if (sim_hi <= hi && sim_lo >= lo) return std::nullopt;
   auto predict = [&](double l, double h, Series* out) {
@@ -86,16 +118,7 @@ std::optional<EffectFit> FitSaturation(const Context& cx, const Series& target) 
   }
   e.sigma["limit"] = cx.sigma.maxCoeff() / 2.0;
   e.channels = ActiveChannels(cx, e.pred);
-  int pinned = 0;
-  const double l = e.params["limit"].get<double>();
-  for (int c = 0; c < cx.nc; ++c) {
-    for (int i = 0; i < cx.n; ++i) {
-      if (std::fabs(cx.sim_mvv(i, c)) > l) ++pinned;
-    }
-  }
-  e.evidence = Fmt(
-      "%d samples where the sim exceeds %.4g mV/V read back pinned at the limit (sim reaches %.4g)",
-      pinned, l, std::max(std::fabs(sim_lo), std::fabs(sim_hi)));
+  e.evidence = PinnedEvidence(cx, e.params["limit"].get<double>(), x);
   return e;
 }
 
