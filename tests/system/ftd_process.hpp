@@ -99,9 +99,12 @@ class FtdProcess {
   }
 
  private:
+  /// Up to 60 s: a sanitizer build composing a long simulated profile on a loaded machine takes
+  /// more than 10 s before it serves; a process that dies ends the wait at once.
   int WaitForPort() {
     const std::regex re("serving Modbus TCP on [^:]+:([0-9]+)");
-    for (int i = 0; i < 1000 && alive(); ++i) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (std::chrono::steady_clock::now() < deadline && alive()) {
       std::smatch m;
       const std::string err = Stderr();
       if (std::regex_search(err, m, re)) return std::stoi(m[1]);
