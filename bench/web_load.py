@@ -3,7 +3,10 @@
 
 soak: two paced ftds side by side, one serving N polling clients (GET /api/v1/state and
       /api/v1/wrench in turn, 10 Hz each) and M event streams, the other none, for S seconds:
-      errors, late samples of both over the same window, RSS of the loaded one.
+      errors, late samples of both over the same window, RSS of the loaded one. Over the same
+      window cyclictest (rt-tests; a SCHED_FIFO thread at ftd's priority waking once per sample
+      period) counts the wake-ups the host itself delivered more than one period late: the
+      platform's share of late samples, measured by a tool that is not ftd.
 cpu:  two ftds at RATE Hz side by side, one with K streams open, the other without: whole-process
       CPU (utime + stime from /proc) over the same windows, REPS repetitions, in % of one core.
 
@@ -15,6 +18,7 @@ import http.client
 import json
 import os
 import re
+import shutil
 import statistics
 import subprocess
 import tempfile
@@ -123,6 +127,34 @@ class Load:
             t.join(timeout=10)
 
 
+def start_cyclictest(rate, seconds, tmp):
+    """cyclictest at ftd's sampling priority and period, histogram in µs; None if not installed."""
+    if shutil.which("cyclictest") is None:
+        return None, None
+    hist = os.path.join(tmp, "cyclictest.hist")
+    period_us = max(1, round(1e6 / rate))
+    p = subprocess.Popen(["cyclictest", "-m", "-q", "-p", "50", "-t", "1", "-i", str(period_us),
+                          "-D", str(int(seconds)), "-h", "200000", f"--histfile={hist}"],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return p, hist
+
+
+def host_late_wakeups(proc, hist, rate):
+    """(wake-ups later than one period, worst latency µs) from cyclictest's histogram."""
+    if proc is None:
+        return None
+    proc.wait(timeout=60)
+    period_us = 1e6 / rate
+    late, worst = 0, None
+    for line in open(hist):
+        if line.startswith("# Max Latencies:"):
+            worst = int(line.split(":")[1])
+        elif not line.startswith("#") and line.strip():
+            us, n = (int(x) for x in line.split()[:2])
+            late += n if us > period_us else 0
+    return late, worst
+
+
 def soak(a):
     with tempfile.TemporaryDirectory() as tmp:
         loaded, lport = start_ftd(a.ftd, a.rate, tmp, "loaded")
@@ -132,6 +164,7 @@ def soak(a):
             load = Load(lport, a.pollers, a.streams)
             time.sleep(2)  # clients connected: the window starts in the steady state
             late0 = [get_json(p, "/api/v1/runtime")["late_samples"] for p in (lport, iport)]
+            ct, hist = start_cyclictest(a.rate, a.seconds, tmp)
             rss = []
             t0 = time.time()
             while time.time() - t0 < a.seconds:
@@ -139,6 +172,7 @@ def soak(a):
                 time.sleep(min(5, a.seconds / 12))
             late1 = [get_json(p, "/api/v1/runtime")["late_samples"] for p in (lport, iport)]
             alive = loaded.poll() is None
+            host = host_late_wakeups(ct, hist, a.rate)
             load.stop()
             rss.append(rss_kb(loaded.pid))
         finally:
@@ -151,6 +185,9 @@ def soak(a):
           f"{load.errors} errors, ftd alive: {alive}")
     print(f"  late samples in the window: loaded ftd {late1[0] - late0[0]}, idle ftd beside it "
           f"{late1[1] - late0[1]}")
+    if host is not None:
+        print(f"  host reference (cyclictest, SCHED_FIFO 50, one wake-up per period): {host[0]} "
+              f"wake-ups more than one period late, worst {host[1]} µs")
     print(f"  RSS of the loaded ftd, kB: first {rss[0]}, max {max(rss)}, last {rss[-1]} "
           f"(mean of first half {statistics.mean(rss[:half]):.0f}, second "
           f"{statistics.mean(rss[half:]):.0f})  (load average {os.getloadavg()[0]:.1f})")
