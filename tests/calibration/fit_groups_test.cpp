@@ -123,6 +123,85 @@ TEST(FitGroups, ABadlyRecordedPoseIsReportedAndDownWeighted) {
   EXPECT_LT(ours, 0.5 * ls);
 }
 
+/// Keeps only the first block of group 0 (a quarter of its rows) and adds `extra_noise` mV/V to
+/// that group's bridges: an orientation recorded with few, noisy rows.
+RigData ThinNoisyFirstGroup(const RigData& full, double extra_noise) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> gauss(0.0, extra_noise);
+  std::vector<Eigen::Index> keep;
+  const int first_block = full.block.front();
+  for (std::size_t i = 0; i < full.block.size(); ++i) {
+    if (full.group[i] != 0 || full.block[i] == first_block)
+      keep.push_back(static_cast<Eigen::Index>(i));
+  }
+  RigData d = full;
+  d.bridges.resize(static_cast<Eigen::Index>(keep.size()), full.bridges.cols());
+  d.wrench.resize(static_cast<Eigen::Index>(keep.size()), 6);
+  d.block.clear();
+  d.group.clear();
+  d.t_s.clear();
+  std::vector<int> renumber(static_cast<std::size_t>(full.block_count), -1);
+  d.block_count = 0;
+  for (std::size_t k = 0; k < keep.size(); ++k) {
+    const auto i = static_cast<std::size_t>(keep[k]);
+    const auto r = static_cast<Eigen::Index>(k);
+    d.bridges.row(r) = full.bridges.row(keep[k]);
+    if (full.group[i] == 0)
+      for (Eigen::Index c = 0; c < d.bridges.cols(); ++c) d.bridges(r, c) += gauss(rng);
+    d.wrench.row(r) = full.wrench.row(keep[k]);
+    int& b = renumber[static_cast<std::size_t>(full.block[i])];
+    if (b < 0) b = d.block_count++;
+    d.block.push_back(b);
+    d.group.push_back(full.group[i]);
+    d.t_s.push_back(full.t_s[i]);
+  }
+  return d;
+}
+
+// The score is the mean over validation groups of each group's held-out mean squared error (÷
+// rated², mean over axes), every orientation counting once: checked against leave-one-group-out
+// least squares solved here, on a rig whose noisiest orientation has a quarter of the rows.
+TEST(FitGroups, EveryValidationGroupCountsOnceInTheScore) {
+  const RigData d = ThinNoisyFirstGroup(Generate(6, 4, 5, -1, 1.0), 2e-3);
+  FitOptions o;
+  o.models = {ModelKind::kLinear};
+  o.lambdas = {0.0};
+  o.rated = {20, 20, 20, 2, 2, 2};
+  const FitResult r = FitCalibration(d, o);
+  ASSERT_EQ(r.folds, 6);
+  ASSERT_EQ(r.candidates.size(), 1u);
+  std::vector<double> per_group;
+  for (int g = 0; g < d.group_count; ++g) {
+    std::vector<Eigen::Index> tr;
+    std::vector<Eigen::Index> te;
+    for (std::size_t i = 0; i < d.group.size(); ++i)
+      (d.group[i] == g ? te : tr).push_back(static_cast<Eigen::Index>(i));
+    Eigen::MatrixXd x(static_cast<Eigen::Index>(tr.size()), 7);
+    Eigen::MatrixXd y(static_cast<Eigen::Index>(tr.size()), 6);
+    for (std::size_t k = 0; k < tr.size(); ++k) {
+      x.row(static_cast<Eigen::Index>(k)) << d.bridges.row(tr[k]), 1.0;
+      y.row(static_cast<Eigen::Index>(k)) = d.wrench.row(tr[k]);
+    }
+    const Eigen::MatrixXd beta = x.colPivHouseholderQr().solve(y);
+    double mse = 0.0;
+    for (const Eigen::Index i : te) {
+      Eigen::RowVectorXd xi(7);
+      xi << d.bridges.row(i), 1.0;
+      const Eigen::RowVectorXd e = xi * beta - d.wrench.row(i);
+      for (int a = 0; a < 6; ++a)
+        mse += std::pow(e(a) / o.rated[static_cast<std::size_t>(a)], 2) / 6.0;
+    }
+    per_group.push_back(mse / static_cast<double>(te.size()));
+  }
+  double mean = 0.0;
+  for (const double m : per_group) mean += m / static_cast<double>(per_group.size());
+  EXPECT_GT(per_group[0], 10 * per_group[1]);  // the thin group is the noisy one
+  EXPECT_NEAR(r.candidates[0].score, mean, 1e-6 * mean);
+  double shares = 0.0;
+  for (const double s : r.candidates[0].fold_score) shares += s;
+  EXPECT_NEAR(shares, r.candidates[0].score, 1e-12 * mean);
+}
+
 /// A candidate with the given per-fold shares of its score.
 ftstack::cal::CandidateScore Candidate(ModelKind kind, int features, double lambda,
                                        std::vector<double> shares) {
