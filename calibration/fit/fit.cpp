@@ -144,13 +144,23 @@ struct Folds {
   VectorXd scale;  // standardisation: 1 / RMS of each centred feature
 };
 
-/// Folds over whole validation units — groups (load directions) when asked for and there are at
-/// least three, else blocks: unit u (in order of first row) goes to fold u mod K, so neighbouring
-/// blocks (an up and a down sweep) land in different folds. Returns a description.
-std::string AssignFolds(const RigData& d, const FitOptions& options, Folds* out) {
-  const bool groups = options.by_group && d.group_count >= 3 && d.group.size() == d.block.size();
-  const std::vector<int>& unit = groups ? d.group : d.block;
-  const int units = groups ? d.group_count : d.block_count;
+/// Folds over whole validation units — temperatures when temperature terms are candidates and
+/// the rig held at least three (levels more than 1 °C apart: a temperature model must predict a
+/// temperature it never saw), else groups (load directions) when asked for and there are at
+/// least three, else blocks: unit u (in order of first row, or coldest first) goes to fold
+/// u mod K, so neighbouring blocks (an up and a down sweep) land in different folds. Returns a
+/// description.
+std::string AssignFolds(const RigData& d, const FitOptions& options, bool temperature_candidates,
+                        Folds* out) {
+  int levels = 0;
+  const std::vector<int> level = temperature_candidates && d.temp_c.size() > 0
+                                     ? TemperatureLevels(d.temp_c, 1.0, &levels)
+                                     : std::vector<int>{};
+  const bool temps = levels >= 3;
+  const bool groups =
+      !temps && options.by_group && d.group_count >= 3 && d.group.size() == d.block.size();
+  const std::vector<int>& unit = temps ? level : groups ? d.group : d.block;
+  const int units = temps ? levels : groups ? d.group_count : d.block_count;
   out->k = std::max(2, std::min(options.folds, units));
   out->rows.assign(static_cast<std::size_t>(out->k), {});
   for (std::size_t i = 0; i < unit.size(); ++i) {
@@ -159,6 +169,7 @@ std::string AssignFolds(const RigData& d, const FitOptions& options, Folds* out)
   out->unit_fraction.assign(static_cast<std::size_t>(out->k), 0.0);
   for (int u = 0; u < units; ++u)
     out->unit_fraction[static_cast<std::size_t>(u % out->k)] += 1.0 / static_cast<double>(units);
+  if (temps) return std::to_string(units) + " temperatures (levels more than 1 °C apart)";
   if (groups) return std::to_string(units) + " groups (" + d.group_method + ")";
   std::string why = options.by_group ? " (fewer than 3 groups)" : "";
   return std::to_string(units) + " load blocks (" + d.block_method + ")" + why;
@@ -488,7 +499,7 @@ FitResult FitCalibration(const RigData& d, const FitOptions& options) {
   const Reference ref = FindReference(d, res.rated, want_temp);
 
   Folds folds;
-  res.validation = AssignFolds(d, options, &folds);
+  res.validation = AssignFolds(d, options, want_temp, &folds);
   res.folds = folds.k;
   CentreFeatures(d, layout, ref, &folds);
   const FeatureBuilder builder(d, layout, ref.offset, ref.t_ref, folds.mu, folds.mu_y);

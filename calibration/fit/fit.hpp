@@ -64,6 +64,12 @@ struct RigData {
                                             const BlockOptions& options, int* block_count,
                                             std::string* method);
 
+/// Temperature levels of a rig that holds temperatures: rows sorted by temperature, a new level
+/// where the gap to the next warmer row exceeds `gap_c` (°C). Returns the level of every row
+/// (0 = coldest) and their number in *count (0 for an empty column).
+[[nodiscard]] std::vector<int> TemperatureLevels(const Eigen::VectorXd& temp_c, double gap_c,
+                                                 int* count);
+
 /// Reads the columns a fit needs (b0…, Fx…Mz, optional temp_C, block/pose, group) and finds
 /// blocks and validation groups (a `group` column wins; otherwise GroupBlocksByLoadDirection
 /// with 5°; a block whose rows carry two group values is refused).

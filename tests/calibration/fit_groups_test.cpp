@@ -202,6 +202,70 @@ TEST(FitGroups, EveryValidationGroupCountsOnceInTheScore) {
   EXPECT_NEAR(shares, r.candidates[0].score, 1e-12 * mean);
 }
 
+/// A linear 6-bridge sensor under a mass in 6 orientations × 2 levers, held at each of
+/// `temps_c`, whose bridge zeros drift by `zero_drift` × (T − 20 °C) (mV/V per °C, channel c
+/// scaled by (c + 1) / 6 with alternating sign), 1e-4 mV/V noise.
+RigData AtTemperatures(const std::vector<double>& temps_c, double zero_drift, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const RigData one = Generate(6, 2, seed, -1, 1.0);
+  RigData d;
+  d.path = "generated";
+  const auto n = one.bridges.rows();
+  const auto t = static_cast<Eigen::Index>(temps_c.size());
+  d.bridges.resize(n * t, 6);
+  d.wrench.resize(n * t, 6);
+  d.temp_c.resize(n * t);
+  for (Eigen::Index k = 0; k < t; ++k) {
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Index r = k * n + i;
+      // The held temperature wanders by 0.2 °C; the bridges drift with it, as the sensor reads it.
+      d.temp_c(r) = temps_c[static_cast<std::size_t>(k)] + 0.2 * gauss(rng);
+      const double dt = d.temp_c(r) - 20.0;
+      for (int c = 0; c < 6; ++c) {
+        const double alpha = zero_drift * (c + 1) / 6.0 * (c % 2 == 0 ? 1.0 : -1.0);
+        d.bridges(r, c) = one.bridges(i, c) + alpha * dt + 1e-4 * gauss(rng);
+      }
+      d.wrench.row(r) = one.wrench.row(i);
+      d.block.push_back(static_cast<int>(k) * one.block_count +
+                        one.block[static_cast<std::size_t>(i)]);
+      d.group.push_back(one.group[static_cast<std::size_t>(i)]);
+      d.t_s.push_back(static_cast<double>(r) * 0.01);
+    }
+  }
+  d.block_count = one.block_count * static_cast<int>(t);
+  d.group_count = one.group_count;
+  d.block_method = "generated";
+  d.group_method = one.group_method;
+  return d;
+}
+
+// Temperature terms are candidates validated by holding out whole temperatures: a zero drift of
+// 20 noise σ per °C is compensated with the slopes it was made with; without drift the same rig
+// keeps the linear model.
+TEST(FitTemperature, WholeTemperaturesAreHeldOutAndTermsTakenOnlyWhenTheyMatter) {
+  const std::vector<double> temps = {5.0, 15.0, 25.0, 35.0};
+  FitOptions o;
+  o.rated = {20, 20, 20, 2, 2, 2};
+  o.models = {ModelKind::kLinear, ModelKind::kLinearTemp};  // the question here: temperature or not
+  const FitResult drift = FitCalibration(AtTemperatures(temps, 2e-3, 11), o);
+  EXPECT_EQ(drift.validation, "4 temperatures (levels more than 1 °C apart)");
+  EXPECT_EQ(drift.folds, 4);
+  EXPECT_EQ(drift.kind, ModelKind::kLinearTemp);
+  ASSERT_TRUE(drift.cal.temperature_compensated);
+  for (int c = 0; c < 6; ++c) {
+    const double alpha = 2e-3 * (c + 1) / 6.0 * (c % 2 == 0 ? 1.0 : -1.0);
+    EXPECT_NEAR(drift.cal.bias_slope_mvv_per_c[static_cast<std::size_t>(c)], alpha, 2e-5) << c;
+  }
+  const FitResult flat = FitCalibration(AtTemperatures(temps, 0.0, 11), o);
+  EXPECT_EQ(flat.validation, "4 temperatures (levels more than 1 °C apart)");
+  EXPECT_EQ(flat.kind, ModelKind::kLinear) << flat.over_simplest.complex;
+  EXPECT_FALSE(flat.cal.temperature_compensated);
+  // Two temperatures cannot be held out in turn as a set of three or more: the load directions are.
+  const FitResult two = FitCalibration(AtTemperatures({10.0, 30.0}, 2e-3, 11), o);
+  EXPECT_EQ(two.validation.find("temperatures"), std::string::npos) << two.validation;
+}
+
 /// A candidate with the given per-fold shares of its score.
 ftstack::cal::CandidateScore Candidate(ModelKind kind, int features, double lambda,
                                        std::vector<double> shares) {
