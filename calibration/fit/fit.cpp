@@ -135,6 +135,7 @@ Reference FindReference(const RigData& d, const std::array<double, 6>& rated, bo
 struct Folds {
   int k = 0;
   std::vector<std::vector<std::size_t>> rows;  // row indices per fold
+  std::vector<double> unit_fraction;           // validation units in the fold / all units
   VectorXd mu;                                 // global feature means (mu(0) = 0)
   Eigen::Matrix<double, 6, 1> mu_y;            // global target means
   std::vector<FoldStats> stats;                // per fold
@@ -143,18 +144,32 @@ struct Folds {
   VectorXd scale;  // standardisation: 1 / RMS of each centred feature
 };
 
-/// Folds over whole validation units — groups (load directions) when asked for and there are at
-/// least three, else blocks: unit u (in order of first row) goes to fold u mod K, so neighbouring
-/// blocks (an up and a down sweep) land in different folds. Returns a description.
-std::string AssignFolds(const RigData& d, const FitOptions& options, Folds* out) {
-  const bool groups = options.by_group && d.group_count >= 3 && d.group.size() == d.block.size();
-  const std::vector<int>& unit = groups ? d.group : d.block;
-  const int units = groups ? d.group_count : d.block_count;
+/// Folds over whole validation units — temperatures when temperature terms are candidates and
+/// the rig held at least three (levels more than 1 °C apart: a temperature model must predict a
+/// temperature it never saw), else groups (load directions) when asked for and there are at
+/// least three, else blocks: unit u (in order of first row, or coldest first) goes to fold
+/// u mod K, so neighbouring blocks (an up and a down sweep) land in different folds. Returns a
+/// description.
+std::string AssignFolds(const RigData& d, const FitOptions& options, bool temperature_candidates,
+                        Folds* out) {
+  int levels = 0;
+  const std::vector<int> level = temperature_candidates && d.temp_c.size() > 0
+                                     ? TemperatureLevels(d.temp_c, 1.0, &levels)
+                                     : std::vector<int>{};
+  const bool temps = levels >= 3;
+  const bool groups =
+      !temps && options.by_group && d.group_count >= 3 && d.group.size() == d.block.size();
+  const std::vector<int>& unit = temps ? level : groups ? d.group : d.block;
+  const int units = temps ? levels : groups ? d.group_count : d.block_count;
   out->k = std::max(2, std::min(options.folds, units));
   out->rows.assign(static_cast<std::size_t>(out->k), {});
   for (std::size_t i = 0; i < unit.size(); ++i) {
     out->rows[static_cast<std::size_t>(unit[i] % out->k)].push_back(i);
   }
+  out->unit_fraction.assign(static_cast<std::size_t>(out->k), 0.0);
+  for (int u = 0; u < units; ++u)
+    out->unit_fraction[static_cast<std::size_t>(u % out->k)] += 1.0 / static_cast<double>(units);
+  if (temps) return std::to_string(units) + " temperatures (levels more than 1 °C apart)";
   if (groups) return std::to_string(units) + " groups (" + d.group_method + ")";
   std::string why = options.by_group ? " (fewer than 3 groups)" : "";
   return std::to_string(units) + " load blocks (" + d.block_method + ")" + why;
@@ -233,15 +248,18 @@ Solved SolveWithoutFold(const Layout& layout, const Folds& folds, const std::vec
   return s;
 }
 
-/// Each fold's share of the score: Σ over axes of SSE / (rows · rated²) / 6.
+/// Fold k's share of the score: its held-out rows' mean over axes of (error / rated)², times the
+/// fraction of the validation units it holds (each unit counts once, whatever its row count).
 double FoldShare(const Eigen::Matrix<double, 6, 1>& sse, const std::array<double, 6>& rated,
-                 std::size_t rows) {
+                 const Folds& folds, int k) {
+  const std::size_t rows = folds.rows[static_cast<std::size_t>(k)].size();
+  if (rows == 0) return 0.0;
   double share = 0.0;
   for (std::size_t a = 0; a < 6; ++a) {
     share +=
         sse(static_cast<Eigen::Index>(a)) / static_cast<double>(rows) / std::pow(rated[a], 2) / 6.0;
   }
-  return share;
+  return share * folds.unit_fraction[static_cast<std::size_t>(k)];
 }
 
 /// Cross-validates every candidate model and ridge strength into res->candidates.
@@ -257,13 +275,13 @@ void CrossValidate(const Layout& layout, const Folds& folds, const std::vector<M
         const Solved s = SolveWithoutFold(layout, folds, cols, kind, lambda, k);
         const Eigen::Matrix<double, 6, 1> fold_sse =
             HeldOutSse(folds.stats[static_cast<std::size_t>(k)], cols, s.beta);
-        c.fold_score.push_back(FoldShare(fold_sse, res->rated, rows));
+        c.fold_score.push_back(FoldShare(fold_sse, res->rated, folds, k));
+        c.score += c.fold_score.back();
         sse += fold_sse;
       }
       c.kind = kind;
       c.lambda = lambda;
       c.features = static_cast<int>(cols.size());
-      c.score = FoldShare(sse, res->rated, rows);
       for (std::size_t a = 0; a < 6; ++a) {
         c.rms_si[a] = std::sqrt(sse(static_cast<Eigen::Index>(a)) / static_cast<double>(rows));
       }
@@ -368,7 +386,7 @@ std::vector<double> SuspectWeights(const RigData& d, const std::vector<BlockScor
 /// The chosen model trained on the weighted folds and tested on the unweighted held-out rows,
 /// scored as a candidate (with its per-fold shares).
 CandidateScore WeightedScore(const Layout& layout, const Folds& folds, const Folds& weighted,
-                             const std::vector<int>& cols, const FitResult& res, std::size_t rows) {
+                             const std::vector<int>& cols, const FitResult& res) {
   CandidateScore c;
   c.kind = res.kind;
   c.lambda = res.lambda;
@@ -376,7 +394,7 @@ CandidateScore WeightedScore(const Layout& layout, const Folds& folds, const Fol
   for (int k = 0; k < folds.k; ++k) {
     const Solved s = SolveWithoutFold(layout, weighted, cols, res.kind, res.lambda, k);
     c.fold_score.push_back(FoldShare(
-        HeldOutSse(folds.stats[static_cast<std::size_t>(k)], cols, s.beta), res.rated, rows));
+        HeldOutSse(folds.stats[static_cast<std::size_t>(k)], cols, s.beta), res.rated, folds, k));
     c.score += c.fold_score.back();
   }
   return c;
@@ -481,7 +499,7 @@ FitResult FitCalibration(const RigData& d, const FitOptions& options) {
   const Reference ref = FindReference(d, res.rated, want_temp);
 
   Folds folds;
-  res.validation = AssignFolds(d, options, &folds);
+  res.validation = AssignFolds(d, options, want_temp, &folds);
   res.folds = folds.k;
   CentreFeatures(d, layout, ref, &folds);
   const FeatureBuilder builder(d, layout, ref.offset, ref.t_ref, folds.mu, folds.mu_y);
@@ -506,11 +524,12 @@ FitResult FitCalibration(const RigData& d, const FitOptions& options) {
   if (!weight.empty()) {
     weighted.k = folds.k;
     weighted.rows = folds.rows;
+    weighted.unit_fraction = folds.unit_fraction;
     weighted.mu = folds.mu;
     weighted.mu_y = folds.mu_y;
     AccumulateFolds(builder, layout.total, rows, &weighted, &weight);
     weighted.scale = folds.scale;
-    const CandidateScore robust = WeightedScore(layout, folds, weighted, cols, res, rows);
+    const CandidateScore robust = WeightedScore(layout, folds, weighted, cols, res);
     res.robust_margin = CompareCandidates(chosen, robust);
     res.robust_margin.complex += " down-weighted";
     res.plain_score = chosen.score;

@@ -64,6 +64,12 @@ struct RigData {
                                             const BlockOptions& options, int* block_count,
                                             std::string* method);
 
+/// Temperature levels of a rig that holds temperatures: rows sorted by temperature, a new level
+/// where the gap to the next warmer row exceeds `gap_c` (°C). Returns the level of every row
+/// (0 = coldest) and their number in *count (0 for an empty column).
+[[nodiscard]] std::vector<int> TemperatureLevels(const Eigen::VectorXd& temp_c, double gap_c,
+                                                 int* count);
+
 /// Reads the columns a fit needs (b0…, Fx…Mz, optional temp_C, block/pose, group) and finds
 /// blocks and validation groups (a `group` column wins; otherwise GroupBlocksByLoadDirection
 /// with 5°; a block whose rows carry two group values is refused).
@@ -84,9 +90,11 @@ enum class ModelKind {
 
 struct FitOptions {
   std::vector<ModelKind> models;  ///< candidates; empty → every model the data supports
-  /// Ridge strengths tried, relative to the standardised features (0 = plain least squares).
-  std::vector<double> lambdas = {0.0,  1e-9, 1e-7, 1e-5, 1e-4, 1e-3,
-                                 3e-3, 0.01, 0.03, 0.1,  0.3,  1.0};
+  /// Ridge strengths tried, relative to the standardised features (0 = plain least squares):
+  /// below 1e-4 a few points, then 1, 2, 3, 5 per decade up to 1, so that no step exceeds ×2
+  /// and the choice can land between the points of a coarser grid.
+  std::vector<double> lambdas = {0.0,  1e-9, 1e-7, 1e-5, 1e-4, 2e-4, 3e-4, 5e-4, 1e-3, 2e-3, 3e-3,
+                                 5e-3, 0.01, 0.02, 0.03, 0.05, 0.1,  0.2,  0.3,  0.5,  1.0};
   /// Cross-validation folds, ≤ number of validation units. Unit g goes to fold g mod folds, so
   /// with no more units than folds every unit is held out alone.
   int folds = 10;
@@ -100,11 +108,15 @@ struct FitOptions {
 struct CandidateScore {
   ModelKind kind = ModelKind::kLinear;
   double lambda = 0.0;
-  int features = 0;                ///< coefficients per axis (incl. intercept)
-  double score = 0.0;              ///< mean over axes of (held-out RMS / rated)²
+  int features = 0;  ///< coefficients per axis (incl. intercept)
+  /// Mean over validation units (groups or blocks) of the unit's mean over axes of
+  /// (held-out RMS / rated)²: every orientation a new use may bring counts once, however many
+  /// rows it was recorded with.
+  double score = 0.0;
   std::array<double, 6> rms_si{};  ///< held-out RMS per axis, N and N·m
-  /// Each fold's share of `score` (its rows' squared errors over all rows): they sum to score,
-  /// and two candidates' shares, fold by fold, are the paired differences of the choice.
+  /// Each fold's share of `score` (its rows' mean squared error × its units / all units): they
+  /// sum to score, and two candidates' shares, fold by fold, are the paired differences of the
+  /// choice.
   std::vector<double> fold_score;
 };
 

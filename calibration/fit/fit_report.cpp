@@ -254,7 +254,7 @@ std::string FitSummary(const FitResult& fit, const fw::LoadReport& fixed) {
                   fixed.worst_case_error_si[a]);
     o << line;
   }
-  o << "candidates (score = mean (RMS/rated)^2):\n";
+  o << "candidates (score = mean over validation units of mean over axes (error/rated)^2):\n";
   for (const CandidateScore& c : fit.candidates) {
     o << "  " << ToString(c.kind) << " lambda=" << Fmt("%g", c.lambda) << " features=" << c.features
       << " score=" << Fmt("%.4g", c.score) << "\n";

@@ -266,4 +266,24 @@ double LoadSetCondition(const std::vector<Wrench>& loads, const Wrench& rated) {
   return LoadSetCondition(w, r);
 }
 
+std::vector<int> TemperatureLevels(const Eigen::VectorXd& temp_c, double gap_c, int* count) {
+  const auto rows = static_cast<std::size_t>(temp_c.size());
+  std::vector<std::size_t> order(rows);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return temp_c(static_cast<Eigen::Index>(a)) < temp_c(static_cast<Eigen::Index>(b));
+  });
+  std::vector<int> level(rows, 0);
+  int current = 0;
+  for (std::size_t k = 0; k < rows; ++k) {
+    if (k > 0 && temp_c(static_cast<Eigen::Index>(order[k])) -
+                         temp_c(static_cast<Eigen::Index>(order[k - 1])) >
+                     gap_c)
+      ++current;
+    level[order[k]] = current;
+  }
+  *count = rows == 0 ? 0 : current + 1;
+  return level;
+}
+
 }  // namespace ftstack::cal

@@ -11,7 +11,9 @@ the pair is written the same way and run through `ftcal apply` with no unit opti
 calibration's own converter decides), and the held-out error is compared with plain affine least
 squares on the raw codes solved here with numpy. Error = sqrt(mean over axes (RMS / scale)^2),
 scale = largest |load| per axis. Prints one line per split (the choice and its margin, as ftcal
-printed them) and the summary; exits 1 when a target of the protocol is missed.
+printed them), the summary of the development half of the pairs (i + j even: the half a change
+of the method is tuned on) and of the validation half (i + j odd), and the summary of all 66;
+exits 1 when a target of the protocol is missed.
 
 usage: printed_pairs.py DATA_FOLDER FTCAL_BINARY
 """
@@ -54,7 +56,7 @@ def main():
     scale = np.abs(w).max(0)
     rated = ",".join(f"{v:.9g}" for v in scale)
     score = lambda e: np.sqrt(np.mean((e / scale) ** 2))
-    ratios = []
+    ratios, dev = [], []
     with tempfile.TemporaryDirectory() as tmp:
         train, test = os.path.join(tmp, "train.csv"), os.path.join(tmp, "test.csv")
         cal, applied = os.path.join(tmp, "cal.json"), os.path.join(tmp, "applied.csv")
@@ -77,10 +79,15 @@ def main():
             beta = np.linalg.lstsq(a, w[tr], rcond=None)[0]
             ref = np.column_stack([x[te], np.ones(te.sum())]) @ beta - w[te]
             ratios.append(score(got - w[te]) / score(ref))
+            dev.append((i + j) % 2 == 0)
             choice = re.search(r"^choice [^:]*: (.*)$", fit.stdout, re.M)
             print(f"pair {i:2d},{j:2d}: {ratios[-1]:.3f}x  flagged rows {int((status != 0).sum())}  "
                   f"{choice.group(1) if choice else '?'}", flush=True)
     r = np.array(ratios)
+    dev = np.array(dev)
+    for name, part in (("development half (i + j even)", r[dev]), ("validation half (i + j odd)", r[~dev])):
+        print(f"{name}: {len(part)} splits, mean {part.mean():.3f}x, median {np.median(part):.3f}x, "
+              f"worst {part.max():.3f}x, {int((part > 1.08).sum())} above 1.08x")
     above = int((r > 1.08).sum())
     print(f"{len(r)} splits: mean {r.mean():.3f}x, median {np.median(r):.3f}x, worst {r.max():.3f}x, "
           f"{above} above 1.08x (targets: mean <= 0.97, worst <= 1.20, at most 3 above 1.08)")
