@@ -59,6 +59,8 @@ struct OpcuaServer::Impl {
   void Read(const OpcuaSource& src, UA_DataValue* value);
   /// Builds the device object, its variables and methods (opcua_nodes.cpp); throws FtdError.
   void BuildAddressSpace();
+  /// The DI-named properties of the device object and its DeviceHealth variable.
+  void AddDeviceProperties(const UA_NodeId& dev);
   UA_NodeId AddObject(const UA_NodeId& parent, const std::string& id, const char* name,
                       const char* description);
   /// A variable read from the map; `analog`: an AnalogItemType (EURange, EngineeringUnits).

@@ -312,11 +312,7 @@ UA_NodeId OpcuaServer::Impl::AddObject(const UA_NodeId& parent, const std::strin
   return node;
 }
 
-void OpcuaServer::Impl::BuildAddressSpace() {
-  const UA_NodeId objects = UA_NODEID_NUMERIC(0, UA_NS0ID_OBJECTSFOLDER);
-  UA_NodeId dev = AddObject(objects, "Sensor", "ForceTorqueSensor",
-                            "the six-axis force/torque sensor ftd serves (OPC UA for Devices "
-                            "properties in the DI namespace)");
+void OpcuaServer::Impl::AddDeviceProperties(const UA_NodeId& dev) {
   // The DI device properties, with DI's browse names (the DI type nodes are not loaded).
   char crc[16];
   std::snprintf(crc, sizeof crc, "%08X", static_cast<unsigned>(info.cal_crc));
@@ -367,6 +363,14 @@ void OpcuaServer::Impl::BuildAddressSpace() {
     UA_NodeId_clear(&id);
     if (rc != UA_STATUSCODE_GOOD) throw FtdError("OPC UA: cannot add DeviceHealth");
   }
+}
+
+void OpcuaServer::Impl::BuildAddressSpace() {
+  const UA_NodeId objects = UA_NODEID_NUMERIC(0, UA_NS0ID_OBJECTSFOLDER);
+  UA_NodeId dev = AddObject(objects, "Sensor", "ForceTorqueSensor",
+                            "the six-axis force/torque sensor ftd serves (OPC UA for Devices "
+                            "properties in the DI namespace)");
+  AddDeviceProperties(dev);
 
   using K = OpcuaSource::Kind;
   UA_NodeId wrench = AddObject(dev, "Sensor.Wrench", "Wrench",

@@ -21,13 +21,20 @@ namespace {
 
 /// open62541's messages, warnings and worse, on stderr (its default logger writes to stdout,
 /// where ftd prints its readings).
-void LogToStderr(void*, UA_LogLevel level, UA_LogCategory, const char* msg, va_list args) {
-  if (level < UA_LOGLEVEL_WARNING) return;
+void LogToStderr(void* quiet, UA_LogLevel level, UA_LogCategory, const char* msg, va_list args) {
+  if (level < UA_LOGLEVEL_WARNING || *static_cast<bool*>(quiet)) return;
   std::fprintf(stderr, "ftd: opcua: ");
   std::vfprintf(stderr, msg, args);
   std::fputc('\n', stderr);
 }
-UA_Logger g_logger{LogToStderr, nullptr, nullptr};
+/// Quiet while the access control is set up: open62541 warns on every set-up that a logged-in
+/// user has all rights (true: ftd has no per-node rights, docs/opcua.md).
+bool g_log_quiet = false;
+UA_Logger g_logger{LogToStderr, &g_log_quiet, nullptr};
+
+UA_StatusCode RejectUserCertificate(const UA_CertificateVerification*, const UA_ByteString*) {
+  return UA_STATUSCODE_BADCERTIFICATEUNTRUSTED;
+}
 
 bool IsLoopback(const std::string& host) {
   return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
@@ -106,7 +113,10 @@ void OpcuaServer::Open() {
   UA_ServerConfig c;
   std::memset(&c, 0, sizeof c);
   c.logging = &g_logger;
-  Check(UA_ServerConfig_setBasics_withPort(&c, port_), "configuration");
+  g_log_quiet = true;
+  const UA_StatusCode basics = UA_ServerConfig_setBasics_withPort(&c, port_);
+  g_log_quiet = false;
+  Check(basics, "configuration");
   // Listen on the asked address only.
   UA_Array_delete(c.serverUrls, c.serverUrlsSize, &UA_TYPES[UA_TYPES_STRING]);
   const std::string url = "opc.tcp://" + host_ + ":" + std::to_string(port_);
@@ -123,6 +133,11 @@ void OpcuaServer::Open() {
   UA_LocalizedText_clear(&c.applicationDescription.applicationName);
   c.applicationDescription.applicationName = UA_LOCALIZEDTEXT_ALLOC("en", "ftd");
 
+  // No certificate user tokens: a user is anonymous or has the credentials file's password (the
+  // default session PKI accepts any certificate as a user identity, which would bypass the
+  // password). Without a verifier the access control offers no certificate token; the rejecting
+  // one set after it refuses such a token should a client send one anyway.
+  c.sessionPKI.verifyCertificate = nullptr;
   try {
     if (secure_) {
       files.v.push_back(ReadBytes("--opcua-cert", opt.opcua_cert));
@@ -133,11 +148,9 @@ void OpcuaServer::Open() {
         trust.push_back(files.v.back());
       }
       // Only the listed client certificates open a secure channel (none listed: none does).
+      if (c.secureChannelPKI.clear != nullptr) c.secureChannelPKI.clear(&c.secureChannelPKI);
       Check(UA_CertificateVerification_Trustlist(&c.secureChannelPKI, trust.data(), trust.size(),
                                                  nullptr, 0, nullptr, 0),
-            "trust list");
-      Check(UA_CertificateVerification_Trustlist(&c.sessionPKI, trust.data(), trust.size(), nullptr,
-                                                 0, nullptr, 0),
             "trust list");
       Check(UA_ServerConfig_addSecurityPolicyBasic256Sha256(&c, &files.v[0], &files.v[1]),
             "certificate and key (DER or PEM, RSA 2048–4096)");
@@ -165,10 +178,17 @@ void OpcuaServer::Open() {
       // A password crosses a None channel in clear: only on loopback, else encrypted with the
       // server's key (the user token's own policy).
       c.allowNonePolicyPassword = loopback;
-      Check(UA_AccessControl_default(&c, false, nullptr, 1, &login), "access control");
+      g_log_quiet = true;
+      const UA_StatusCode ac = UA_AccessControl_default(&c, false, nullptr, 1, &login);
+      g_log_quiet = false;
+      Check(ac, "access control");
     } else {
-      Check(UA_AccessControl_default(&c, true, nullptr, 0, nullptr), "access control");
+      g_log_quiet = true;
+      const UA_StatusCode ac = UA_AccessControl_default(&c, true, nullptr, 0, nullptr);
+      g_log_quiet = false;
+      Check(ac, "access control");
     }
+    c.sessionPKI.verifyCertificate = RejectUserCertificate;
   } catch (...) {
     UA_ServerConfig_clean(&c);
     throw;
