@@ -6,12 +6,14 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "daemon/opcua_impl.hpp"
@@ -202,7 +204,21 @@ void OpcuaServer::Open() {
 }
 
 void OpcuaServer::Run(const std::atomic<bool>& stop) {
-  while (!stop.load(std::memory_order_relaxed)) UA_Server_run_iterate(impl_->server, true);
+  // While a callback (a subscription's publish cycle) is due within one round, the thread works
+  // in rounds on a fixed grid: everything due in a round, network input included, is handled in
+  // one wake-up. Each subscription's timer has its own phase, and a wake-up costs more than the
+  // work it does; without fast callbacks the thread sleeps until input or the next callback.
+  using Clock = std::chrono::steady_clock;
+  const auto round = std::chrono::milliseconds(static_cast<int>(kOpcuaMinIntervalMs));
+  while (!stop.load(std::memory_order_relaxed)) {
+    const UA_UInt16 next_ms = UA_Server_run_iterate(impl_->server, false);
+    if (next_ms >= round.count()) {
+      UA_Server_run_iterate(impl_->server, true);
+      continue;
+    }
+    const auto since = Clock::now().time_since_epoch();
+    std::this_thread::sleep_until(Clock::time_point((since / round + 1) * round));
+  }
   UA_Server_run_shutdown(impl_->server);
 }
 
