@@ -42,7 +42,8 @@ deps() {
   $sudo apt-get -o DPkg::Lock::Timeout=600 install -y -q --no-install-recommends "${missing[@]}"
 }
 
-# The web page's browser test (tests/web): puppeteer-core from its lock file, into tests/web only.
+# The npm test clients from their lock files, each into its own folder: the web page's browser test
+# (tests/web) and the OPC UA client (tests/opcua).
 # Node comes from Debian unless one is already installed.
 web_test_deps() {
   if ! command -v npm >/dev/null 2>&1; then
@@ -52,12 +53,16 @@ web_test_deps() {
     DEBIAN_FRONTEND=noninteractive $sudo apt-get -o DPkg::Lock::Timeout=600 install -y -q \
       --no-install-recommends nodejs npm || { log "no npm: the browser test will be skipped"; return 0; }
   fi
-  local lock="$ROOT/tests/web/package-lock.json" stamp="$ROOT/tests/web/node_modules/.ftstack-lock"
-  if [ ! -f "$stamp" ] || ! cmp -s "$lock" "$stamp"; then
-    log "installing the browser test's npm packages (tests/web, npm ci)"
-    (cd "$ROOT/tests/web" && npm ci --no-audit --no-fund --loglevel=error) &&
-      cp "$lock" "$stamp" || log "npm ci failed: the browser test will be skipped"
-  fi
+  local dir
+  # tests/web: the page's browser test (puppeteer-core); tests/opcua: the OPC UA client (node-opcua).
+  for dir in web opcua; do
+    local lock="$ROOT/tests/$dir/package-lock.json" stamp="$ROOT/tests/$dir/node_modules/.ftstack-lock"
+    if [ ! -f "$stamp" ] || ! cmp -s "$lock" "$stamp"; then
+      log "installing the $dir tests' npm packages (tests/$dir, npm ci)"
+      (cd "$ROOT/tests/$dir" && npm ci --no-audit --no-fund --loglevel=error) &&
+        cp "$lock" "$stamp" || log "npm ci failed in tests/$dir: its tests will be skipped"
+    fi
+  done
 }
 
 build() {

@@ -41,10 +41,10 @@ fi
 log "building the harnesses (progress below)"
 cmake --build "$BUILD" -j "$(nproc)" --target fuzzers
 declare -A dict=([recording]=csv [cal_file]=json [sensor]=json [profile]=json [ati]=xml [payload]=json)
-[ ${#names[@]} -gt 0 ] || names=(recording cal_file ati sensor profile modbus tcp_frame payload rdt)
+[ ${#names[@]} -gt 0 ] || names=(recording cal_file ati sensor profile modbus tcp_frame payload rdt opcua)
 # Input size caps (bytes): each is above the largest seed of its format, so every seed runs whole.
 declare -A max_len=([recording]=4096 [cal_file]=4096 [ati]=2048 [sensor]=4096 [profile]=1024
-                    [payload]=2048 [rdt]=1024 [modbus]=512 [tcp_frame]=2048)
+                    [payload]=2048 [rdt]=1024 [modbus]=512 [tcp_frame]=2048 [opcua]=4096)
 mkdir -p "$BUILD/findings"
 status=0
 table=$(printf '%-10s %10s %8s %8s %8s %8s  %s' harness execs exec/s cov ft findings result)

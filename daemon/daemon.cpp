@@ -116,6 +116,7 @@ void Ftd::Start() {
     map_->SetMqttCounters(&mqtt_->counters());
   }
   if (!opt_.http.empty()) OpenHttp(cfg);
+  if (!opt_.opcua.empty()) OpenOpcua(cfg);
   if (!opt_.log.empty()) {
     // The paced simulator stamps wall-clock conversion times (n / (rate · speed)): scaled by
     // the speed, the log's t is the simulated time the samples were composed at.
@@ -154,6 +155,10 @@ void Ftd::StartThreads() {
     threads_.emplace_back([this] { http_->Run(stop_); });
     pthread_setname_np(threads_.back().native_handle(), "ftd-http");
   }
+  if (opcua_) {
+    threads_.emplace_back([this] { opcua_->Run(stop_); });
+    pthread_setname_np(threads_.back().native_handle(), "ftd-opcua");
+  }
 }
 
 void Ftd::OpenHttp(const fw::DeviceConfig& cfg) {
@@ -188,6 +193,34 @@ void Ftd::OpenHttp(const fw::DeviceConfig& cfg) {
   std::fprintf(stderr, "ftd: serving the web page on %s:%u — open %s://%s:%u/\n",
                http_->host().c_str(), port, http_->tls() ? "https" : "http", http_->host().c_str(),
                port);
+}
+
+void Ftd::OpenOpcua(const fw::DeviceConfig& cfg) {
+  OpcuaDeviceInfo info;
+  for (std::size_t i = 0; i < 6; ++i) {
+    info.rated[i] = static_cast<double>(cfg.rated_lsb[i]) * fw::AxisLsb(i);
+  }
+  const std::uint8_t slot = cfg.initial_slot;
+  const std::string file = slot == 0 ? opt_.cal : opt_.cal_b;
+  info.cal_crc = cfg.slots[slot].crc32;
+  info.serial = "built-in (" + opt_.adc + ")";
+  if (!file.empty()) {
+    try {
+      const cal::CalFile f = cal::LoadCalFile(file);
+      info.serial = f.serial;
+      info.cal_date = f.date;
+    } catch (const std::exception&) {
+      info.serial =
+          "unknown";  // the slot loaded it a moment ago; a file changed since is not fatal
+    }
+  }
+  info.adc = opt_.adc;
+  info.rate_hz = opt_.rate_hz;
+  opcua_ = std::make_unique<OpcuaServer>(opt_, map_.get(), std::move(info));
+  opcua_->Open();
+  std::fprintf(stderr, "ftd: serving OPC UA on opc.tcp://%s:%u (%s)\n", opcua_->host().c_str(),
+               static_cast<unsigned>(opcua_->port()),
+               opcua_->secure() ? "Basic256Sha256 Sign&Encrypt" : "security None, loopback");
 }
 
 nlohmann::json Ftd::WebRuntime() const {

@@ -16,6 +16,7 @@
 #include "daemon/calibration_set.hpp"
 #include "daemon/http_server.hpp"
 #include "daemon/mqtt_publisher.hpp"
+#include "daemon/opcua_server.hpp"
 #include "daemon/options.hpp"
 #include "daemon/sample_log.hpp"
 #include "daemon/servers.hpp"
@@ -81,6 +82,8 @@ class Ftd {
   void BackOff(std::uint32_t pause_us);
   /// Opens the web server of --http over the map; `cfg` gives the rated range and the slots.
   void OpenHttp(const fw::DeviceConfig& cfg);
+  /// Opens the OPC UA server of --opcua over the map (device object from `cfg`).
+  void OpenOpcua(const fw::DeviceConfig& cfg);
   /// The live figures the web page shows beside the map: sample rate, clients.
   [[nodiscard]] nlohmann::json WebRuntime() const;
 
@@ -93,6 +96,7 @@ class Ftd {
   Servers servers_;
   std::unique_ptr<MqttPublisher> mqtt_;
   std::unique_ptr<HttpServer> http_;
+  std::unique_ptr<OpcuaServer> opcua_;
   SampleLog log_;
 
   std::atomic<bool> stop_{false};

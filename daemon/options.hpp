@@ -77,6 +77,13 @@ struct FtdOptions {
   std::string http_cert;            ///< PEM certificate: serve HTTPS (with http_key)
   std::string http_key;             ///< its private key
   bool http_write_protect = false;  ///< refuse every write from the web (page and API)
+  // The OPC UA server (daemon/opcua_server.hpp, docs/opcua.md).
+  std::string opcua;                     ///< HOST:PORT of the OPC UA server ("" = none)
+  std::string opcua_credentials;         ///< file: user name on line 1, password on line 2
+  std::string opcua_cert;                ///< server certificate: Basic256Sha256 (with opcua_key)
+  std::string opcua_key;                 ///< its private key
+  std::vector<std::string> opcua_trust;  ///< client certificates trusted for Basic256Sha256
+  bool opcua_write_protect = false;      ///< refuse every method call that changes the sensor
 };
 
 /// User name (line 1) and password (line 2) from a file, as --mqtt-credentials and

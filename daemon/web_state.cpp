@@ -57,7 +57,7 @@ constexpr CauseText kCauses[fw::kHealthCauses + 1] = {
      "inspect for damage; re-calibrate before trusting the readings"},
 };
 
-constexpr const char* kTareSources[5] = {"", "modbus", "rdt", "mqtt", "web"};
+constexpr const char* kTareSources[6] = {"", "modbus", "rdt", "mqtt", "web", "opcua"};
 
 double F(const std::uint16_t* r) { return static_cast<double>(fw::UnpackFloat32(r)); }
 /// A float register pair as JSON: NaN (no value) becomes null.
@@ -193,7 +193,7 @@ nlohmann::json StateFromRegisters(const std::uint16_t* in, const std::uint16_t* 
     if (number == 0) continue;
     const std::uint16_t src = r[2];
     tares.push_back({{"number", number},
-                     {"source", src < 5 ? kTareSources[src] : "unknown"},
+                     {"source", src < 6 ? kTareSources[src] : "unknown"},
                      {"time_s", fw::UnpackU32(r + 4)},
                      {"temperature_c", FJ(r + 6)},
                      {"load_n_nm", Six(r + 8)}});

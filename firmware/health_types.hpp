@@ -54,6 +54,7 @@ enum class TareSource : std::uint8_t {
   kRdt = 2,     ///< ATI RDT command 0x0042 "set software bias" (ftd --rdt)
   kMqtt = 3,    ///< the Sparkplug command Device Control/Tare (ftd --mqtt)
   kWeb = 4,     ///< the web page or its JSON API (ftd --http)
+  kOpcua = 5,   ///< an OPC UA method call Tare (ftd --opcua)
 };
 
 /// One completed tare, as the history keeps it.

@@ -12,6 +12,7 @@
 #include "tools/common.hpp"
 #include "tools/ftd/http_options.hpp"
 #include "tools/ftd/mqtt_options.hpp"
+#include "tools/ftd/opcua_options.hpp"
 #if FTSTACK_FTD_SIMULATOR
 #include "daemon/sim/sim_backend.hpp"
 #endif
@@ -80,6 +81,7 @@ void AddOptions(CLI::App& app, Args& a) {
   app.add_option("--modbus-rtu", opt.modbus_rtu, "serve Modbus RTU on a serial DEVICE");
   AddRdtOptions(app, opt);
   ftstack::tools::AddHttpOptions(app, opt);
+  ftstack::tools::AddOpcuaOptions(app, opt);
   ftstack::tools::AddMqttOptions(app, opt);
   app.add_option("--baud", opt.baud, "RTU baud rate")->check(CLI::Range(300u, 4000000u));
   app.add_option("--parity", a.parity, "RTU parity N|E|O")->check(CLI::IsMember({"N", "E", "O"}));
