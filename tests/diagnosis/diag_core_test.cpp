@@ -270,19 +270,19 @@ TEST(DiagHonesty, PiecesStraddlingZeroContradictAClaimAndOneSignDoesNot) {
                           {"agree", false},
                           {"min", {-0.001, -0.02, 0.0005}},
                           {"max", {0.005, 0.004, 0.002}}};
-  const std::string why = PiecesContradict(cx, f);
+  const std::string why = NotResolved(cx, f);
   EXPECT_NE(why.find("fraction = -0.01, per piece -0.02–0.004"), std::string::npos) << why;
   EXPECT_EQ(SpreadWords(f), "fraction on b1 per piece -0.02–0.004");
   f.spread["fraction"]["min"] = {-0.001, -0.03, 0.0005};
   f.spread["fraction"]["max"] = {0.005, -0.002, 0.002};
-  EXPECT_EQ(PiecesContradict(cx, f), "");
+  EXPECT_EQ(NotResolved(cx, f), "");
   EXPECT_EQ(SpreadWords(f), "fraction on b1 per piece -0.03–-0.002");
   // A parameter without a stated range (an onset time is the piece's own) never contradicts.
   EffectFit o;
   o.name = "overload_shift";
   o.params["onset_s"] = 2.0;
   o.spread["onset_s"] = {{"pieces", 3}, {"agree", false}, {"min", -1.0}, {"max", 3.0}};
-  EXPECT_EQ(PiecesContradict(cx, o), "");
+  EXPECT_EQ(NotResolved(cx, o), "");
   EXPECT_EQ(SpreadWords(o), "onset_s per piece -1–3");
 }
 
