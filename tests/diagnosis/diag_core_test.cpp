@@ -166,6 +166,12 @@ TEST_P(DiagFixture, NamesLocatesAndModelsTheEffect) {
   // Noise estimate within 5 % of the true σ on every channel.
   for (int ch = 0; ch < r.noise_rms.size(); ++ch)
     EXPECT_NEAR(r.noise_rms(ch), kNoise, 0.05 * kNoise);
+  // Every fitted parameter is typed with a unit from the vocabulary or the effect's declaration
+  // (never guessed from its key; "" for a ratio).
+  for (const auto& p : TypedParameters(r.cx, e)) {
+    EXPECT_TRUE(p["unit"].is_string()) << c.name << " " << p.dump();
+    EXPECT_TRUE(p["status"].is_string()) << c.name << " " << p.dump();
+  }
   const std::string n = c.name;
   if (n == "creep") {
     EXPECT_NEAR(e.params["tau_s"].get<double>(), fx.truth, 0.15 * fx.truth);
