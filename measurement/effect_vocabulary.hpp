@@ -47,6 +47,9 @@ enum ParamRole : unsigned {
   kInjected = 1U,
   kReported = 2U,
   kBoth = 3U,
+  /// A figure the report may carry beside the required ones (a variant's or a derived value):
+  /// listed for its unit and meaning, which the report writers take from here.
+  kDescribed = 4U,
 };
 
 /// One parameter of an effect.
@@ -77,16 +80,30 @@ inline constexpr std::array kZeroOffset = {
 inline constexpr std::array kZeroDrift = {
     P{"amplitude_mvv", T::kNumber, "mV/V", "RMS of the slow wander over the record", kInjected,
       "amplitude"},
-    P{"corner_hz", T::kNumber, "Hz", "highest frequency of the wander", kInjected, ""}, kChannels};
+    P{"corner_hz", T::kNumber, "Hz", "highest frequency of the wander", kInjected, ""},
+    P{"span_mvv", T::kNumber, "mV/V", "range of the fitted wander, per channel", kDescribed, ""},
+    P{"level_from_s", T::kList, "s", "start of every fitted level (stepped variant)", kReported,
+      ""},
+    P{"levels_mvv", T::kList, "mV/V", "every fitted level, per channel (stepped variant)",
+      kReported, ""},
+    kChannels};
 inline constexpr std::array kThermalZeroDrift = {
     P{"coef_per_K", T::kList, "mV/V/K", "offset per kelvin, per channel", kBoth, ""},
     P{"t0_c", T::kNumber, "°C", "temperature of zero offset", kInjected, ""}, kChannels};
 inline constexpr std::array kThermalSpanDrift = {
     P{"coef_per_K", T::kNumber, "1/K", "relative sensitivity change per kelvin", kBoth, ""},
-    P{"t0_c", T::kNumber, "°C", "temperature of nominal sensitivity", kInjected, ""}, kChannels};
+    P{"t0_c", T::kNumber, "°C", "temperature of nominal sensitivity", kInjected, ""},
+    P{"ref_temp_C", T::kNumber, "°C", "fitted temperature of nominal sensitivity", kDescribed, ""},
+    P{"coef_per_K_by_channel", T::kList, "1/K",
+      "relative sensitivity change per kelvin, per channel", kDescribed, ""},
+    kChannels};
 inline constexpr std::array kExcitationDrift = {
     P{"amplitude", T::kNumber, "", "RMS of the common relative sensitivity wander", kInjected, ""},
-    P{"corner_hz", T::kNumber, "Hz", "highest frequency of the wander", kInjected, ""}};
+    P{"corner_hz", T::kNumber, "Hz", "highest frequency of the wander", kInjected, ""},
+    P{"factor_min", T::kNumber, "", "least fitted sensitivity factor over the record", kDescribed,
+      ""},
+    P{"factor_max", T::kNumber, "", "largest fitted sensitivity factor over the record", kDescribed,
+      ""}};
 inline constexpr std::array kCreep = {
     P{"tau_s", T::kNumber, "s", "first-order creep time constant", kBoth, ""},
     P{"fraction", T::kNumber, "", "share of a load change that creeps in (report: per channel)",
@@ -99,15 +116,29 @@ inline constexpr std::array kCreep = {
     kChannels};
 inline constexpr std::array kHysteresis = {
     P{"amplitude", T::kNumber, "", "loop size as a fraction of rated load", kInjected, ""},
-    P{"width", T::kNumber, "", "widest play threshold as a fraction of rated load", kInjected, ""}};
+    P{"width", T::kNumber, "", "widest play threshold as a fraction of rated load", kInjected, ""},
+    P{"travel_fraction", T::kNumber, "", "loop width as a fraction of the load's travel",
+      kDescribed, ""},
+    P{"half_width_mvv", T::kList, "mV/V", "loop half width, per channel", kDescribed, ""},
+    P{"loop_half_height_mvv", T::kList, "mV/V", "loop half height, per channel", kDescribed, ""},
+    P{"relay_levels", T::kNumber, "", "load levels of the relay grid", kDescribed, ""}};
 inline constexpr std::array kBridgeNonlinearity = {
     P{"channels", T::kChannels, "", "bridges with a quadratic term", kBoth, ""},
-    P{"coef", T::kNumber, "1/(mV/V)", "quadratic coefficient: b += coef·b²", kInjected, ""}};
+    P{"coef", T::kNumber, "1/(mV/V)", "quadratic coefficient: b += coef·b²", kInjected, ""},
+    P{"quadratic_per_mvv", T::kList, "1/(mV/V)", "fitted quadratic coefficient, per channel",
+      kDescribed, ""}};
 inline constexpr std::array kGeometricNonlinearity = {
-    P{"coef", T::kNumber, "", "cubic term at rated load", kInjected, ""}};
+    P{"coef", T::kNumber, "", "cubic term at rated load", kInjected, ""},
+    P{"cubic_per_mvv2", T::kList, "1/(mV/V)²", "fitted cubic coefficient, per channel", kDescribed,
+      ""},
+    P{"relative_at_peak", T::kList, "", "cubic term relative to the output at the peak load",
+      kDescribed, ""}};
 inline constexpr std::array kLoadStiffening = {
     P{"coef", T::kNumber, "", "relative bending/shear sensitivity change at rated Fz", kInjected,
-      ""}};
+      ""},
+    P{"fz_peak_n", T::kNumber, "N", "largest |Fz| of the record", kDescribed, ""},
+    P{"kappa_at_peak_Fz", T::kList, "", "relative sensitivity change at the peak Fz, per channel",
+      kDescribed, ""}};
 inline constexpr std::array kMisalignment = {
     P{"axis", T::kRotAxis, "", "rotation axis (x, y, z)", kBoth, ""},
     P{"angle_deg", T::kNumber, "deg", "rotation of the sensor frame", kBoth, ""}};
@@ -117,7 +148,9 @@ inline constexpr std::array kGainError = {
 inline constexpr std::array kTimeSkew = {
     P{"delay_s", T::kNumber, "s", "delay of the recording (>0: real lags)", kBoth, ""}};
 inline constexpr std::array kSaturation = {
-    P{"limit", T::kNumber, "mV/V", "clipping level", kBoth, ""}, kChannels};
+    P{"limit", T::kNumber, "mV/V", "clipping level", kBoth, ""},
+    P{"limit_high", T::kNumber, "mV/V", "upper clipping level", kDescribed, ""},
+    P{"limit_low", T::kNumber, "mV/V", "lower clipping level", kDescribed, ""}, kChannels};
 inline constexpr std::array kOverloadShift = {
     P{"onset_s", T::kNumber, "s", "time of the overload and the shift", kBoth, ""},
     P{"shift", T::kNumber, "mV/V", "zero shift on the most sensitive channel", kInjected, ""},
@@ -132,7 +165,20 @@ inline constexpr std::array kMainsInterference = {
     P{"freq_hz", T::kNumber, "Hz", "pick-up frequency", kBoth, ""},
     P{"amplitude_mvv", T::kNumber, "mV/V", "peak amplitude (report: per channel)", kBoth,
       "amplitude"},
-    P{"phase_deg", T::kNumber, "deg", "phase at t = 0", kInjected, ""}, kChannels};
+    P{"phase_deg", T::kNumber, "deg", "phase at t = 0", kInjected, ""},
+    P{"h2_amplitude_mvv", T::kList, "mV/V", "harmonic 2's peak amplitude, per channel", kDescribed,
+      ""},
+    P{"h2_seen_at_hz", T::kNumber, "Hz", "where harmonic 2 was found", kDescribed, ""},
+    P{"h3_amplitude_mvv", T::kList, "mV/V", "harmonic 3's peak amplitude, per channel", kDescribed,
+      ""},
+    P{"h3_seen_at_hz", T::kNumber, "Hz", "where harmonic 3 was found", kDescribed, ""},
+    P{"h4_amplitude_mvv", T::kList, "mV/V", "harmonic 4's peak amplitude, per channel", kDescribed,
+      ""},
+    P{"h4_seen_at_hz", T::kNumber, "Hz", "where harmonic 4 was found", kDescribed, ""},
+    P{"h5_amplitude_mvv", T::kList, "mV/V", "harmonic 5's peak amplitude, per channel", kDescribed,
+      ""},
+    P{"h5_seen_at_hz", T::kNumber, "Hz", "where harmonic 5 was found", kDescribed, ""},
+    kChannels};
 inline constexpr std::array kResonance = {
     P{"freq_hz", T::kNumber, "Hz", "undamped natural frequency", kBoth, ""},
     P{"damping_ratio", T::kNumber, "", "damping ratio ζ", kBoth, ""},
@@ -144,6 +190,7 @@ inline constexpr std::array kResonance = {
       ""},
     P{"participation2", T::kNumber, "",
       "mode 2's share of the output, per channel (two-mode variant)", kReported, ""},
+    P{"damped_freq_hz", T::kNumber, "Hz", "damped frequency the record rings at", kDescribed, ""},
     kChannels};
 inline constexpr std::array kConverterGlitch = {
     P{"count", T::kNumber, "", "isolated wrong codes (report: how many were found)", kBoth, ""},

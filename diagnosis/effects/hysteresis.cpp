@@ -231,12 +231,7 @@ std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Series& 
   e.params["loop_half_height_mvv"] = weights;
   e.sigma["loop_half_height_mvv"] = sigmas;
   const int best_c = fx::DominantChannel(cx, e.pred);
-  for (int c = 0; c < cx.nc; ++c) {
-    if (e.pred.col(c).cast<double>().squaredNorm() * cx.weight(c) > 0.01 * cx.n) {
-      e.channels.push_back(c);
-    }
-  }
-  if (e.channels.empty()) e.channels.push_back(best_c);
+  e.channels = fx::ChannelsAboveNoise(cx, e.pred);
   const Eigen::VectorXd col = e.pred.col(best_c).cast<double>();
   char buf[200];
   std::snprintf(buf, sizeof buf,

@@ -328,12 +328,7 @@ std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Series& targ
   const int top_axis = LoopHalfHeights(best.ops, fit, range, &e);
   if (!best.weights_only) e.params["travel_fraction"] = best.travel_fraction;
   const int bc = fx::DominantChannel(cx, e.pred);
-  for (int c = 0; c < cx.nc; ++c) {
-    if (e.pred.col(c).cast<double>().squaredNorm() * cx.weight(c) > 0.01 * cx.n) {
-      e.channels.push_back(c);
-    }
-  }
-  if (e.channels.empty()) e.channels.push_back(bc);
+  e.channels = fx::ChannelsAboveNoise(cx, e.pred);
   const Eigen::VectorXd col = e.pred.col(bc).cast<double>();
   char buf[240];
   std::snprintf(buf, sizeof buf,

@@ -330,14 +330,15 @@ void SpreadClaims(Context* cx, std::vector<EffectFit>* claimed_effects) {
   }
 }
 
-/// Claims whose pieces of the record contradict them (PiecesContradict) are not findings: they
-/// leave the claims for r.dropped ("not_claimed"), with the reason. At least one claim is kept
-/// only when it stands (an empty list means nothing is claimed).
+/// Claims the engine's rule no longer lets stand once their pieces are known (NotResolved: a
+/// parameter at a bound, not identified, or whose pieces of the record disagree in sign) are not
+/// findings: they leave the claims for r.dropped ("not_claimed"), with the reason. At least one
+/// claim is kept only when it stands (an empty list means nothing is claimed).
 void DropContradictedClaims(const Context& cx, std::vector<EffectFit>* claimed,
                             std::vector<std::string>* dropped) {
   std::vector<EffectFit> kept;
   for (EffectFit& f : *claimed) {
-    const std::string why = PiecesContradict(cx, f);
+    const std::string why = NotResolved(cx, f);
     if (why.empty()) {
       kept.push_back(std::move(f));
     } else {

@@ -93,6 +93,57 @@ nlohmann::json OneSpread(const std::vector<std::vector<double>>& pieces,
           {"sigma", flat(sd)}, {"larger", flat(larger)}, {"agree", agree}};
 }
 
+/// The element of largest |value| of a parameter (per-channel parameters: the channel that carries
+/// it) and that value; (0, 0) when none is a number.
+std::pair<std::size_t, double> LargestElement(const nlohmann::json& v) {
+  std::size_t e = 0;
+  double value = 0.0;
+  const std::size_t dim = v.is_array() ? v.size() : 1;
+  for (std::size_t k = 0; k < dim; ++k) {
+    const nlohmann::json& x = v.is_array() ? v[k] : v;
+    if (x.is_number() && std::fabs(x.get<double>()) > std::fabs(value)) {
+      value = x.get<double>();
+      e = k;
+    }
+  }
+  return {e, value};
+}
+
+/// Why a declared parameter's value is not resolved against its range, or "": a scalar by the
+/// engine's StatusOf, per-channel values by the largest |value| above hi.
+std::string BoundWords(const EffectFit& fit, const ParamSpec& r) {
+  if (!fit.params.contains(r.key)) return "";
+  const std::vector<double> v = Values(fit.params[r.key]);
+  if (v.size() == 1 && fit.params[r.key].is_number()) return ScalarWords(r, v[0]);
+  double largest = 0.0;
+  for (double x : v) largest = std::max(largest, std::fabs(x));
+  if (largest > r.hi) {
+    return Fmt("%s up to %.4g beyond its range (%s, %.4g)", r.key, largest, r.hi_what, r.hi);
+  }
+  return "";
+}
+
+/// Why the pieces of the record contradict a declared parameter, or "": for a parameter of one
+/// sign by its physics (lo ≥ 0), the pieces' values of its largest-|value| element straddle zero.
+/// A signed parameter (a delay, an angle) near zero may take either sign in a piece; a wide range
+/// of one sign is an uncertain size: its claim stands, its evidence and spread say the pieces
+/// disagree (a range rule dropped true creep on 4-s-hold fixtures, one piece reading 3× the whole
+/// record's fraction).
+std::string PiecesWords(const EffectFit& fit, const ParamSpec& r) {
+  if (r.lo < 0.0 || !fit.spread.contains(r.key) || !fit.params.contains(r.key)) return "";
+  const auto& s = fit.spread[r.key];
+  if (!s.contains("min")) return "";
+  const auto [e, value] = LargestElement(fit.params[r.key]);
+  const nlohmann::json& lo_j = s["min"].is_array() ? s["min"][e] : s["min"];
+  const nlohmann::json& hi_j = s["max"].is_array() ? s["max"][e] : s["max"];
+  if (value == 0.0 || !lo_j.is_number() || !hi_j.is_number()) return "";
+  const double lo = lo_j.get<double>();
+  const double hi = hi_j.get<double>();
+  if (lo * hi >= 0.0) return "";
+  return Fmt("not resolved: pieces disagree (%s = %.4g, per piece %.4g–%.4g)", r.key, value, lo,
+             hi);
+}
+
 }  // namespace
 
 std::string NotResolved(const Context& cx, const EffectFit& fit) {
@@ -102,19 +153,14 @@ std::string NotResolved(const Context& cx, const EffectFit& fit) {
 
 std::string NotResolved(const Context& cx, const EffectFit& fit, const EffectSpec& spec) {
   if (spec.ranges == nullptr) return "";
-  for (const ParamSpec& r : spec.ranges(cx)) {
-    if (!fit.params.contains(r.key)) continue;
-    const std::vector<double> v = Values(fit.params[r.key]);
-    if (v.size() == 1 && fit.params[r.key].is_number()) {
-      std::string words = ScalarWords(r, v[0]);
-      if (!words.empty()) return words;
-      continue;
-    }
-    double largest = 0.0;
-    for (double x : v) largest = std::max(largest, std::fabs(x));
-    if (largest > r.hi) {
-      return Fmt("%s up to %.4g beyond its range (%s, %.4g)", r.key, largest, r.hi_what, r.hi);
-    }
+  const std::vector<ParamSpec> declared = spec.ranges(cx);
+  for (const ParamSpec& r : declared) {
+    std::string words = BoundWords(fit, r);
+    if (!words.empty()) return words;
+  }
+  for (const ParamSpec& r : declared) {
+    std::string words = PiecesWords(fit, r);
+    if (!words.empty()) return words;
   }
   return "";
 }
@@ -191,7 +237,11 @@ nlohmann::json TypedParameters(const Context& cx, const EffectFit& fit, const Ef
 
 void PieceSpreads(Context* cx, const Series& target, EffectFit* fit) {
   const EffectSpec* spec = FindEffect(fit->name);
-  if (spec == nullptr || fit->sigma.empty()) return;
+  if (spec != nullptr) PieceSpreads(cx, target, fit, *spec);
+}
+
+void PieceSpreads(Context* cx, const Series& target, EffectFit* fit, const EffectSpec& spec) {
+  if (fit->sigma.empty()) return;
   const std::vector<std::uint8_t> train = cx->train;
   const std::size_t n_train = cx->n_train;
   const auto& t = cx->data->t_s;
@@ -202,8 +252,8 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit) {
   for (int p = 0; p < kSpreadPieces; ++p) {
     const double t_lo = t.front() + span * p;
     SelectPiece(cx, train, t_lo, p + 1 == kSpreadPieces ? t.back() + 1.0 : t_lo + span);
-    std::optional<EffectFit> piece = FitNear(*spec, *cx, target, fit, false);
-    if (!piece || !NotResolved(*cx, *piece).empty()) {
+    std::optional<EffectFit> piece = FitNear(spec, *cx, target, fit, false);
+    if (!piece || !NotResolved(*cx, *piece, spec).empty()) {
       ++unresolved;
       continue;
     }
@@ -222,26 +272,6 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit) {
     fit->spread[key] = s;
   }
 }
-
-namespace {
-
-/// The element of largest |value| of a parameter (per-channel parameters: the channel that carries
-/// it) and that value; (0, 0) when none is a number.
-std::pair<std::size_t, double> LargestElement(const nlohmann::json& v) {
-  std::size_t e = 0;
-  double value = 0.0;
-  const std::size_t dim = v.is_array() ? v.size() : 1;
-  for (std::size_t k = 0; k < dim; ++k) {
-    const nlohmann::json& x = v.is_array() ? v[k] : v;
-    if (x.is_number() && std::fabs(x.get<double>()) > std::fabs(value)) {
-      value = x.get<double>();
-      e = k;
-    }
-  }
-  return {e, value};
-}
-
-}  // namespace
 
 std::string SpreadWords(const EffectFit& fit) {
   std::string out;
@@ -263,37 +293,6 @@ std::string SpreadWords(const EffectFit& fit) {
                s["min"][e].get<double>(), s["max"][e].get<double>());
   }
   return out;
-}
-
-std::string PiecesContradict(const Context& cx, const EffectFit& fit) {
-  const EffectSpec* spec = FindEffect(fit.name);
-  if (spec == nullptr || spec->ranges == nullptr) return "";
-  std::vector<std::string> ranged;
-  // Parameters of one sign by their physics (lo ≥ 0): pieces of both signs contradict them. A
-  // signed parameter (a delay, an angle) near zero may take either sign in a piece.
-  for (const ParamSpec& r : spec->ranges(cx)) {
-    if (r.lo >= 0.0) ranged.emplace_back(r.key);
-  }
-  for (auto it = fit.spread.begin(); it != fit.spread.end(); ++it) {
-    const auto& s = it.value();
-    if (!s.contains("min") || !fit.params.contains(it.key())) continue;
-    if (std::find(ranged.begin(), ranged.end(), it.key()) == ranged.end()) continue;
-    const nlohmann::json& v = fit.params[it.key()];
-    const auto [e, value] = LargestElement(v);
-    const nlohmann::json& lo_j = s["min"].is_array() ? s["min"][e] : s["min"];
-    const nlohmann::json& hi_j = s["max"].is_array() ? s["max"][e] : s["max"];
-    if (value == 0.0 || !lo_j.is_number() || !hi_j.is_number()) continue;
-    const double lo = lo_j.get<double>();
-    const double hi = hi_j.get<double>();
-    // Pieces of both signs contradict the effect itself. A wide range of one sign is an uncertain
-    // size: the claim stands, its evidence and spread say the pieces disagree (a range rule
-    // dropped true creep on 4-s-hold fixtures, one piece reading 3× the whole record's fraction).
-    if (lo * hi < 0.0) {
-      return Fmt("not resolved: pieces disagree (%s = %.4g, per piece %.4g–%.4g)", it.key().c_str(),
-                 value, lo, hi);
-    }
-  }
-  return "";
 }
 
 }  // namespace ftstack::diag

@@ -11,8 +11,13 @@
 
 namespace ftstack::diag {
 
-/// Why `fit` is not resolved ("tau_s = 0.30 s at its lower bound (3 samples)"), or "" when every
-/// ranged parameter of its plug-in lies inside its range, more than 2 % (in log) from each bound.
+/// The engine's one rule for every effect: why `fit` is never claimed, or "" when it may be. For
+/// every parameter its plug-in declares (EffectSpec::ranges), in order: at_bound or
+/// not_identified by StatusOf ("tau_s = 0.30 s at its lower bound (3 samples)"; per-channel
+/// values: the largest |value| above hi), then, once PieceSpreads has filled fit.spread,
+/// pieces_disagree for a parameter of one sign by its physics (lo ≥ 0) whose pieces' values (of
+/// its largest element) straddle zero ("not resolved: pieces disagree (fraction = -0.01, per
+/// piece -0.02–0.004)").
 [[nodiscard]] std::string NotResolved(const Context& cx, const EffectFit& fit);
 /// The same against a given plug-in (one the registry need not hold).
 [[nodiscard]] std::string NotResolved(const Context& cx, const EffectFit& fit,
@@ -30,14 +35,11 @@ inline constexpr int kSpreadPieces = 4;
 /// refit fails or is not resolved is left out and counted in "unresolved_pieces". cx's hold-out
 /// mask is restored before returning.
 void PieceSpreads(Context* cx, const Series& target, EffectFit* fit);
+/// The same with a given plug-in (one the registry need not hold).
+void PieceSpreads(Context* cx, const Series& target, EffectFit* fit, const EffectSpec& spec);
 
 /// "τ per piece 28–95 s"-style words for a fit's spreads that disagree, or "".
 [[nodiscard]] std::string SpreadWords(const EffectFit& fit);
-/// Why a claim is not a finding when its pieces contradict it: for some parameter with a stated
-/// physical range (EffectSpec::ranges: a scale of the physics, not a location such as an onset
-/// time, nor a load-dependent coefficient the pieces' load coverage moves) and a spread, the
-/// pieces' values (of its largest-|value| element) straddle zero. Empty when none does.
-[[nodiscard]] std::string PiecesContradict(const Context& cx, const EffectFit& fit);
 
 /// The report's typed `parameters` of a fit (docs/spec/diagnosis.md): one object per fitted
 /// numeric parameter of fit.params (counts, integers, are model orders and left out) with "key",

@@ -164,6 +164,15 @@ int DominantChannel(const Context& cx, const Series& pred) {
   return best;
 }
 
+std::vector<int> ChannelsAboveNoise(const Context& cx, const Series& pred, double share) {
+  std::vector<int> out;
+  for (int c = 0; c < cx.nc; ++c) {
+    if (pred.col(c).cast<double>().squaredNorm() * cx.weight(c) > share * cx.n) out.push_back(c);
+  }
+  if (out.empty()) out.push_back(DominantChannel(cx, pred));
+  return out;
+}
+
 /// Channels carrying at least `share` of the prediction's whitened energy.
 std::vector<int> ActiveChannels(const Context& cx, const Series& pred, double share) {
   Vec e(cx.nc);

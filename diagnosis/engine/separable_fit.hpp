@@ -246,6 +246,9 @@ std::vector<int> StrongestTwo(const Context& cx, const Series& r);
 int DominantChannel(const Context& cx, const Series& pred);
 /// Channels carrying at least `share` of the prediction's whitened energy.
 std::vector<int> ActiveChannels(const Context& cx, const Series& pred, double share = 0.02);
+/// Channels on which the prediction's whitened mean square exceeds `share` (of the noise's, 1),
+/// or the dominant channel alone when none does.
+std::vector<int> ChannelsAboveNoise(const Context& cx, const Series& pred, double share = 0.01);
 /// Channels whose single coefficient is significant (|β|/σ > 5) and carries ≥ 5 % of the energy
 /// explained across channels.
 std::vector<int> SignificantChannels(const Context& cx, const ChannelFit& f, const Series& pred,

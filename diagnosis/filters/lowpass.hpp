@@ -14,9 +14,9 @@ namespace ftstack::diag {
 void FirstOrderLowPass(const double* t_s, const double* x, std::size_t n, double tau_s, double* y);
 
 /// The same for m columns x[c] → y[c] on one clock, each row with its own dt: the step coefficients
-/// are computed once per row for all columns, for chunks of rows in vectorized loops (lowpass1.cpp;
-/// once for a uniform clock). Where restart[i] != 0 (restart may be nullptr) the filter starts
-/// again at rest at x[i] (a new recording begins there).
+/// are computed once per row for all columns, for chunks of rows in vectorized loops
+/// (first_order.cpp; once for a uniform clock). Where restart[i] != 0 (restart may be nullptr) the
+/// filter starts again at rest at x[i] (a new recording begins there).
 void FirstOrderLowPassColumns(const double* t_s, std::size_t n, double tau_s,
                               const double* const* x, double* const* y, std::size_t m,
                               const std::uint8_t* restart = nullptr);
@@ -81,7 +81,8 @@ void SecondOrderLowPass(const double* t_s, const double* x, std::size_t n, doubl
                         double damping_ratio, double* y);
 
 /// The same for m columns on one clock, each row with its own dt (coefficients once per row, for
-/// chunks of rows in vectorized loops: lowpass2.cpp), with restarts as FirstOrderLowPassColumns.
+/// chunks of rows in vectorized loops: second_order.cpp), with restarts as
+/// FirstOrderLowPassColumns.
 void SecondOrderLowPassColumns(const double* t_s, std::size_t n, double freq_hz,
                                double damping_ratio, const double* const* x, double* const* y,
                                std::size_t m, const std::uint8_t* restart = nullptr);

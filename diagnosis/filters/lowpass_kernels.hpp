@@ -1,4 +1,5 @@
-// Math kernels of the exact low passes (lowpass1.cpp, lowpass2.cpp), written for vectorized loops.
+// Math kernels of the exact low passes (first_order.cpp, second_order.cpp), written for vectorized
+// loops.
 #pragma once
 
 #include <algorithm>

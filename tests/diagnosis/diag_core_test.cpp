@@ -166,6 +166,12 @@ TEST_P(DiagFixture, NamesLocatesAndModelsTheEffect) {
   // Noise estimate within 5 % of the true σ on every channel.
   for (int ch = 0; ch < r.noise_rms.size(); ++ch)
     EXPECT_NEAR(r.noise_rms(ch), kNoise, 0.05 * kNoise);
+  // Every fitted parameter is typed with a unit from the vocabulary or the effect's declaration
+  // (never guessed from its key; "" for a ratio).
+  for (const auto& p : TypedParameters(r.cx, e)) {
+    EXPECT_TRUE(p["unit"].is_string()) << c.name << " " << p.dump();
+    EXPECT_TRUE(p["status"].is_string()) << c.name << " " << p.dump();
+  }
   const std::string n = c.name;
   if (n == "creep") {
     EXPECT_NEAR(e.params["tau_s"].get<double>(), fx.truth, 0.15 * fx.truth);
@@ -270,19 +276,19 @@ TEST(DiagHonesty, PiecesStraddlingZeroContradictAClaimAndOneSignDoesNot) {
                           {"agree", false},
                           {"min", {-0.001, -0.02, 0.0005}},
                           {"max", {0.005, 0.004, 0.002}}};
-  const std::string why = PiecesContradict(cx, f);
+  const std::string why = NotResolved(cx, f);
   EXPECT_NE(why.find("fraction = -0.01, per piece -0.02–0.004"), std::string::npos) << why;
   EXPECT_EQ(SpreadWords(f), "fraction on b1 per piece -0.02–0.004");
   f.spread["fraction"]["min"] = {-0.001, -0.03, 0.0005};
   f.spread["fraction"]["max"] = {0.005, -0.002, 0.002};
-  EXPECT_EQ(PiecesContradict(cx, f), "");
+  EXPECT_EQ(NotResolved(cx, f), "");
   EXPECT_EQ(SpreadWords(f), "fraction on b1 per piece -0.03–-0.002");
   // A parameter without a stated range (an onset time is the piece's own) never contradicts.
   EffectFit o;
   o.name = "overload_shift";
   o.params["onset_s"] = 2.0;
   o.spread["onset_s"] = {{"pieces", 3}, {"agree", false}, {"min", -1.0}, {"max", 3.0}};
-  EXPECT_EQ(PiecesContradict(cx, o), "");
+  EXPECT_EQ(NotResolved(cx, o), "");
   EXPECT_EQ(SpreadWords(o), "onset_s per piece -1–3");
 }
 

@@ -50,6 +50,35 @@ std::optional<EffectFit> FitWarmup(const Context& cx, const Series& target) {
 
 const EffectSpec kWarmup{.fit = &FitWarmup, .ranges = &WarmupSpecs};
 
+/// A second toy: a gain error of one sign by its physics (0 to 5 % of the load's output).
+std::vector<ParamSpec> GainSpecs(const Context& /*cx*/) {
+  return {{.key = "gain_fraction",
+           .lo = 0.0,
+           .hi = 0.05,
+           .lo_what = "none",
+           .hi_what = "5 %",
+           .scale = ParamScale::kLinear}};
+}
+
+std::optional<EffectFit> FitGain(const Context& cx, const Series& target) {
+  const Eigen::MatrixXd& load = cx.load;
+  EffectFit e;
+  e.name = "toy_gain";
+  e.n_params = cx.nc;
+  const fx::ChannelFit f = fx::FitChannels(
+      cx, target, 1, [&](int i, int c, double* x) { x[0] = load(i, c); }, &e.pred);
+  e.train_sse_w = f.sse_w;
+  fx::PutChannelCoef(cx, f, 0, "gain_fraction", &e);
+  return e;
+}
+
+EffectSpec ToyGain() {
+  EffectSpec s;
+  s.fit = &FitGain;
+  s.ranges = &GainSpecs;
+  return s;
+}
+
 // --- the test ---------------------------------------------------------------------------------
 
 /// 3 bridges at 100 Hz for 60 s on random load steps; real = sim + a_c·e^(−t/τ) + noise 1e-3.
@@ -123,6 +152,44 @@ TEST(DiagToyEffect, TruthOutsideItsRangeEndsAtTheBoundAndIsNotResolved) {
   const auto& p = Typed(typed, "warmup_tau_s");
   ASSERT_FALSE(p.is_null()) << typed.dump();
   EXPECT_EQ(p["status"], "at_bound");
+}
+
+/// 3 bridges at 100 Hz for 60 s on random load steps; real = sim·(1 + g) + noise 1e-4, g = +1 %
+/// on every bridge, except from `flip_s` on, where it is −1 %.
+DiagData GainFlip(double flip_s, unsigned seed) {
+  DiagData d = Warmup(1.0, seed);  // its load steps; its real columns are replaced
+  std::mt19937 rng(seed + 1U);
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (Eigen::Index i = 0; i < d.sim_mvv.rows(); ++i) {
+    const double gain = d.t_s[static_cast<std::size_t>(i)] < flip_s ? 0.01 : -0.01;
+    for (Eigen::Index c = 0; c < d.sim_mvv.cols(); ++c) {
+      d.real_mvv(i, c) = d.sim_mvv(i, c) * (1.0 + gain) + 1e-4 * g(rng);
+    }
+  }
+  return d;
+}
+
+// The engine's claim rule on a declared parameter whose pieces of the record disagree in sign:
+// a gain of +1 % that turns to −1 % in the last of the 4 pieces fits to about +0.5 % on the whole
+// record and is never claimed; the same gain held throughout is.
+TEST(DiagToyEffect, PiecesThatDisagreeInSignAreNeverClaimed) {
+  const EffectSpec spec = ToyGain();
+  for (const double flip_s : {46.0, 1e9}) {
+    const DiagData d = GainFlip(flip_s, 11);
+    Context cx = MakeContext(d);
+    auto fit = FitGain(cx, cx.resid);
+    ASSERT_TRUE(fit);
+    EXPECT_EQ(NotResolved(cx, *fit, spec), "");  // no pieces known yet: inside its range
+    PieceSpreads(&cx, cx.resid, &*fit, spec);
+    ASSERT_TRUE(fit->spread.contains("gain_fraction")) << fit->spread.dump();
+    const std::string why = NotResolved(cx, *fit, spec);
+    if (flip_s < 60.0) {
+      EXPECT_NE(why.find("pieces disagree (gain_fraction"), std::string::npos)
+          << why << " " << fit->spread.dump();
+    } else {
+      EXPECT_EQ(why, "") << fit->spread.dump();
+    }
+  }
 }
 
 }  // namespace

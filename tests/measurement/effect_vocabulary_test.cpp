@@ -73,7 +73,7 @@ TEST(EffectVocabulary, KeysCarryUnitsAndAliasesResolve) {
   for (const auto& def : kEffectVocabulary) {
     for (const auto& p : def.params) {
       EXPECT_FALSE(p.meaning.empty()) << def.name << "." << p.key;
-      EXPECT_NE(p.roles & kBoth, 0U) << def.name << "." << p.key;
+      EXPECT_NE(p.roles & (kBoth | kDescribed), 0U) << def.name << "." << p.key;
       const std::string key(p.key);
       // A key ending in a unit suffix declares that unit.
       if (key.ends_with("_s")) {
@@ -85,7 +85,7 @@ TEST(EffectVocabulary, KeysCarryUnitsAndAliasesResolve) {
       if (key.ends_with("_deg")) {
         EXPECT_EQ(p.unit, "deg") << key;
       }
-      if (key.ends_with("_mvv")) {
+      if (key.ends_with("_mvv") && !key.ends_with("_per_mvv")) {
         EXPECT_EQ(p.unit, "mV/V") << key;
       }
       units.insert(std::string(p.unit));
