@@ -23,9 +23,9 @@ struct FtdOptions {
   std::optional<std::array<double, 6>> sim_wrench;  ///< constant applied wrench, N and N·m
   std::string replay;                               ///< recording whose wrench columns are played
   /// Effects injected into the simulated sensor (--sim-effect, ftsim record's vocabulary); with
-  /// them (or a sim_profile) the bridges are rendered once at start-up over sim_span_s of
-  /// sim_profile (a profile of ftsim record; empty: the constant --sim-wrench at 20 °C) and hold
-  /// their last value after.
+  /// them (or a sim_profile) the bridges are composed (at start-up, or piecewise when long) over
+  /// sim_span_s of sim_profile (a profile of ftsim record; empty: the constant --sim-wrench at 20
+  /// °C) and hold their last value after.
   std::vector<std::string> sim_effects;
   std::string sim_profile;
   double sim_span_s = 600.0;

@@ -160,8 +160,9 @@ void AdditiveEffects(const std::vector<Effect>& effects, const ComposeInput& in,
         break;
       case EffectKind::kZeroDrift: {
         for (const int ch : e.channels) {
-          const auto d = Wander(in.t_s, e.num.at("amplitude_mvv"), e.num.at("corner_hz"),
-                                e.seed + static_cast<std::uint64_t>(ch) * 0x9E3779B9ULL);
+          const auto d =
+              Wander(in.t_s, e.num.at("amplitude_mvv"), e.num.at("corner_hz"),
+                     e.seed + static_cast<std::uint64_t>(ch) * 0x9E3779B9ULL, in.span_t_s);
           for (std::size_t i = 0; i < ns; ++i) out(ch, static_cast<Eigen::Index>(i)) += d[i];
         }
         break;
@@ -199,8 +200,9 @@ void AdditiveEffects(const std::vector<Effect>& effects, const ComposeInput& in,
 
 /// `count` wrong codes at seeded rows (never the first or last two, at least five rows apart),
 /// each on one of the effect's channels, ± offset_mvv with a seeded sign.
-void AddConverterGlitches(const Effect& e, Eigen::MatrixXd& out) {
-  const auto ns = static_cast<int>(out.cols());
+void AddConverterGlitches(const Effect& e, const ComposeInput& in, Eigen::MatrixXd& out) {
+  const auto ns = static_cast<int>(in.span_rows > 0 ? in.span_rows : out.cols());
+  const auto row0 = static_cast<int>(in.row0);
   const auto count = static_cast<int>(e.num.at("count"));
   if (ns < 5 || e.channels.empty()) return;
   SeededRandom rng(e.seed ^ 0x6C62272E07BB0142ULL);
@@ -213,34 +215,47 @@ void AddConverterGlitches(const Effect& e, Eigen::MatrixXd& out) {
     rows.push_back(row);
     const int ch =
         e.channels[static_cast<std::size_t>(rng.Index(static_cast<int>(e.channels.size())))];
-    out(ch, row) += (rng.Uniform() < 0.5 ? -1.0 : 1.0) * e.num.at("offset_mvv");
+    const double offset = (rng.Uniform() < 0.5 ? -1.0 : 1.0) * e.num.at("offset_mvv");
+    if (row >= row0 && row - row0 < out.cols()) out(ch, row - row0) += offset;
   }
 }
 
 }  // namespace
 
 std::vector<double> Wander(const std::vector<double>& t_s, double amplitude, double corner_hz,
-                           std::uint64_t seed) {
+                           std::uint64_t seed, const std::vector<double>* span_t_s) {
   std::vector<double> d(t_s.size(), 0.0);
-  if (t_s.size() < 2 || amplitude == 0.0) return d;
+  const std::vector<double>& grid = span_t_s != nullptr ? *span_t_s : t_s;
+  if (grid.size() < 2 || amplitude == 0.0) return d;
   SeededRandom rng(seed ^ 0xD1B54A32D192ED03ULL);
-  const double span = t_s.back() - t_s.front();
+  const double span = grid.back() - grid.front();
   const double f_lo = std::min(0.25 / span, 0.5 * corner_hz);
   constexpr int kTerms = 12;
+  std::array<double, kTerms> freq{};
+  std::array<double, kTerms> amp{};
+  std::array<double, kTerms> phase{};
   for (int k = 0; k < kTerms; ++k) {
-    const double f = f_lo * std::pow(corner_hz / f_lo, static_cast<double>(k) / (kTerms - 1));
-    const double a = std::abs(rng.Normal()) / f;
-    const double ph = rng.Uniform(0.0, 2.0 * std::numbers::pi);
-    for (std::size_t i = 0; i < t_s.size(); ++i) {
-      d[i] += a * (std::sin(2.0 * std::numbers::pi * f * (t_s[i] - t_s[0]) + ph) - std::sin(ph));
+    const auto j = static_cast<std::size_t>(k);
+    freq[j] = f_lo * std::pow(corner_hz / f_lo, static_cast<double>(k) / (kTerms - 1));
+    amp[j] = std::abs(rng.Normal()) / freq[j];
+    phase[j] = rng.Uniform(0.0, 2.0 * std::numbers::pi);
+  }
+  const auto at = [&](double t) {
+    double v = 0.0;
+    for (std::size_t j = 0; j < kTerms; ++j) {
+      v += amp[j] * (std::sin(2.0 * std::numbers::pi * freq[j] * (t - grid.front()) + phase[j]) -
+                     std::sin(phase[j]));
     }
-  }
+    return v;
+  };
   double ss = 0.0;
-  for (const double v : d) ss += v * v;
-  const double rms = std::sqrt(ss / static_cast<double>(d.size()));
-  if (rms > 0) {
-    for (double& v : d) v *= amplitude / rms;
+  for (const double t : grid) {
+    const double v = at(t);
+    ss += v * v;
   }
+  const double rms = std::sqrt(ss / static_cast<double>(grid.size()));
+  const double scale = rms > 0 ? amplitude / rms : 1.0;
+  for (std::size_t i = 0; i < t_s.size(); ++i) d[i] = at(t_s[i]) * scale;
   return d;
 }
 
@@ -279,7 +294,8 @@ Eigen::MatrixXd Compose(const std::vector<Effect>& effects, const ComposeInput& 
         out.row(ch) += e.num.at("coef") * out.row(ch).cwiseAbs2();
       }
     } else if (e.kind == EffectKind::kExcitationDrift) {
-      const auto d = Wander(in.t_s, e.num.at("amplitude"), e.num.at("corner_hz"), e.seed);
+      const auto d =
+          Wander(in.t_s, e.num.at("amplitude"), e.num.at("corner_hz"), e.seed, in.span_t_s);
       for (std::size_t i = 0; i < ns; ++i) out.col(static_cast<Eigen::Index>(i)) *= 1.0 + d[i];
     }
   }
@@ -296,7 +312,7 @@ Eigen::MatrixXd Compose(const std::vector<Effect>& effects, const ComposeInput& 
   }
   // 7. Isolated wrong codes of the converter: after everything the analogue side does.
   for (const auto& e : effects) {
-    if (e.kind == EffectKind::kConverterGlitch) AddConverterGlitches(e, out);
+    if (e.kind == EffectKind::kConverterGlitch) AddConverterGlitches(e, in, out);
   }
   return out;
 }

@@ -79,6 +79,12 @@ struct ComposeInput {
   std::vector<double> t_s;     ///< sample times, uniform
   std::vector<double> temp_c;  ///< body temperature per sample
   Wrench rated = Wrench::Ones();
+  /// When t_s is one piece of a longer recording: a grid of the whole recording's times (slow
+  /// wanders are laid out and scaled to their RMS over it), the piece's first row in the
+  /// recording and the recording's rows (converter glitches are placed over all of them).
+  const std::vector<double>* span_t_s = nullptr;
+  std::size_t row0 = 0;
+  std::size_t span_rows = 0;
 };
 
 /// Bridge outputs (N × samples, mV/V, noise-free) with `effects` applied; no effects gives the
@@ -90,8 +96,10 @@ struct ComposeInput {
 void InsertOverload(const Effect& e, LoadProfile& profile, const Wrench& rated);
 
 /// Slow random wander (sum of 12 sinusoids with 1/f amplitudes between ≈1/(4·duration) and
-/// corner_hz, random phases), zero at t[0] and scaled to RMS `amplitude` over t.
+/// corner_hz, random phases), zero at t[0] and scaled to RMS `amplitude` over t. With `span_t_s`
+/// the duration, the zero and the RMS are those of that grid (t_s a piece of it).
 [[nodiscard]] std::vector<double> Wander(const std::vector<double>& t_s, double amplitude,
-                                         double corner_hz, std::uint64_t seed);
+                                         double corner_hz, std::uint64_t seed,
+                                         const std::vector<double>* span_t_s = nullptr);
 
 }  // namespace ftstack::sim

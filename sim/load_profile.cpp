@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "measurement/recording.hpp"
+#include "sim/work_cycles.hpp"
 
 namespace ftstack::sim {
 
@@ -476,13 +477,36 @@ LoadProfile::LoadProfile(std::string name, std::vector<double> load_t_s, std::ve
   }
 }
 
+namespace {
+
+Wrench InterpWrench(const std::vector<double>& t, const std::vector<Wrench>& w, double t_s) {
+  if (t_s <= t.front()) return w.front();
+  if (t_s >= t.back()) return w.back();
+  const auto it = std::upper_bound(t.begin(), t.end(), t_s);
+  const std::size_t b = static_cast<std::size_t>(it - t.begin());
+  const double f = (t_s - t[b - 1]) / (t[b] - t[b - 1]);
+  return w[b - 1] + f * (w[b] - w[b - 1]);
+}
+
+}  // namespace
+
 Wrench LoadProfile::LoadAt(double t_s) const {
-  if (t_s <= load_t_.front()) return load_.front();
-  if (t_s >= load_t_.back()) return load_.back();
-  const auto it = std::upper_bound(load_t_.begin(), load_t_.end(), t_s);
-  const std::size_t b = static_cast<std::size_t>(it - load_t_.begin());
-  const double f = (t_s - load_t_[b - 1]) / (load_t_[b] - load_t_[b - 1]);
-  return load_[b - 1] + f * (load_[b] - load_[b - 1]);
+  Wrench w = InterpWrench(load_t_, load_, t_s);
+  if (!vibration_t_.empty()) {
+    w += InterpWrench(vibration_t_, vibration_, t_s) *
+         std::sin(2.0 * std::numbers::pi * vibration_hz_ * t_s);
+  }
+  return w;
+}
+
+void LoadProfile::SetVibration(double freq_hz, std::vector<double> amplitude_t_s,
+                               std::vector<Wrench> amplitude) {
+  if (!(freq_hz > 0) || amplitude_t_s.empty() || amplitude_t_s.size() != amplitude.size()) {
+    throw ProfileError(name_ + ": a vibration needs a frequency > 0 and amplitude keyframes");
+  }
+  vibration_hz_ = freq_hz;
+  vibration_t_ = std::move(amplitude_t_s);
+  vibration_ = std::move(amplitude);
 }
 
 double LoadProfile::TemperatureAt(double t_s) const { return Interp(temp_t_, temp_c_, t_s); }
@@ -549,6 +573,7 @@ LoadProfile MakeProfile(const std::string& spec, const Wrench& rated, std::uint6
   if (spec == "base-estop") {
     return Generated("base-estop", BaseEstopCycle, 1000.0, rated, seed, duration_s, false);
   }
+  if (spec.rfind("work:", 0) == 0) return MakeWorkCycle(spec.substr(5), rated, seed, duration_s);
   std::string path = spec;
   if (path.rfind("file:", 0) == 0) path = path.substr(5);
   if (EndsWith(path, ".json")) {
@@ -557,7 +582,7 @@ LoadProfile MakeProfile(const std::string& spec, const Wrench& rated, std::uint6
   if (EndsWith(path, ".csv")) return FromCsv(path, duration_s);
   throw ProfileError("unknown profile '" + spec +
                      "' (rig, taps, thermal, hold, base-pick, base-tilt, base-estop, or a .json "
-                     "keyframe / .csv recording file)");
+                     "keyframe / .csv recording file, or work:NAME)");
 }
 
 }  // namespace ftstack::sim

@@ -51,6 +51,11 @@ class LoadProfile {
   void Splice(double t0_s, double t1_s, const std::vector<double>& t_s,
               const std::vector<Wrench>& w);
 
+  /// Adds a tool vibration: amplitude(t)·sin(2π·freq_hz·t), the amplitude (N, N·m peak per axis)
+  /// piecewise linear between its keyframes as the load is.
+  void SetVibration(double freq_hz, std::vector<double> amplitude_t_s,
+                    std::vector<Wrench> amplitude);
+
   [[nodiscard]] const std::string& name() const { return name_; }
   [[nodiscard]] double duration_s() const { return duration_s_; }
   [[nodiscard]] double default_rate_hz() const { return default_rate_hz_; }
@@ -65,6 +70,9 @@ class LoadProfile {
   std::vector<double> temp_c_;
   double duration_s_ = 0.0;
   double default_rate_hz_ = 200.0;
+  double vibration_hz_ = 0.0;
+  std::vector<double> vibration_t_;
+  std::vector<Wrench> vibration_;
 };
 
 /// Builds a profile. `spec` is one of
@@ -81,6 +89,8 @@ class LoadProfile {
 ///            (≈ 24 s, 200 Hz); pick-and-place then an emergency stop in which every component
 ///            reaches its rated value within 20 ms and rings down at 8 Hz (≈ 14 s, 1 kHz). On a
 ///            sensor rated at the Panda base figures (300/410 N, 280/190 N·m) these are them.
+///   work:NAME  a robot or machine work cycle (sim/work_cycles.hpp: machine-tending, palletising,
+///            assembly, polishing, hand-guiding, screwdriving, night-idle); 24 h at 1 kHz
 ///   PATH     (or file:PATH) a JSON keyframe file (schema "ftstack-profile/1": {"keyframes":
 ///            [{"t_s", "wrench": [6], "temp_C"}], "rate_hz"}) or a recording CSV with t and the
 ///            wrench columns (temp_C optional)

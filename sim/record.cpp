@@ -120,25 +120,6 @@ double CheckedNoise(const RecordRequest& req) {
   return noise;
 }
 
-/// Saturation effects without a limit get 0.9 × the 99.5th percentile of |output| of their
-/// channels in the effect-free prediction, so the largest loads clip.
-void DefaultSaturationLimits(const Eigen::MatrixXd& sim, std::vector<Effect>* effects) {
-  for (auto& e : *effects) {
-    if (e.kind != EffectKind::kSaturation || !std::isnan(e.num["limit"])) continue;
-    std::vector<double> mags;
-    for (Eigen::Index i = 0; i < sim.cols(); ++i) {
-      double m = 0.0;
-      for (const int ch : e.channels) m = std::max(m, std::abs(sim(ch, i)));
-      mags.push_back(m);
-    }
-    const auto q =
-        mags.begin() + static_cast<std::ptrdiff_t>(0.995 * static_cast<double>(mags.size() - 1));
-    std::nth_element(mags.begin(), q, mags.end());
-    e.num["limit"] = 0.9 * *q;
-    if (!(*q > 0)) throw std::invalid_argument("saturation: the recording has no load to clip");
-  }
-}
-
 /// The real recording's bridges after the simulated ADC, back in mV/V, and its temperature.
 struct AdcOutput {
   std::vector<std::vector<double>> bridges_mvv;  // per channel
@@ -259,32 +240,55 @@ nlohmann::json MakeTruth(const RecordRequest& req, const ComposeInput& in,
 
 }  // namespace
 
+void DefaultSaturationLimits(const Eigen::MatrixXd& sim, std::vector<Effect>* effects) {
+  for (auto& e : *effects) {
+    if (e.kind != EffectKind::kSaturation || !std::isnan(e.num["limit"])) continue;
+    std::vector<double> mags;
+    for (Eigen::Index i = 0; i < sim.cols(); ++i) {
+      double m = 0.0;
+      for (const int ch : e.channels) m = std::max(m, std::abs(sim(ch, i)));
+      mags.push_back(m);
+    }
+    const auto q =
+        mags.begin() + static_cast<std::ptrdiff_t>(0.995 * static_cast<double>(mags.size() - 1));
+    std::nth_element(mags.begin(), q, mags.end());
+    e.num["limit"] = 0.9 * *q;
+    if (!(*q > 0)) throw std::invalid_argument("saturation: the recording has no load to clip");
+  }
+}
+
+std::vector<Effect> ResolveEffects(const SensorModel& model, LoadProfile& profile, double rate_hz,
+                                   const std::vector<EffectSpec>& specs, std::uint64_t seed) {
+  const auto rows = static_cast<std::size_t>(std::floor(profile.duration_s() * rate_hz + 1e-9)) + 1;
+  EffectContext ctx;
+  ctx.channels = model.channel_count();
+  ctx.rated = model.rated();
+  ctx.sensitivity = model.Sensitivity();
+  ctx.duration_s = static_cast<double>(rows - 1) / rate_hz;
+  ctx.rate_hz = rate_hz;
+  ctx.t0_c = profile.TemperatureAt(0.0);
+  ctx.seed = seed;
+  std::vector<Effect> effects;
+  for (std::size_t i = 0; i < specs.size(); ++i) {
+    effects.push_back(ResolveEffect(specs[i], ctx, static_cast<int>(i)));
+  }
+  for (const auto& e : effects) {
+    if (e.kind == EffectKind::kOverloadShift) InsertOverload(e, profile, ctx.rated);
+  }
+  return effects;
+}
+
 ComposeSetup SetUpCompose(const SensorModel& model, LoadProfile& profile, double rate_hz,
                           const std::vector<EffectSpec>& specs, std::uint64_t seed) {
-  const Wrench rated = model.rated();
   const auto rows = static_cast<std::size_t>(std::floor(profile.duration_s() * rate_hz + 1e-9)) + 1;
   ComposeSetup setup;
   ComposeInput& in = setup.in;
   in.model = &model;
   in.profile = &profile;
-  in.rated = rated;
+  in.rated = model.rated();
   in.t_s.resize(rows);
   for (std::size_t i = 0; i < rows; ++i) in.t_s[i] = static_cast<double>(i) / rate_hz;
-
-  EffectContext ctx;
-  ctx.channels = model.channel_count();
-  ctx.rated = rated;
-  ctx.sensitivity = model.Sensitivity();
-  ctx.duration_s = in.t_s.back();
-  ctx.rate_hz = rate_hz;
-  ctx.t0_c = profile.TemperatureAt(0.0);
-  ctx.seed = seed;
-  for (std::size_t i = 0; i < specs.size(); ++i) {
-    setup.effects.push_back(ResolveEffect(specs[i], ctx, static_cast<int>(i)));
-  }
-  for (const auto& e : setup.effects) {
-    if (e.kind == EffectKind::kOverloadShift) InsertOverload(e, profile, rated);
-  }
+  setup.effects = ResolveEffects(model, profile, rate_hz, specs, seed);
   in.temp_c.resize(rows);
   for (std::size_t i = 0; i < rows; ++i) in.temp_c[i] = profile.TemperatureAt(in.t_s[i]);
   return setup;

@@ -39,6 +39,13 @@ struct RecordResult {
 /// SensorDescriptionError or std::invalid_argument with a one-line reason.
 [[nodiscard]] RecordResult MakeRecording(const RecordRequest& request);
 
+/// `specs` resolved against `model` for `profile` sampled at `rate_hz` (defaults filled in; the
+/// overloads an overload_shift needs inserted into `profile`).
+[[nodiscard]] std::vector<Effect> ResolveEffects(const SensorModel& model, LoadProfile& profile,
+                                                 double rate_hz,
+                                                 const std::vector<EffectSpec>& specs,
+                                                 std::uint64_t seed);
+
 /// What Compose needs for `profile` sampled at `rate_hz` from 0 to its duration, with `specs`
 /// resolved against `model` (defaults filled in; the overloads an overload_shift needs inserted
 /// into `profile`). The input points at `model` and `profile`: they must outlive it.
@@ -53,6 +60,10 @@ struct ComposeSetup {
 /// The bridge outputs (N × rows, mV/V, noise-free) with the set-up's effects, as MakeRecording
 /// composes its real recording (saturation limits defaulted from the model's prediction).
 [[nodiscard]] Eigen::MatrixXd ComposeWithEffects(ComposeSetup* setup);
+
+/// Saturation effects without a limit get 0.9 × the 99.5th percentile of |output| of their
+/// channels in `sim`, the effect-free prediction (N × samples), so the largest loads clip.
+void DefaultSaturationLimits(const Eigen::MatrixXd& sim, std::vector<Effect>* effects);
 
 /// Parses several --effect arguments (see ParseEffectSpec).
 [[nodiscard]] std::vector<EffectSpec> ParseEffects(const std::vector<std::string>& texts);

@@ -10,9 +10,11 @@
 #include "measurement/recording.hpp"
 #include "sim/ideal_calibration.hpp"
 #include "sim/load_profile.hpp"
+#include "sim/piecewise_compose.hpp"
 #include "sim/record.hpp"
 #include "sim/sensor_description.hpp"
 #include "sim/simulated_sensor.hpp"
+#include "sim/streamed_bridges.hpp"
 #include "sim/wrench_source.hpp"
 
 namespace ftstack::daemon {
@@ -48,9 +50,17 @@ class RenderedBridges final : public hal::sim::BridgeSignalSource {
   double rate_hz_;
 };
 
+/// Recordings up to this many rows are composed whole at start-up (exactly what `ftsim record`
+/// composes); longer ones piece by piece while they are read (bounded memory: a 24 h profile at
+/// 1 kHz would take ≈ 4 GB whole).
+constexpr double kWholeRows = 2e6;
+/// Rows per piece of a streamed recording (65 s at 1 kHz).
+constexpr std::size_t kPieceRows = std::size_t{1} << 16;
+
 /// The bridges of `desc` under the options' profile (or constant wrench) with --sim-effect
 /// injected, over --sim-span-s at the sample rate. Throws on a bad effect or profile.
-std::unique_ptr<RenderedBridges> Render(const sim::SensorDescription& desc, const FtdOptions& opt) {
+std::unique_ptr<hal::sim::BridgeSignalSource> Render(const sim::SensorDescription& desc,
+                                                     const FtdOptions& opt) {
   const sim::SensorModel& model = *desc.model;
   sim::LoadProfile profile;
   if (!opt.sim_profile.empty()) {
@@ -63,9 +73,17 @@ std::unique_ptr<RenderedBridges> Render(const sim::SensorDescription& desc, cons
     profile = sim::LoadProfile("constant", {0.0}, {w}, {0.0}, {20.0}, opt.sim_span_s, opt.rate_hz);
   }
   const double rows = profile.duration_s() * opt.rate_hz;
-  if (rows < 2 || rows > 2e7) {
+  if (!(rows >= 2)) {
     throw std::invalid_argument("--sim-span-s: " + std::to_string(rows) +
-                                " samples to render (2 … 2e7: shorten the span or the rate)");
+                                " samples to render (at least 2: lengthen the span)");
+  }
+  if (rows > kWholeRows) {
+    std::vector<sim::Effect> effects = sim::ResolveEffects(
+        model, profile, opt.rate_hz, sim::ParseEffects(opt.sim_effects), opt.seed);
+    return std::make_unique<sim::StreamedBridges>(
+        std::make_unique<sim::PiecewiseComposition>(model, std::move(profile), opt.rate_hz,
+                                                    std::move(effects), kPieceRows),
+        opt.rate_hz);
   }
   sim::ComposeSetup setup =
       sim::SetUpCompose(model, profile, opt.rate_hz, sim::ParseEffects(opt.sim_effects), opt.seed);
@@ -127,7 +145,7 @@ class SimulatedBackend final : public AdcBackend {
   }
 
   sim::SensorDescription desc_;
-  std::unique_ptr<RenderedBridges> rendered_;
+  std::unique_ptr<hal::sim::BridgeSignalSource> rendered_;
   std::unique_ptr<hal::sim::SimAdc> rendered_adc_;
   std::unique_ptr<sim::WrenchSource> source_;
   std::unique_ptr<sim::SimulatedAdc> simulated_;

@@ -237,6 +237,23 @@ void ExpectMainsFlagged(double amplitude_mvv, bool one_bridge) {
   std::printf("\n");
 }
 
+TEST(FtdHealth, DayLongWorkCycleIsComposedInPiecesAndWatched) {
+  // 24 h at 1 kHz (8.64e7 samples: ≈ 4 GB composed whole, beyond what ftd composed at start-up);
+  // composed in pieces while read, the tone is flagged as on a short span.
+  Health h({"--sim-profile", "work:night-idle", "--sim-span-s", "86400", "--sim-effect",
+            "mains_interference:freq_hz=50,amplitude_mvv=0.002"},
+           5);
+  ASSERT_GT(h.port(), 0) << h.Stderr();
+  const Flag f = h.WaitFor(fw::HealthCause::kMains50, 20.0);
+  ASSERT_TRUE(f.found) << h.Stderr();
+  ExpectFlaggedBy(f, 5.0);
+  const auto truth = OnAxes({0.002, 0.002, 0.002, 0.002, 0.002, 0.002});
+  std::array<double, 6> abs_truth{};
+  for (std::size_t a = 0; a < 6; ++a) abs_truth[a] = std::fabs(truth[a]);
+  ExpectWithinFactor2(f.error, abs_truth, 2e-4, 2e-4);
+  EXPECT_NEAR(f.error[2], abs_truth[2], 0.03 * abs_truth[2]);
+}
+
 TEST(FtdHealth, MainsOfAnyAmplitudeOnEveryBridgeFlagged) {
   for (const double a : {0.002, 0.05, 0.2}) ExpectMainsFlagged(a, false);
 }
