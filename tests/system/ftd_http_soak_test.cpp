@@ -3,7 +3,6 @@
 // samples never going back, streams never stalling, ftd's memory flat and sampling alive.
 // CI runs 5 s; FTSTACK_SOAK_SECONDS=60 build/tests/test_ftd_http_soak runs the long version. The
 // client is plain POSIX sockets and HTTP/1.1 written here, independent of the server's library.
-// The TSan stage runs it too (the HTTP threads beside sampling and Modbus).
 #include <gtest/gtest.h>
 #include <sys/socket.h>
 #include <unistd.h>
