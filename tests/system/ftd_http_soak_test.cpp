@@ -18,29 +18,19 @@
 
 #include "tests/system/ftd_process.hpp"
 #include "tests/system/raw_connect.hpp"
+#include "tests/system/soak.hpp"
 
 namespace ftstack {
 namespace {
+
+using test::SoakSeconds;
+using test::VmRssKb;
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 constexpr bool kSanitized = true;  // this test and ftd come from the same sanitizer build
 #else
 constexpr bool kSanitized = false;
 #endif
-
-double SoakSeconds() {
-  const char* s = std::getenv("FTSTACK_SOAK_SECONDS");
-  const double v = s != nullptr ? std::atof(s) : 5.0;
-  return v > 0 ? v : 5.0;
-}
-
-long VmRssKb(pid_t pid) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
-  for (std::string line; std::getline(in, line);) {
-    if (line.rfind("VmRSS:", 0) == 0) return std::atol(line.c_str() + 6);
-  }
-  return -1;
-}
 
 /// A socket with send and receive timeouts, or -1.
 int Open(int port, int timeout_ms) {

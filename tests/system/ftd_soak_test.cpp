@@ -20,28 +20,16 @@
 #include "tests/support/temp_dir.hpp"
 #include "tests/system/ftd_process.hpp"
 #include "tests/system/raw_connect.hpp"
+#include "tests/system/soak.hpp"
 
 namespace ftstack {
 namespace {
 
+using test::SoakSeconds;
+using test::VmRssKb;
+
 using fw::UnpackFloat32;
 using fw::UnpackU32;
-
-double SoakSeconds() {
-  const char* s = std::getenv("FTSTACK_SOAK_SECONDS");
-  const double v = s != nullptr ? std::atof(s) : 5.0;
-  return v > 0 ? v : 5.0;
-}
-
-/// Resident memory of a process, kB (VmRSS of /proc/PID/status); -1 when unreadable.
-long VmRssKb(pid_t pid) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("VmRSS:", 0) == 0) return std::atol(line.c_str() + 6);
-  }
-  return -1;
-}
 
 modbus_t* Connect(int port) {
   modbus_t* ctx = modbus_new_tcp("127.0.0.1", port);
