@@ -27,7 +27,8 @@ claimed) as above; the ringing is not asserted there (Ketter 133's holds of 7-65
 for its line to be a resolved per-change ringing; SEESL shows no line), which is printed. The time
 each diagnosis takes is printed, not asserted (performance lives in bench/).
 
-Usage: diag_ringing_real_test.py FTDIAG
+Usage: diag_ringing_real_test.py FTDIAG [--seeds S1,S2,...]
+(--seeds: a subset of the generator seeds; the sanitizer stage runs two, the checks unchanged.)
 """
 
 import os
@@ -173,9 +174,14 @@ def check_real(ftdiag, work, file, failures):
 
 def main():
     ftdiag = sys.argv[1]
+    seeds = (101, 102, 103, 104, 105, 106, 110, 117, 123)
+    if len(sys.argv) == 4 and sys.argv[2] == "--seeds":
+        seeds = tuple(int(s) for s in sys.argv[3].split(","))
+    elif len(sys.argv) != 2:
+        sys.exit("usage: diag_ringing_real_test.py FTDIAG [--seeds S1,S2,...]")
     failures = []
     with tempfile.TemporaryDirectory() as work:
-        for seed in (101, 102, 103, 104, 105, 106, 110, 117, 123):
+        for seed in seeds:
             check_generator(ftdiag, work, seed, failures)
         for file in ("ketter133_2024-02-14.csv", "seesl_2024-01-22.csv"):
             check_real(ftdiag, work, file, failures)
