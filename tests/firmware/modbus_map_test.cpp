@@ -264,15 +264,19 @@ struct Stamped {
 TEST(Seqlock, ReadersNeverSeeTornValues) {
   Seqlock<Stamped> lock;
   std::atomic<bool> done{false};
+  std::atomic<std::uint32_t> pause_sink{0};
   std::thread writer([&] {
     Stamped s{};
-    for (std::uint32_t i = 1; i <= 100000; ++i) {
+    for (std::uint32_t i = 1; i <= 200000; ++i) {
       s.seq = i;
       for (std::size_t k = 0; k < s.payload.size(); ++k) {
         s.payload[k] = std::int64_t{i} * 1000003 + static_cast<std::int64_t>(k);
       }
       lock.Write(s);
-      if (i % 4 == 0) std::this_thread::yield();  // a sampling thread also pauses between samples
+      // A sampling thread pauses between samples; it busy-waits here rather than yielding, as a
+      // yield hands its core to a spinning reader for a whole time slice on a 2-core machine
+      // (40 s for this test instead of under a second).
+      for (int k = 0; k < 64; ++k) pause_sink.fetch_add(1, std::memory_order_relaxed);
     }
     done = true;
   });
