@@ -170,23 +170,40 @@ if [ -x "$B/bench_diag" ]; then
             if (u > 0) printf "  1e6 rows: jittered / uniform CPU = %.2f, wall = %.2f\n", j / u,
               t["BM_DiagnoseClock1M/1000000/1/iterations:1"] / t["BM_DiagnoseClock1M/1000000/0/iterations:1"] }'
   [ -s "$B/diag_clock_rss" ] && echo "  peak resident memory of the run (largest case): $(( $(cat "$B/diag_clock_rss") / 1024 )) MB"
-  # The real command on the same data written as CSV: wall and user CPU time (reading included; the
-  # CPU time is the steadier figure on a loaded machine) and peak memory.
+  # The real command on the same data written as CSV: wall and CPU time (user + system; reading
+  # included; the CPU time is the steadier figure on a loaded machine) and peak memory. With
+  # FTDIAG_BASELINE=/path/to/an/older/ftdiag the older binary runs on the same files in the same run
+  # (the ratio new / old) and the two JSON reports are compared byte for byte.
   if [ -x "$B/bench_diag_data" ] && [ -x "$BUILD/bin/ftdiag" ]; then
-    section "ftdiag diagnose (the command, CSV in, JSON out), 8 channels: wall time and peak memory (GNU time)"
+    section "ftdiag diagnose (the command, CSV in, JSON out), 8 channels: wall time, CPU and peak memory (GNU time; issue 39: 1e5 rows <= 2 s, 1e6 rows <= 15 s and < 500 MB)"
     tmp=$(mktemp -d)
+    # diag_run LABEL BINARY OUT.json: one diagnosis of the pair in $tmp; prints a line, sets $cpu.
+    diag_run() {
+      if /usr/bin/time -f "%e %U %S %M" -o "$tmp/tv" "$2" diagnose --sim "$tmp/sim.csv" \
+          --real "$tmp/real.csv" --json "$3" >/dev/null 2>&1; then
+        read -r wall user sys kb < "$tmp/tv"
+        cpu=$(awk -v u="$user" -v s="$sys" 'BEGIN { printf "%.1f", u + s }')
+        printf "  %8d rows %-9s %-8s %7.1f s wall %7.1f s CPU %6d MB peak  verdict %s\n" "$rows" \
+          "$label" "$1" "$wall" "$cpu" $((kb / 1024)) \
+          "$(sed -n 's/.*"verdict": *"\([^"]*\)".*/\1/p' "$3" | head -1)"
+      else
+        cpu=""
+        echo "  $rows rows $label $1: ftdiag diagnose failed"
+      fi
+    }
     for rows in 100000 1000000; do
       for jit in 0 1; do
         label=$([ "$jit" = 1 ] && echo jittered || echo uniform)
         "$B/bench_diag_data" "$rows" "$jit" "$tmp/sim.csv" "$tmp/real.csv"
-        if /usr/bin/time -f "%e %U %M" -o "$tmp/tv" "$BUILD/bin/ftdiag" diagnose --sim "$tmp/sim.csv" \
-            --real "$tmp/real.csv" --json "$tmp/out.json" >/dev/null 2>&1; then
-          read -r wall user kb < "$tmp/tv"
-          printf "  %8d rows %-9s %7.1f s wall %7.1f s CPU %6d MB peak  verdict %s\n" "$rows" \
-            "$label" "$wall" "$user" $((kb / 1024)) \
-            "$(sed -n 's/.*"verdict": *"\([^"]*\)".*/\1/p' "$tmp/out.json" | head -1)"
-        else
-          echo "  $rows rows $label: ftdiag diagnose failed"
+        diag_run this "$BUILD/bin/ftdiag" "$tmp/out.json"
+        if [ -n "${FTDIAG_BASELINE:-}" ] && [ -x "$FTDIAG_BASELINE" ]; then
+          new_cpu=$cpu
+          diag_run baseline "$FTDIAG_BASELINE" "$tmp/base.json"
+          if [ -n "$cpu" ] && [ -n "$new_cpu" ]; then
+            printf "  %8d rows %-9s CPU this / baseline = %.2f, reports %s\n" "$rows" "$label" \
+              "$(awk -v a="$new_cpu" -v b="$cpu" 'BEGIN { print a / b }')" \
+              "$(cmp -s "$tmp/out.json" "$tmp/base.json" && echo identical || echo DIFFER)"
+          fi
         fi
       done
     done

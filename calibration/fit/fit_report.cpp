@@ -1,5 +1,7 @@
 #include "calibration/fit/fit_report.hpp"
 
+#include "measurement/html_text.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -17,22 +19,6 @@ std::string Fmt(const char* fmt, double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, fmt, v);
   return buf;
-}
-
-std::string Escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '<') {
-      o += "&lt;";
-    } else if (c == '>') {
-      o += "&gt;";
-    } else if (c == '&') {
-      o += "&amp;";
-    } else {
-      o += c;
-    }
-  }
-  return o;
 }
 
 /// "Nice" axis limit ≥ v.
@@ -292,14 +278,15 @@ void WriteFitReport(const std::string& path, const FitResult& fit, const RigData
     p95_pct[a] = fit.heldout_p95_si[a] / fit.rated[a] * 100;
   }
   out << "<!DOCTYPE html><html><head><meta charset='utf-8'><title>Calibration fit: "
-      << Escape(title) << "</title><style>body{font-family:sans-serif;margin:20px;max-width:1200px}"
+      << HtmlEscape(title)
+      << "</title><style>body{font-family:sans-serif;margin:20px;max-width:1200px}"
       << "table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid #bbb;padding:3px 8px;"
       << "text-align:right}th{background:#eee}.plots svg{margin:4px}</style></head><body>";
-  out << "<h1>Calibration fit: " << Escape(title) << "</h1>";
+  out << "<h1>Calibration fit: " << HtmlEscape(title) << "</h1>";
   out << "<p>Model <b>" << ToString(fit.kind) << "</b>, ridge &lambda; = " << Fmt("%g", fit.lambda)
       << ", chosen by " << fit.folds << "-fold cross-validation holding out whole "
-      << Escape(fit.validation) << " (" << fit.block_count << " blocks found by "
-      << Escape(fit.block_method) << ", " << fit.rows
+      << HtmlEscape(fit.validation) << " (" << fit.block_count << " blocks found by "
+      << HtmlEscape(fit.block_method) << ", " << fit.rows
       << " rows). Errors below are on <b>held-out</b> rows only.</p>";
   out << "<p>Condition number of the load set: <b>" << Fmt("%.3g", fit.load_condition)
       << "</b>; of the chosen model's standardised design: <b>" << Fmt("%.3g", fit.design_condition)

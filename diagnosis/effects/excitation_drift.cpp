@@ -117,6 +117,7 @@ namespace ftstack::diag {
 EffectSpec ExcitationDriftPlugin() {
   return {.kind = EffectKind::kExcitationDrift,
           .traits = kTimeBased,
+          .confounders = kConfoundersOfTime,
           .fit = &fx::FitExcitation,
           .refit = &fx::RefitExcitation,
           .cost = 2};

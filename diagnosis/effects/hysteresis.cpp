@@ -251,6 +251,7 @@ namespace ftstack::diag {
 EffectSpec HysteresisPlugin() {
   return {.kind = EffectKind::kHysteresis,
           .traits = kLoadHistory,
+          .confounders = kConfoundersOfLoadHistory,
           .fit = &FitHysteresisFamily,
           .refit = &RefitHysteresis,
           .cost = 2,

@@ -226,6 +226,7 @@ namespace ftstack::diag {
 EffectSpec OverloadShiftPlugin() {
   return {.kind = EffectKind::kOverloadShift,
           .traits = kTimeBased,
+          .confounders = kConfoundersOfTime,
           .fit = &fx::FitOverloadShift,
           .ranges = &fx::OverloadShiftSpecs};
 }

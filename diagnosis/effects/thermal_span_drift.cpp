@@ -86,6 +86,7 @@ namespace ftstack::diag {
 EffectSpec ThermalSpanDriftPlugin() {
   return {.kind = EffectKind::kThermalSpanDrift,
           .traits = kTimeBased | kNeedsTemperature,
+          .confounders = kConfoundersOfTime | kTimeDrift,
           .fit = &fx::FitThermalSpan};
 }
 

@@ -120,6 +120,7 @@ namespace ftstack::diag {
 EffectSpec ThermalZeroDriftPlugin() {
   return {.kind = EffectKind::kThermalZeroDrift,
           .traits = kTimeBased | kNeedsTemperature,
+          .confounders = kConfoundersOfTime | kTimeDrift,
           .fit = &fx::FitThermalZeroPlain,
           .refine_claim = &RefineWithThermalLag,
           .ranges = &ThermalLagSpecs};

@@ -242,6 +242,7 @@ namespace ftstack::diag {
 EffectSpec ZeroDriftPlugin() {
   return {.kind = EffectKind::kZeroDrift,
           .traits = kTimeBased | kDriftInTime | kRefineOnlyIfBetter,
+          .confounders = kConfoundersOfTime,
           .fit = &fx::FitZeroDrift,
           .refine_claim = &RefineWithThermalLag};
 }

@@ -74,15 +74,11 @@ using RefineFn = std::optional<EffectFit> (*)(const Context&, const Series& targ
 /// What the engine reads about an effect instead of its name (bits of EffectSpec::traits).
 enum EffectTrait : unsigned {
   kNoTraits = 0U,
-  /// Its shape is a function of time (or of a temperature that may be monotone in time): tested
-  /// against per-recording offsets, a function of the load and its history, a load polynomial.
+  /// Its shape is a function of time (or of a temperature that may be monotone in time).
   kTimeBased = 1U << 0U,
-  /// A rate-independent function of the load's history (hysteresis): where every load is held once
-  /// an offset per load or per recording mimics it; per-hold offsets and a load polynomial are of
-  /// its own kind and are not tested against it.
+  /// A rate-independent function of the load's history (hysteresis).
   kLoadHistory = 1U << 1U,
-  /// Driven by the recorded temperature: tested against the drift in time (kDriftInTime) where the
-  /// temperature is monotone in time.
+  /// Driven by the recorded temperature.
   kNeedsTemperature = 1U << 2U,
   /// The plain drift in time: the alternative the engine tests temperature-driven effects against.
   kDriftInTime = 1U << 3U,
@@ -91,12 +87,33 @@ enum EffectTrait : unsigned {
   kRefineOnlyIfBetter = 1U << 4U,
 };
 
+/// The alternatives a claim must beat on the held-out rows (bits of EffectSpec::confounders): the
+/// rows of the engine's confounder table (identifiability.cpp), each tested where the data allow
+/// it.
+enum Confounder : unsigned {
+  kNoConfounders = 0U,
+  kSegmentOffsets = 1U << 0U,  ///< one offset per channel and joined recording (≥ 2 segments)
+  kLoadOffsets = 1U << 1U,     ///< one offset per channel and distinct static load
+  kHoldOffsets = 1U << 2U,     ///< one offset per channel and load hold: the load's history
+  kLoadPolynomial = 1U << 3U,  ///< a quadratic polynomial of the reference wrench per channel
+  /// The kDriftInTime effect, where the temperature is monotone in time.
+  kTimeDrift = 1U << 4U,
+};
+/// What a drift in time must beat: offsets per recording, per load and per hold (a function of
+/// the load and its history) and a smooth function of the load.
+inline constexpr unsigned kConfoundersOfTime =
+    kSegmentOffsets | kLoadOffsets | kHoldOffsets | kLoadPolynomial;
+/// What a function of the load's history must beat where every load is held once: offsets per
+/// recording and per load (per-hold offsets and a load polynomial are of its own kind).
+inline constexpr unsigned kConfoundersOfLoadHistory = kSegmentOffsets | kLoadOffsets;
+
 /// An effect plug-in: its kind in the vocabulary, its traits and its fit functions. Each family's
 /// file defines one (`EffectSpec FamilyPlugin()`), the registry (diagnosis/effects/registry.cpp)
 /// lists them; the engine knows effects only by these.
 struct EffectSpec {
   EffectKind kind = EffectKind::kNone;
-  unsigned traits = kNoTraits;  ///< EffectTrait bits
+  unsigned traits = kNoTraits;            ///< EffectTrait bits
+  unsigned confounders = kNoConfounders;  ///< Confounder bits: the table rows it must beat
   FitFn fit = nullptr;
   RefitFn refit = nullptr;  ///< nullptr: the effect has no costly search; fit() is used
   int cost = 1;  ///< relative cost of a fit: when fits run in parallel, costlier ones start first

@@ -108,18 +108,6 @@ std::string Fmt(const char* f, double a, double b) {
   return buf;
 }
 
-/// What a confounder is, in words ("… explains it as well" follows).
-std::string ConfounderWords(const std::string& what, int groups) {
-  if (what == "segment_offsets")
-    return Fmt("one offset per joined recording (%.0f segments)", groups, 0);
-  if (what == "load_function")
-    return Fmt("one offset per distinct static load (%.0f loads)", groups, 0);
-  if (what == "load_polynomial") {
-    return Fmt("a quadratic function of the reference wrench per channel (%.0f terms)", groups, 0);
-  }
-  return Fmt("one offset per load hold (%.0f holds: a function of the load's history)", groups, 0);
-}
-
 /// The rest of a confounding sentence: the effect's held-out improvement beyond the confounder.
 std::string BeyondWords(double z_rest, double z_alone) {
   return Fmt(
@@ -269,17 +257,17 @@ double PowerBeyondOffsets(const Context& cx, const Series& pred, const std::vect
 
 }  // namespace
 
-std::vector<int> ConfounderGroups(const Context& cx, const std::string& name, int* groups) {
+std::vector<int> ConfounderGroups(const Context& cx, Confounder which, int* groups) {
   const DiagData& d = *cx.data;
   std::vector<int> g;
   *groups = 0;
-  if (name == "hold_offsets") return d.has_wrench() ? HoldGroups(cx, groups) : g;
-  if (name == "segment_offsets") {
+  if (which == kHoldOffsets) return d.has_wrench() ? HoldGroups(cx, groups) : g;
+  if (which == kSegmentOffsets) {
     if (cx.segments < 2 || d.segment.size() != static_cast<std::size_t>(cx.n)) return g;
     *groups = cx.segments;
     return d.segment;
   }
-  if (name == "load_function" && d.has_wrench()) {
+  if (which == kLoadOffsets && d.has_wrench()) {
     const auto keys = LoadKeys(d, cx.n);
     std::map<std::array<long long, 6>, int> seen;
     g.resize(static_cast<std::size_t>(cx.n));
@@ -400,31 +388,64 @@ bool StatesIdentify(const Context& cx, const EffectFit& fit, double z_claim,
   return identified;
 }
 
-/// The offset-shaped confounders, each one offset per group of rows. A per-hold offset is itself a
-/// function of the load's history, so it cannot confound an effect of that kind, and it can be
-/// refuted by the load states (StatesIdentify) where the effect lies within it.
-struct OffsetConfounder {
+/// The confounder table: the models an effect's declared Confounder bits name, in the order they
+/// are tried, with their key in the report and what each is in words (%.0f: its groups or terms;
+/// "… explains it as well" follows). The drift in time (kTimeDrift) is an effect of the registry
+/// and is tried last (DriftInTimeConfounds).
+struct ConfounderRow {
+  Confounder bit;
   const char* name;
-  bool is_load_history;
-  bool refutable_by_load_states;
+  const char* words;
 };
-constexpr OffsetConfounder kOffsetConfounders[] = {
-    {"segment_offsets", false, false},
-    {"load_function", false, false},
-    {"hold_offsets", true, true},
+constexpr ConfounderRow kConfounderTable[] = {
+    {kSegmentOffsets, "segment_offsets", "one offset per joined recording (%.0f segments)"},
+    {kLoadOffsets, "load_function", "one offset per distinct static load (%.0f loads)"},
+    {kHoldOffsets, "hold_offsets",
+     "one offset per load hold (%.0f holds: a function of the load's history)"},
+    {kLoadPolynomial, "load_polynomial",
+     "a quadratic function of the reference wrench per channel (%.0f terms)"},
 };
+
+/// The held-out test of one row of the table against the effect (CheckConfounders'): true when the
+/// effect is identified beside it or the row does not apply to the data; else *sentence says why
+/// not. A per-hold offset the effect lies within is tested as the load states (StatesIdentify).
+bool RowIdentifies(const Context& cx, const EffectFit& fit, const ConfounderRow& row,
+                   double z_claim, double z_alone, const SimplerFn& simpler, const BeyondFn& beyond,
+                   std::string* sentence) {
+  double z_rest = 0.0;
+  if (row.bit == kLoadPolynomial) {  // a smooth function of the load, ramps included
+    if (!cx.data->has_wrench() || cx.n <= 20 * kLoadTerms) return true;
+    if (beyond([&](const Series& y) { return LoadPolynomial(cx, y); }, kLoadTerms * cx.nc,
+               &z_rest)) {
+      return true;
+    }
+    *sentence = Fmt(row.words, kLoadTerms, 0) + BeyondWords(z_rest, z_alone);
+    return false;
+  }
+  int groups = 0;
+  const std::vector<int> g = ConfounderGroups(cx, row.bit, &groups);
+  if (g.empty()) return true;
+  if (row.bit == kHoldOffsets &&
+      std::sqrt(PowerBeyondOffsets(cx, fit.pred, g, groups)) / 2.0 <= z_claim) {
+    return StatesIdentify(cx, fit, z_claim, g, groups, simpler, beyond, z_alone, sentence);
+  }
+  const auto offsets = [&](const Series& y) { return GroupOffsets(cx, y, g, groups); };
+  const bool identified = beyond(offsets, groups * cx.nc, &z_rest);
+  if (DebugOn()) {
+    std::fprintf(stderr, "confounder %s (%d groups) for %s: z_rest %.1f -> %s\n", row.name, groups,
+                 fit.name.c_str(), z_rest, identified ? "identified" : "confounded");
+  }
+  if (!identified) *sentence = Fmt(row.words, groups, 0) + BeyondWords(z_rest, z_alone);
+  return identified;
+}
 
 }  // namespace
 
 Confounding CheckConfounders(const Context& cx, const Series& target, const EffectFit& fit,
                              double z_claim) {
   Confounding out;
-  // A function of the load's history alone (kLoadHistory): where every load is held once (static
-  // poses, no return to a load from the other side) an offset per load or per recording mimics it.
   const EffectSpec* spec = FindEffect(fit.name);
-  if (spec == nullptr) return out;
-  const bool history = spec->Has(kLoadHistory);
-  if (!spec->Has(kTimeBased) && !history) return out;
+  if (spec == nullptr || spec->confounders == kNoConfounders) return out;
   double delta_alone = 0.0;
   double z_alone = 0.0;
   Improvement(cx, target, fit.pred, &delta_alone, &z_alone);
@@ -455,41 +476,14 @@ Confounding CheckConfounders(const Context& cx, const Series& target, const Effe
     return *z_rest > z_claim && delta > 0.0;
   };
   std::vector<std::string> words;
-  for (const auto& [name, is_load_history, refutable_by_load_states] : kOffsetConfounders) {
-    if (history && is_load_history) continue;  // the effect is one
-    int groups = 0;
-    const std::vector<int> g = ConfounderGroups(cx, name, &groups);
-    if (g.empty()) continue;
-    double z_rest = 0.0;
-    const auto offsets = [&](const Series& y) { return GroupOffsets(cx, y, g, groups); };
-    if (refutable_by_load_states &&
-        std::sqrt(PowerBeyondOffsets(cx, fit.pred, g, groups)) / 2.0 <= z_claim) {
-      std::string sentence;
-      if (StatesIdentify(cx, fit, z_claim, g, groups, simpler, beyond, z_alone, &sentence))
-        continue;
-      out.with.push_back(name);
-      words.push_back(std::move(sentence));
-      continue;
-    }
-    const bool identified = beyond(offsets, groups * cx.nc, &z_rest);
-    if (DebugOn()) {
-      std::fprintf(stderr, "confounder %s (%d groups) for %s: z_rest %.1f -> %s\n", name, groups,
-                   fit.name.c_str(), z_rest, identified ? "identified" : "confounded");
-    }
-    if (identified) continue;
-    out.with.push_back(name);
-    words.push_back(ConfounderWords(name, groups) + BeyondWords(z_rest, z_alone));
+  for (const ConfounderRow& row : kConfounderTable) {
+    if ((spec->confounders & row.bit) == 0U) continue;
+    std::string sentence;
+    if (RowIdentifies(cx, fit, row, z_claim, z_alone, simpler, beyond, &sentence)) continue;
+    out.with.emplace_back(row.name);
+    words.push_back(std::move(sentence));
   }
-  const DiagData& d = *cx.data;
-  // A smooth function of the load, ramps included (where holds are short or absent).
-  double z_poly = 0.0;
-  if (d.has_wrench() && !history && cx.n > 20 * kLoadTerms &&
-      !beyond([&](const Series& y) { return LoadPolynomial(cx, y); }, kLoadTerms * cx.nc,
-              &z_poly)) {
-    out.with.push_back("load_polynomial");
-    words.push_back(ConfounderWords("load_polynomial", kLoadTerms) + BeyondWords(z_poly, z_alone));
-  }
-  if (spec->Has(kNeedsTemperature) && d.has_temp()) {
+  if ((spec->confounders & kTimeDrift) != 0U && cx.data->has_temp()) {
     std::string sentence = DriftInTimeConfounds(cx, target, beyond, &out);
     if (!sentence.empty()) words.push_back(std::move(sentence));
   }

@@ -16,34 +16,32 @@ struct Confounding {
   std::string words;              ///< one sentence for a person
 };
 
-/// Tests `fit` (fitted to `target`) against its confounders: the confounder and the effect are
+/// Tests `fit` (fitted to `target`) against the confounders its effect declares
+/// (EffectSpec::confounders, rows of the engine's table): the confounder and the effect are
 /// fitted jointly (backfitting, training rows only), and the effect is confounded with it when the
 /// joint model does not beat the confounder alone on the held-out rows significantly (z at most
-/// `z_claim`) although the confounder
-/// alone, penalised for its parameters like the ranking (Δχ² − p·ln n_hold), scores at least as
-/// well as the effect's penalised score. Confounders tried:
-///  - segment_offsets: one offset per channel and joined recording (≥ 2 segments);
-///  - load_function: one offset per channel and distinct static load (the wrench quantised to
-///    0.5 % of each axis's range; only where loads are held, ≤ rows/20 distinct loads);
-///  - hold_offsets: one offset per channel and load hold (a run of ≥ 0.25 s at one load, with the
-///    movement into it): any function of the load's history (a misfit of a history-dependent
-///    effect). Where the effect lies within those offsets (were it exact, its held-out gain
-///    beyond them would not reach z_claim: e.g. a level per stretch between load changes), they
-///    are tested as the function of the load's history they stand for: one offset per load state
-///    (a hold's load and the previous hold's), which holds reached the same way at different
-///    levels refute; an effect with fewer parameters than the holds' offsets is still identified
-///    by the penalised comparison;
-///  - load_polynomial: a quadratic polynomial of the reference wrench per channel (28 terms): a
-///    smooth function of the load, ramps included (not for a kLoadHistory effect);
-///  - the drift in time (the kDriftInTime effect, reported by its name), for temperature-driven
-///    effects (kNeedsTemperature) when the temperature is monotone in time (|Spearman ρ| >
-///    0.95).
+/// `z_claim`) although the confounder alone, penalised for its parameters like the ranking
+/// (Δχ² − p·ln n_hold), scores at least as well as the effect's penalised score. The rows:
+///  - kSegmentOffsets ("segment_offsets"): one offset per channel and joined recording (≥ 2);
+///  - kLoadOffsets ("load_function"): one offset per channel and distinct static load (the wrench
+///    quantised to 0.5 % of each axis's range; only where loads are held, ≤ rows/20 loads);
+///  - kHoldOffsets ("hold_offsets"): one offset per channel and load hold (a run of ≥ 0.25 s at
+///    one load, with the movement into it): any function of the load's history. Where the effect
+///    lies within those offsets (were it exact, its held-out gain beyond them would not reach
+///    z_claim: e.g. a level per stretch between load changes), they are tested as the function of
+///    the load's history they stand for: one offset per load state (a hold's load and the
+///    previous hold's), which holds reached the same way at different levels refute; an effect
+///    with fewer parameters than the holds' offsets is still identified by the penalised
+///    comparison;
+///  - kLoadPolynomial ("load_polynomial"): a quadratic polynomial of the reference wrench per
+///    channel (28 terms): a smooth function of the load, ramps included;
+///  - kTimeDrift (the kDriftInTime effect, reported by its name): where the temperature is
+///    monotone in time (|Spearman ρ| > 0.95).
 [[nodiscard]] Confounding CheckConfounders(const Context& cx, const Series& target,
                                            const EffectFit& fit, double z_claim);
 
-/// Group of every row for a confounder ("segment_offsets", "load_function"); empty when the
-/// confounder does not apply to the data. *groups receives the number of groups.
-[[nodiscard]] std::vector<int> ConfounderGroups(const Context& cx, const std::string& name,
-                                                int* groups);
+/// Group of every row for an offset confounder (kSegmentOffsets, kLoadOffsets, kHoldOffsets);
+/// empty when it does not apply to the data. *groups receives the number of groups.
+[[nodiscard]] std::vector<int> ConfounderGroups(const Context& cx, Confounder which, int* groups);
 
 }  // namespace ftstack::diag

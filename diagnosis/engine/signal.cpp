@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstddef>
 #include <limits>
 #include <unsupported/Eigen/FFT>
 
@@ -37,11 +38,18 @@ double RobustNoise(const double* x, std::size_t n, double rate_hz) {
 NormalEq::NormalEq(int p)
     : p_(p), xtx_(Eigen::MatrixXd::Zero(p, p)), xty_(Eigen::VectorXd::Zero(p)) {}
 
+// XᵀWX is kept in its upper triangle, column a holding rows b ≤ a: the inner loop then walks
+// contiguous memory (column-major) and vectorises. Each element receives the same products in
+// the same row order as before, so the sums are bit for bit those of the lower-triangle form.
 void NormalEq::Add(const double* x, double y, double w) {
-  for (int a = 0; a < p_; ++a) {
+  double* const xtx = xtx_.data();
+  double* const xty = xty_.data();
+  const auto p = static_cast<std::ptrdiff_t>(p_);
+  for (std::ptrdiff_t a = 0; a < p; ++a) {
     const double wa = w * x[a];
-    xty_(a) += wa * y;
-    for (int b = 0; b <= a; ++b) xtx_(a, b) += wa * x[b];
+    xty[a] += wa * y;
+    double* __restrict col = xtx + a * p;
+    for (std::ptrdiff_t b = 0; b <= a; ++b) col[b] += wa * x[b];
   }
   yty_ += w * y * y;
   rows_ += 1.0;
@@ -52,7 +60,7 @@ void NormalEq::AddSparse(const int* idx, const double* val, int nnz, double y, d
     const double wa = w * val[a];
     xty_(idx[a]) += wa * y;
     for (int b = 0; b < nnz; ++b) {
-      if (idx[b] <= idx[a]) xtx_(idx[a], idx[b]) += wa * val[b];
+      if (idx[b] <= idx[a]) xtx_(idx[b], idx[a]) += wa * val[b];
     }
   }
   yty_ += w * y * y;
@@ -62,7 +70,7 @@ void NormalEq::AddSparse(const int* idx, const double* val, int nnz, double y, d
 NormalEq::Result NormalEq::Solve() const {
   Result r;
   r.rows = rows_;
-  Eigen::MatrixXd a = xtx_.selfadjointView<Eigen::Lower>();
+  Eigen::MatrixXd a = xtx_.selfadjointView<Eigen::Upper>();
   // Jacobi scaling for conditioning; zero columns (features absent) get a unit diagonal.
   Eigen::VectorXd d(p_);
   for (int i = 0; i < p_; ++i) d(i) = a(i, i) > 0 ? 1.0 / std::sqrt(a(i, i)) : 1.0;

@@ -1,6 +1,7 @@
 #include "diagnosis/report/html_report.hpp"
 #include "diagnosis/engine/plausibility.hpp"
 #include "measurement/effect_vocabulary.hpp"
+#include "measurement/html_text.hpp"
 #include "measurement/wrench.hpp"
 
 #include <algorithm>
@@ -13,29 +14,6 @@
 
 namespace ftstack::diag {
 namespace {
-
-std::string Esc(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '<':
-        o += "&lt;";
-        break;
-      case '>':
-        o += "&gt;";
-        break;
-      case '&':
-        o += "&amp;";
-        break;
-      case '"':
-        o += "&quot;";
-        break;
-      default:
-        o += c;
-    }
-  }
-  return o;
-}
 
 std::string Num(double v, const char* f = "%.4g") {
   char b[64];
@@ -55,7 +33,7 @@ std::string Cell(const nlohmann::json& v) {
     }
     return out;
   }
-  return Esc(v.is_string() ? v.get<std::string>() : v.dump());
+  return HtmlEscape(v.is_string() ? v.get<std::string>() : v.dump());
 }
 
 /// A parameter's spread across pieces of the record: "min … max (σ pieces); disagree", or "—".
@@ -89,9 +67,9 @@ std::string ParamTable(const EffectFit& f, const nlohmann::json& typed) {
       if (p["range"].is_array()) range = Cell(p["range"][0]) + " … " + Cell(p["range"][1]);
       status = p["status"].get<std::string>();
     }
-    h += "<tr><td>" + Esc(key) + "</td><td>" + Cell(value) + "</td><td>" + sigma + "</td><td>" +
-         SpreadCell(f, key) + "</td><td>" + Esc(unit) + "</td><td>" + range + "</td><td>" +
-         Esc(status) + "</td></tr>";
+    h += "<tr><td>" + HtmlEscape(key) + "</td><td>" + Cell(value) + "</td><td>" + sigma +
+         "</td><td>" + SpreadCell(f, key) + "</td><td>" + HtmlEscape(unit) + "</td><td>" + range +
+         "</td><td>" + HtmlEscape(status) + "</td></tr>";
   }
   return h + "</table>";
 }
@@ -109,7 +87,7 @@ std::string StandardTable(const EffectFit& f) {
       {"creep_20_30min_pct", "OIML R 60 creep between 20 and 30 min"},
       {"dead_load_return_pct", "minimum dead-load output return (30 min after unloading)"}};
   std::string h = "<p>In OIML R 60's terms (load cells), per bridge, from the fitted model: " +
-                  Esc(o.value("load", "")) +
+                  HtmlEscape(o.value("load", "")) +
                   ".</p><table><tr><th>figure</th><th>value</th><th>± 1σ</th><th>unit</th></tr>";
   for (const auto& row : rows) {
     if (!o.contains(row.key)) continue;
@@ -258,8 +236,8 @@ std::string SvgPlot(const PlotSpec& spec, const std::vector<PlotSeries>& series)
        "\" height=\"" + std::to_string(spec.height) +
        "\" font-family=\"sans-serif\" font-size=\"12\">";
   o += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>";
-  o += "<text x=\"" + std::to_string(ml) + "\" y=\"18\" font-weight=\"bold\">" + Esc(spec.title) +
-       "</text>";
+  o += "<text x=\"" + std::to_string(ml) + "\" y=\"18\" font-weight=\"bold\">" +
+       HtmlEscape(spec.title) + "</text>";
   for (const auto& [a, b] : spec.spans) {
     const double xa = px(std::max(a, x0));
     const double xb = px(std::min(b, x1));
@@ -286,9 +264,9 @@ std::string SvgPlot(const PlotSpec& spec, const std::vector<PlotSeries>& series)
          "</text>";
   }
   o += "<text x=\"" + std::to_string(ml + pw / 2) + "\" y=\"" + std::to_string(spec.height - 6) +
-       "\" text-anchor=\"middle\">" + Esc(spec.x_label) + "</text>";
+       "\" text-anchor=\"middle\">" + HtmlEscape(spec.x_label) + "</text>";
   o += "<text transform=\"translate(14," + std::to_string(mt + ph / 2) +
-       ") rotate(-90)\" text-anchor=\"middle\">" + Esc(spec.y_label) + "</text>";
+       ") rotate(-90)\" text-anchor=\"middle\">" + HtmlEscape(spec.y_label) + "</text>";
   int legend_x = ml + 10;
   for (const auto& s : series) {
     std::vector<double> rx;
@@ -312,7 +290,7 @@ std::string SvgPlot(const PlotSpec& spec, const std::vector<PlotSeries>& series)
       o += "<rect x=\"" + std::to_string(legend_x) + "\" y=\"" + std::to_string(mt + 6) +
            "\" width=\"12\" height=\"4\" fill=\"" + s.color + "\"/>";
       o += "<text x=\"" + std::to_string(legend_x + 16) + "\" y=\"" + std::to_string(mt + 12) +
-           "\">" + Esc(s.label) + "</text>";
+           "\">" + HtmlEscape(s.label) + "</text>";
       legend_x += 24 + 7 * static_cast<int>(s.label.size());
     }
   }
@@ -434,7 +412,7 @@ std::string HtmlConditioning(const DiagData& data, const Report& r) {
   std::string h =
       "<h2>Data conditioning</h2><table><tr><th>channel</th><th>quiet noise "
       "(mV/V)</th><th>in " +
-      Esc(data.real_unit_symbol) + "</th><th>measured in</th></tr>";
+      HtmlEscape(data.real_unit_symbol) + "</th><th>measured in</th></tr>";
   for (std::size_t c = 0; c < k.noise.size(); ++c) {
     const QuietNoise& q = k.noise[c];
     const bool have = q.holds > 0;
@@ -461,8 +439,8 @@ std::string HtmlConditioning(const DiagData& data, const Report& r) {
                     : std::string()) +
        ". Rows excluded with the glitches: " + std::to_string(k.excluded_rows) + ".</p>";
   if (!k.glitches.empty()) {
-    h += "<h2>" + Esc(std::string(EffectOf(EffectKind::kConverterGlitch).name)) + "</h2><p>" +
-         std::to_string(k.glitches.size()) +
+    h += "<h2>" + HtmlEscape(std::string(EffectOf(EffectKind::kConverterGlitch).name)) +
+         "</h2><p>" + std::to_string(k.glitches.size()) +
          " isolated wrong codes, each kept out of every fit:</p><table><tr><th>t (s)</th>"
          "<th>channel</th><th>offset (mV/V)</th></tr>";
     for (const Glitch& g : k.glitches) {
@@ -480,11 +458,11 @@ std::string HtmlCandidates(const Report& r) {
        "ranking)</h2><table><tr><th>effect</th><th>model</th><th>params</th>"
        "<th>held-out RMS after</th><th>z</th><th>score</th><th>claimable</th></tr>";
   for (const auto& cand : r.candidates) {
-    h += "<tr><td>" + Esc(cand.name) + "</td><td>" + Esc(cand.variant) + "</td><td>" +
+    h += "<tr><td>" + HtmlEscape(cand.name) + "</td><td>" + HtmlEscape(cand.variant) + "</td><td>" +
          std::to_string(cand.n_params) + "</td><td>" + Num(cand.hold_rms_after) + "</td><td>" +
          Num(cand.z, "%.1f") + "</td><td>" + Num(cand.score, "%.1f") + "</td><td>" +
          (cand.eligible ? "yes" : "") +
-         (cand.not_resolved.empty() ? "" : "not resolved: " + Esc(cand.not_resolved)) +
+         (cand.not_resolved.empty() ? "" : "not resolved: " + HtmlEscape(cand.not_resolved)) +
          "</td></tr>";
   }
   h += "</table><p>Held-out rows: every third block of " + Num(r.cx.block_s) +
@@ -504,26 +482,26 @@ std::string HtmlReport(const DiagData& data, const Report& r) {
        "4px solid #4a4}.conf{background:#fbeeee;padding:6px;border-left:4px solid #c44}"
        "</style></head><body>";
   h += "<h1>ftdiag: sim vs real</h1>";
-  h += "<p>Real: <code>" + Esc(data.real_name) + "</code>, sim: <code>" + Esc(data.sim_name) +
-       "</code>, " + std::to_string(data.rows()) + " rows × " + std::to_string(data.channels()) +
-       " bridges at " + Num(r.rate_hz) + " Hz.</p>";
+  h += "<p>Real: <code>" + HtmlEscape(data.real_name) + "</code>, sim: <code>" +
+       HtmlEscape(data.sim_name) + "</code>, " + std::to_string(data.rows()) + " rows × " +
+       std::to_string(data.channels()) + " bridges at " + Num(r.rate_hz) + " Hz.</p>";
   if (data.segment.size() == data.rows() && r.cx.segments > 1) {
     h += "<p>" + std::to_string(r.cx.segments) +
          " joined recordings (segments): stateful models restart at each, hold-out blocks never "
          "straddle one.</p>";
   }
-  h += "<p class=\"verdict\">Verdict: " + Esc(r.verdict);
-  for (std::size_t i = 1; i < r.effects.size(); ++i) h += " + " + Esc(r.effects[i].fit.name);
+  h += "<p class=\"verdict\">Verdict: " + HtmlEscape(r.verdict);
+  for (std::size_t i = 1; i < r.effects.size(); ++i) h += " + " + HtmlEscape(r.effects[i].fit.name);
   h += "</p>";
   h += "<p>Held-out RMS (rows not used for fitting, all channels): <b>" + Num(r.hold_rms_before) +
        "</b> → <b>" + Num(r.hold_rms_after) + "</b> mV/V.</p>";
   for (const auto& e : r.effects) {
-    h += "<h2>" + Esc(e.fit.name) + "</h2><p class=\"ev\">" + Esc(e.fit.evidence) +
-         "</p><p>Model: " + Esc(e.fit.variant) + " (" + std::to_string(e.fit.n_params) +
+    h += "<h2>" + HtmlEscape(e.fit.name) + "</h2><p class=\"ev\">" + HtmlEscape(e.fit.evidence) +
+         "</p><p>Model: " + HtmlEscape(e.fit.variant) + " (" + std::to_string(e.fit.n_params) +
          " parameters). Held-out RMS " + Num(e.hold_rms_before) + " → " + Num(e.hold_rms_after) +
          " mV/V.</p>" + ParamTable(e.fit, TypedParameters(r.cx, e.fit)) + StandardTable(e.fit);
     if (!e.confounded_with.empty()) {
-      h += "<p class=\"conf\"><b>Not identified.</b> " + Esc(e.confounding) +
+      h += "<p class=\"conf\"><b>Not identified.</b> " + HtmlEscape(e.confounding) +
            " The verdict does not name it.</p>";
     }
   }
@@ -532,11 +510,11 @@ std::string HtmlReport(const DiagData& data, const Report& r) {
     const std::size_t colon = d.find(": ");
     const std::string name = colon == std::string::npos ? d : d.substr(0, colon);
     const std::string why = colon == std::string::npos ? "" : d.substr(colon + 2);
-    h += "<h2>" + Esc(name) + " (not claimed)</h2><p class=\"conf\"><b>Not claimed.</b> " +
-         Esc(name) +
+    h += "<h2>" + HtmlEscape(name) + " (not claimed)</h2><p class=\"conf\"><b>Not claimed.</b> " +
+         HtmlEscape(name) +
          " improved the held-out rows beside the claimed effect, but one offset per load hold "
          "explains that improvement as well, so it is left out of the effects and the verdict. " +
-         Esc(why) + "</p>";
+         HtmlEscape(why) + "</p>";
   }
   h += HtmlChannels(r);
   h += HtmlConditioning(data, r);

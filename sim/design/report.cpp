@@ -1,5 +1,7 @@
 #include "sim/design/report.hpp"
 
+#include "measurement/html_text.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -9,29 +11,6 @@
 
 namespace ftstack::sim::design {
 namespace {
-
-std::string Esc(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        o += "&amp;";
-        break;
-      case '<':
-        o += "&lt;";
-        break;
-      case '>':
-        o += "&gt;";
-        break;
-      case '"':
-        o += "&quot;";
-        break;
-      default:
-        o += c;
-    }
-  }
-  return o;
-}
 
 /// A log-log plot area: data range [x0, x1] × [y0, y1] onto a w × h pixel box with margins.
 struct LogPlot {
@@ -70,10 +49,10 @@ struct LogPlot {
           ml, w - mr, py, ml - 5, py + 4, e);
     }
     o << fmt::format("<text x='{}' y='{}' text-anchor='middle'>{}</text>\n", (ml + w - mr) / 2,
-                     h - 12, Esc(xl));
+                     h - 12, HtmlEscape(xl));
     o << fmt::format(
         "<text transform='translate(16,{}) rotate(-90)' text-anchor='middle'>{}</text>\n",
-        (mt + h - mb) / 2, Esc(yl));
+        (mt + h - mb) / 2, HtmlEscape(yl));
   }
 };
 
@@ -107,14 +86,14 @@ void CatalogueScatter(std::ostream& o, const Catalog& cat, const Trend& t,
     o << fmt::format(
         "<circle cx='{:.1f}' cy='{:.1f}' r='{:.1f}' fill='{}' stroke='#222'>"
         "<title>{} {} {}</title></circle>\n",
-        p.X(r.fxy_n), p.Y(r.txy_nm), rad, conf ? "#333" : "none", Esc(r.vendor), Esc(r.model),
-        Esc(r.calibration));
+        p.X(r.fxy_n), p.Y(r.txy_nm), rad, conf ? "#333" : "none", HtmlEscape(r.vendor),
+        HtmlEscape(r.model), HtmlEscape(r.calibration));
   }
   if (req != nullptr && req->peak(0) > 0) {
     o << fmt::format(
         "<path d='M{0:.1f},{1:.1f} m-7,0 l14,0 m-7,-7 l0,14' stroke='#0a0' "
         "stroke-width='3'/><text x='{2:.1f}' y='{1:.1f}' fill='#070'>{3}</text>\n",
-        p.X(req->peak(0)), p.Y(req->peak(3)), p.X(req->peak(0)) + 9, Esc(req->name));
+        p.X(req->peak(0)), p.Y(req->peak(3)), p.X(req->peak(0)) + 9, HtmlEscape(req->name));
   }
   o << "</svg>\n";
 }
@@ -225,7 +204,7 @@ void WriteDesignReport(std::ostream& o, const std::vector<Candidate>& ds, const 
     (void)PrintRequirementVerdict(text, ds, *req, 8);
     PrintGoal(text, ds, *req);
   }
-  o << "<pre>" << Esc(text.str()) << "</pre>\n";
+  o << "<pre>" << HtmlEscape(text.str()) << "</pre>\n";
   o << "<h2>Catalogue: moment range against force range</h2>\n<div class='pair'><div>";
   CatalogueScatter(o, cat, t, ds, req);
   o << fmt::format(
@@ -236,10 +215,10 @@ void WriteDesignReport(std::ostream& o, const std::vector<Candidate>& ds, const 
       "<b id='trend-exponent'>{:.3f}</b> (all {} rows with values, confirmed or not: {:.3f}).</p>"
       "<p>Squares: swept designs (orange hub-spoke, blue guided; solid = Pareto front) at their "
       "per-axis Fxy and tilt capacities. Green cross: the requirement.</p><p>Rows in the fit: ",
-      cat.rows.size(), Esc(cat.origin), t.n, t.coefficient, t.exponent, t.exponent, all.n,
+      cat.rows.size(), HtmlEscape(cat.origin), t.n, t.coefficient, t.exponent, t.exponent, all.n,
       all.exponent);
   for (const CatalogRow* r : t.used)
-    o << Esc(r->vendor + " " + r->model + " " + r->calibration) << "; ";
+    o << HtmlEscape(r->vendor + " " + r->model + " " + r->calibration) << "; ";
   o << "</p></div></div>\n<h2>Pareto front: tilt capacity against force resolution</h2>\n";
   ParetoPlot(o, ds);
   o << "<p>Green dashed: 0.1 N resolution and 280 N·m tilting (the goal); green rims: designs "
@@ -269,9 +248,9 @@ void WriteDesignReport(std::ostream& o, const std::vector<Candidate>& ds, const 
   }
   o << "</table>\n<h2>Selected designs: strain maps and capacities</h2>\n";
   for (const Candidate* c : Showcase(ds, req)) {
-    o << "<h3>" << Esc(c->id + " (" + c->model.family + ", " + c->model.material.name + ")")
+    o << "<h3>" << HtmlEscape(c->id + " (" + c->model.family + ", " + c->model.material.name + ")")
       << "</h3><p>";
-    for (const auto& [k, v] : c->model.parameters) o << fmt::format("{}={:.4g} ", Esc(k), v);
+    for (const auto& [k, v] : c->model.parameters) o << fmt::format("{}={:.4g} ", HtmlEscape(k), v);
     o << "</p><div class='pair'><div>";
     const EnvelopeLoads rated(c->figures.capacity.head<2>().minCoeff(), c->figures.capacity(2),
                               c->figures.tilt_capacity_nm, c->figures.capacity(5));
@@ -282,7 +261,7 @@ void WriteDesignReport(std::ostream& o, const std::vector<Candidate>& ds, const 
       o << fmt::format(
           "<p>under {}: utilisation yield {:.2f}, gauge range {:.2f}, buckling {:.2f} "
           "→ {}</p>",
-          Esc(req->name), c->check.yield, c->check.gauge, c->check.buckling,
+          HtmlEscape(req->name), c->check.yield, c->check.gauge, c->check.buckling,
           c->check.met() ? "carries it" : "binding: " + c->check.binding());
     }
     o << "</div></div>\n";

@@ -283,8 +283,8 @@ constexpr bool kSanitized = false;
 // its prediction and the list of training rows, not a table of 8 bytes a row and channel (the
 // resident peak of the fit stays under 1.6 predictions; with the table it is about 2.4).
 TEST(DiagMemory, OverloadShiftHoldsNoSuffixTable) {
-  // Large buffers mapped and returned when freed, as ftdiag runs (the resident peak then counts
-  // what the fit allocates, not heap memory freed before it).
+  // Large buffers mapped and returned when freed (the resident peak then counts what the fit
+  // allocates, not heap memory freed before it).
   // (A sanitizer's allocator ignores it: the peak is then not checked.)
   const bool mapped = mallopt(M_MMAP_THRESHOLD, 1 << 20) == 1;
   const auto fx = testing::MakeFixture({{"overload_shift", 8}}, 3, 2000.0, kNoise, 6.0);

@@ -61,18 +61,21 @@ void DrawBar(double fraction, const char* stage, void* user) {
   std::fflush(stderr);
 }
 
-/// Large buffers (≥ 1 MiB: columns, n × N matrices) are mapped and returned to the system when
-/// freed, not kept in malloc's heap: glibc otherwise raises its mapping threshold after the first
-/// such free and later frees of up to 32 MiB stay resident (measured at 10^6 × 8 rows: 68 MB
-/// still resident after reading the files).
-void ReturnLargeBuffersToTheSystem() {
+/// The diagnosis allocates and frees n × N buffers (predictions, features, targets) for every
+/// candidate fit. Mapped one by one, each would be faulted in and zeroed by the kernel again. They
+/// are kept in one heap instead: no mapping, one arena for every thread (a buffer freed by one
+/// thread serves the next fit on any), and up to 256 MiB of free space kept rather than returned
+/// (time and peak memory: docs/diagnosis.md, "Buffers kept for the next fit").
+void KeepBuffersForTheNextFit() {
 #ifdef __GLIBC__
-  mallopt(M_MMAP_THRESHOLD, 1 << 20);
+  mallopt(M_MMAP_MAX, 0);
+  mallopt(M_ARENA_MAX, 1);
+  mallopt(M_TRIM_THRESHOLD, 256 << 20);
 #endif
 }
 
 int RunDiagnose(const DiagnoseArgs& args) {
-  ReturnLargeBuffersToTheSystem();
+  KeepBuffersForTheNextFit();
   Bar bar;
   try {
     if (args.sim.empty() == args.model.empty()) {
