@@ -7,7 +7,8 @@
 #   ftstack_fw_*         firmware: integer core, device, Modbus       -> hal_if, fw
 #   ftstack_measurement  host types: wrench, units, recording format, -> nothing of ours
 #                        effect vocabulary, shared numerics
-#   ftstack_cal_file     what a board loads: calibration file, slots  -> hal_if, fw
+#   ftstack_cal_file     what a board loads: calibration file, slots, -> hal_if, fw, meas
+#                        the unit a calibration reads
 #   ftstack_cal_fit      fitting, fit reports, offline apply          -> hal_if, fw, meas, calfile, calfit
 #   ftstack_cal_ati        (calfit) the ATI calibration-file import; ftstack_cal_fit links it
 #   ftstack_sim*         physics simulator, rigs, recordings          -> hal_if, hal, meas, calfile, sim
@@ -140,7 +141,7 @@ function(ftstack_check_layers)
   set(allowed_hal "hal_if")
   set(allowed_fw "hal_if;fw")
   set(allowed_meas "")
-  set(allowed_calfile "hal_if;fw")
+  set(allowed_calfile "hal_if;fw;meas")
   set(allowed_calfit "hal_if;fw;meas;calfile;calfit")
   set(allowed_sim "hal_if;hal;meas;calfile;sim")
   set(allowed_daemon "hal_if;hal;fw;meas;calfile;daemon")

@@ -24,8 +24,17 @@ fw::CalSlot SlotFromFile(const std::string& path, const hal::AdcInfo& adc,
   const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
   fw::CalSlot slot;
   slot.fixed = cal::ToFixed(file, cal::AdcForDevice(file, adc));
-  std::fprintf(stderr, "ftd: calibration %s: input unit %s\n", path.c_str(),
-               file.input_unit.c_str());
+  // Which converter the file was fitted from, beside what this ADC makes of it: a calibration in
+  // mV/V reads any converter through the HAL's scale; one in counts only the same rails.
+  const std::string fitted = file.extra.value("recording_unit", std::string());
+  const std::string converter = file.extra.value("converter", std::string());
+  std::string origin;
+  if (!fitted.empty()) {
+    origin = " (fitted from " + fitted +
+             (converter.empty() ? "" : " of converter (" + converter + ")") + ")";
+  }
+  std::fprintf(stderr, "ftd: calibration %s: input unit %s%s, read from this ADC's counts\n",
+               path.c_str(), file.input_unit.c_str(), origin.c_str());
   slot.crc32 = j.is_discarded() ? FixedFormCrc(slot.fixed) : cal::ContentCrc(j);
   slot.present = true;
   if (rated != nullptr) *rated = file.rated;

@@ -10,6 +10,7 @@
 #include "calibration/file/cal_file.hpp"
 #include "daemon/hardware_adc.hpp"
 #include "daemon/realtime.hpp"
+#include "daemon/replay_backend.hpp"
 
 namespace ftstack::daemon {
 
@@ -64,6 +65,8 @@ void Ftd::MakeBackend() {
         throw FtdError("this ftd was built for a board without the simulator; use --adc hx711|spi");
       }
       backend_ = simulator_(opt_);
+    } else if (opt_.adc == "replay") {
+      backend_ = MakeReplayBackend(opt_);
     } else {
       backend_ = MakeHardwareBackend(opt_);
       if (opt_.cal.empty()) throw FtdError("--adc " + opt_.adc + " needs --cal CAL.json");

@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "measurement/units.hpp"
+
 namespace ftstack::daemon {
 
 /// A start-up failure of the daemon; what() is the one-line reason.
@@ -19,9 +21,12 @@ class FtdError : public std::runtime_error {
 
 /// Everything `ftd` is told on its command line (shared spec cli.md).
 struct FtdOptions {
-  std::string adc = "sim";                          ///< sim, hx711, spi
+  std::string adc = "sim";                          ///< sim, hx711, spi, replay
   std::optional<std::array<double, 6>> sim_wrench;  ///< constant applied wrench, N and N·m
-  std::string replay;                               ///< recording whose wrench columns are played
+  /// Recording played: its wrench columns through the simulated sensor (--adc sim), or its bridge
+  /// columns as the calibration's converter (--adc replay, read in replay_units if declared).
+  std::string replay;
+  UnitOverrides replay_units;
   /// Effects injected into the simulated sensor (--sim-effect, ftsim record's vocabulary); with
   /// them (or a sim_profile) the bridges are composed (at start-up, or piecewise when long) over
   /// sim_span_s of sim_profile (a profile of ftsim record; empty: the constant --sim-wrench at 20

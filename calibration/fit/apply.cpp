@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "calibration/file/recorded_unit.hpp"
 #include "firmware/core.hpp"
 
 namespace ftstack::cal {
@@ -36,10 +37,7 @@ Recording ApplyCalibration(const CalFile& cal, const Recording& in) {
             ? static_cast<std::int32_t>(std::lround(std::clamp((*temp)[i], -1e6, 1e6) * 1000.0))
             : 0;
     for (std::size_t c = 0; c < n; ++c) {
-      double v = std::nearbyint((*b[c])[i] * counts_per_input);
-      if (v > rails.max_counts) v = rails.max_counts;
-      if (v < rails.min_counts) v = rails.min_counts;
-      sample.counts[c] = static_cast<std::int32_t>(v);
+      sample.counts[c] = InputCounts((*b[c])[i], counts_per_input, rails);
       if (hal::NearRail(sample.counts[c], rails)) sample.flags[c] |= hal::kChannelSaturated;
     }
     core.Process(sample, false, o);

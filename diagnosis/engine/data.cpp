@@ -25,8 +25,6 @@ void Relay(std::size_t done, std::size_t total, void* user) {
   }
 }
 
-/// Converts `rec`'s bridge columns from their declared unit to mV/V, refusing values outside the
-/// declared converter's codes or, undeclared, outside the assumed converter (±3.90625 mV/V).
 /// The declared unit's symbol and its values per mV/V (0 when the scale is not known).
 void UnitScale(const InputUnit& u, std::string* symbol, double* per_mvv) {
   *symbol = ToString(u.unit);
@@ -39,14 +37,11 @@ void UnitScale(const InputUnit& u, std::string* symbol, double* per_mvv) {
   }
 }
 
-std::string ToMvv(Recording* rec, bool check_assumed, std::string* symbol = nullptr,
-                  double* per_mvv = nullptr, bool* ratiometric = nullptr) {
-  const InputUnit u = ResolveInputUnit(*rec);
-  if (symbol != nullptr && per_mvv != nullptr) UnitScale(u, symbol, per_mvv);
-  if (ratiometric != nullptr) {
-    *ratiometric =
-        u.unit == BridgeUnit::kCounts && u.source != "format default" && u.converter.ratiometric;
-  }
+/// Converts `rec`'s bridge columns from the unit its declaration (overridden by `cli`) says to
+/// mV/V, refusing values outside the declared converter's codes or, undeclared, outside the
+/// assumed converter (±3.90625 mV/V); returns that unit.
+InputUnit DeclaredToMvv(Recording* rec, bool check_assumed, const UnitOverrides& cli) {
+  const InputUnit u = ResolveInputUnit(*rec, cli);
   const std::size_t n = rec->BridgeCount();
   ValueRange r;
   r.unit = ToString(u.unit);
@@ -63,11 +58,24 @@ std::string ToMvv(Recording* rec, bool check_assumed, std::string* symbol = null
     CheckBridgeRange(*rec, n, r, 0.0);
   }
   ConvertBridgesToMvv(rec, n, u);
+  return u;
+}
+
+/// Converts `rec`'s bridges to mV/V by `units`; one line naming the unit and its source.
+std::string ToMvv(Recording* rec, bool check_assumed, const RealUnits& units,
+                  std::string* symbol = nullptr, double* per_mvv = nullptr,
+                  bool* ratiometric = nullptr) {
+  const InputUnit u = units.rule ? units.rule(rec) : DeclaredToMvv(rec, check_assumed, units.cli);
+  if (symbol != nullptr && per_mvv != nullptr) UnitScale(u, symbol, per_mvv);
+  if (ratiometric != nullptr) {
+    *ratiometric =
+        u.unit == BridgeUnit::kCounts && u.source != "format default" && u.converter.ratiometric;
+  }
   return Describe(u);
 }
 
-Recording Read(const std::string& path, ProgressRelay* relay, DiagData* unit_of,
-               bool check_assumed) {
+Recording Read(const std::string& path, ProgressRelay* relay, DiagData* unit_of, bool check_assumed,
+               const RealUnits& units) {
   ReadOptions opt;
   opt.required = {"t"};
   opt.require_bridges = true;
@@ -77,10 +85,10 @@ Recording Read(const std::string& path, ProgressRelay* relay, DiagData* unit_of,
   }
   Recording rec = ReadRecording(path, opt);
   if (unit_of != nullptr) {
-    unit_of->real_unit = ToMvv(&rec, check_assumed, &unit_of->real_unit_symbol,
+    unit_of->real_unit = ToMvv(&rec, check_assumed, units, &unit_of->real_unit_symbol,
                                &unit_of->real_units_per_mvv, &unit_of->real_ratiometric);
   } else {
-    (void)ToMvv(&rec, check_assumed);
+    (void)ToMvv(&rec, check_assumed, units);
   }
   return rec;
 }
@@ -209,24 +217,24 @@ DiagData FromRecordings(const Recording& sim, const Recording& real) {
 }
 
 DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path, ProgressFn progress,
-                     void* user) {
+                     void* user, const RealUnits& units) {
   ProgressRelay r1{progress, user, 0.0, 0.5, "reading sim"};
   ProgressRelay r2{progress, user, 0.5, 0.5, "reading real"};
   try {
-    DiagData units;
+    DiagData unit_of;
     // Memory: the sim's bridges are copied and released before the real file is read, and the
     // real's once copied; the peak is about one recording plus the diagnosis data.
-    Recording sim = Read(sim_path, &r1, nullptr, false);
+    Recording sim = Read(sim_path, &r1, nullptr, false, RealUnits{});
     const std::size_t ns = sim.BridgeCount();
     Eigen::MatrixXd sim_mvv = Bridges(sim, ns);
     ReleaseBridges(&sim, ns);
     std::vector<std::size_t>().swap(sim.data_lines);
-    Recording real = Read(real_path, &r2, &units, true);
+    Recording real = Read(real_path, &r2, &unit_of, true, units);
     DiagData d = Assemble(sim, ns, std::move(sim_mvv), real, &real);
-    d.real_unit = units.real_unit;
-    d.real_unit_symbol = units.real_unit_symbol;
-    d.real_units_per_mvv = units.real_units_per_mvv;
-    d.real_ratiometric = units.real_ratiometric;
+    d.real_unit = unit_of.real_unit;
+    d.real_unit_symbol = unit_of.real_unit_symbol;
+    d.real_units_per_mvv = unit_of.real_units_per_mvv;
+    d.real_ratiometric = unit_of.real_ratiometric;
     return d;
   } catch (const RecordingError& e) {
     throw DiagInputError(e.what());
@@ -235,7 +243,7 @@ DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path, 
 
 DiagData LoadPredictedReal(const std::string& real_path, const std::string& model_name,
                            int channels, const BridgePredictor& predict, ProgressFn progress,
-                           void* user) {
+                           void* user, const RealUnits& units) {
   ProgressRelay r1{progress, user, 0.0, 0.8, "reading real"};
   Recording real;
   std::string unit;
@@ -252,7 +260,7 @@ DiagData LoadPredictedReal(const std::string& real_path, const std::string& mode
       opt.progress_user = &r1;
     }
     real = ReadRecording(real_path, opt);
-    unit = ToMvv(&real, true, &symbol, &per_mvv, &ratiometric);
+    unit = ToMvv(&real, true, units, &symbol, &per_mvv, &ratiometric);
   } catch (const RecordingError& e) {
     throw DiagInputError(e.what());
   }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "measurement/recording.hpp"
+#include "measurement/units.hpp"
 #include "measurement/wrench.hpp"
 
 namespace ftstack::diag {
@@ -67,11 +68,21 @@ inline constexpr double kSegmentGapPeriods = 10.0;
 /// Progress callback: (fraction done 0…1, what is happening).
 using ProgressFn = void (*)(double fraction, const char* stage, void* user);
 
+/// How the real recording's bridge unit is decided: `rule`, where given, converts the bridge
+/// columns in place to mV/V (refusing what cannot be its unit) and returns the unit they were in
+/// and the source that decided it; else the recording's declaration, overridden by `cli`, with
+/// the range of the declared converter (undeclared: of the assumed one, ±3.90625 mV/V).
+struct RealUnits {
+  UnitOverrides cli;
+  std::function<InputUnit(Recording* real)> rule;
+};
+
 /// Builds the pair from two recordings already read: checks bridge counts and alignment.
 [[nodiscard]] DiagData FromRecordings(const Recording& sim, const Recording& real);
 /// Reads SIM.csv and REAL.csv (recording-format.md) and aligns them.
 [[nodiscard]] DiagData LoadSimReal(const std::string& sim_path, const std::string& real_path,
-                                   ProgressFn progress = nullptr, void* user = nullptr);
+                                   ProgressFn progress = nullptr, void* user = nullptr,
+                                   const RealUnits& units = {});
 /// Predicts the outputs (mV/V) of every bridge for a wrench (N, N·m) and a temperature (°C).
 using BridgePredictor = std::function<void(const Wrench& w, double temperature_c, double* out_mvv)>;
 /// Reads REAL.csv and predicts its bridges with `predict` (a model of `channels` bridges named
@@ -79,6 +90,7 @@ using BridgePredictor = std::function<void(const Wrench& w, double temperature_c
 [[nodiscard]] DiagData LoadPredictedReal(const std::string& real_path,
                                          const std::string& model_name, int channels,
                                          const BridgePredictor& predict,
-                                         ProgressFn progress = nullptr, void* user = nullptr);
+                                         ProgressFn progress = nullptr, void* user = nullptr,
+                                         const RealUnits& units = {});
 
 }  // namespace ftstack::diag

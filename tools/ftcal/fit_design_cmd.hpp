@@ -8,14 +8,12 @@
 
 #include "calibration/fit/commands.hpp"
 #include "measurement/units.hpp"
+#include "tools/unit_options.hpp"
 
 namespace ftstack::tools {
 
 /// Today's date, ISO 8601 (UTC).
 [[nodiscard]] std::string Today();
-
-/// The unit options fit, apply and check share (recording-format.md, "Declared bridge units").
-void AddUnitOptions(CLI::App* sub, UnitOverrides* units);
 
 /// What `ftcal fit` is told on the command line.
 struct FitCli {

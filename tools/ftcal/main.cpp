@@ -19,17 +19,6 @@ std::string Today() {
   return buf;
 }
 
-/// The unit options fit, apply and check share (recording-format.md, "Declared bridge units").
-void AddUnitOptions(CLI::App* sub, ftstack::UnitOverrides* units) {
-  sub->add_option("--bridge-unit", units->unit,
-                  "unit of the b* columns: mV/V, V or counts (overrides # bridge_unit)");
-  sub->add_option("--converter", units->converter,
-                  "converter of counts: \"bits=10,coding=unsigned|signed|offset-binary,gain=1,"
-                  "ratiometric=yes,reference_ratio=1,reference_v=…,full_scale_mvv=…\"");
-  sub->add_option("--excitation-v", units->excitation_v, "bridge excitation, V")
-      ->check(CLI::PositiveNumber);
-}
-
 }  // namespace ftstack::tools
 
 int main(int argc, char** argv) {

@@ -13,6 +13,7 @@
 #include "tools/ftd/http_options.hpp"
 #include "tools/ftd/mqtt_options.hpp"
 #include "tools/ftd/opcua_options.hpp"
+#include "tools/ftd/source_options.hpp"
 #if FTSTACK_FTD_SIMULATOR
 #include "daemon/sim/sim_backend.hpp"
 #endif
@@ -58,12 +59,9 @@ struct Args {
 
 void AddOptions(CLI::App& app, Args& a) {
   ftstack::daemon::FtdOptions& opt = a.opt;
-  app.add_option("--adc", opt.adc, "ADC backend: sim, hx711, spi")
-      ->check(CLI::IsMember({"sim", "hx711", "spi"}));
+  ftstack::tools::AddSourceOptions(app, opt);
   app.add_option("--sim-wrench", a.sim_wrench,
                  "constant applied wrench FX,FY,FZ,MX,MY,MZ (N, N·m)");
-  app.add_option("--replay", opt.replay, "play the wrench columns of a recording")
-      ->check(CLI::ExistingFile);
   app.add_option("--rate-hz", opt.rate_hz, "sample rate, Hz")->check(CLI::Range(1u, 100000u));
   app.add_option("--cal", opt.cal,
                  "calibration file, slot 0 (default: the simulated sensor's own)");
@@ -87,8 +85,6 @@ void AddOptions(CLI::App& app, Args& a) {
   app.add_option("--parity", a.parity, "RTU parity N|E|O")->check(CLI::IsMember({"N", "E", "O"}));
   app.add_option("--unit-id", opt.unit_id, "Modbus unit id")->check(CLI::Range(1u, 247u));
   app.add_option("--log", opt.log, "write published samples to a recording (CSV)");
-  app.add_option("--gpiochip", opt.gpiochip, "GPIO chip for --adc hx711");
-  app.add_option("--spidev", opt.spidev, "SPI device for --adc spi");
   app.add_option("--duration-s", a.duration_s,
                  "stop after this many seconds (0: run until signalled)")
       ->check(CLI::NonNegativeNumber);

@@ -16,6 +16,7 @@
 #include "diagnosis/evaluation/scorecard.hpp"
 #include "diagnosis/report/html_report.hpp"
 #include "diagnosis/report/json_report.hpp"
+#include "tools/unit_options.hpp"
 
 namespace {
 
@@ -30,6 +31,7 @@ enum ExitCode : int {
 
 struct DiagnoseArgs {
   std::string sim, model, real, json, html;
+  RealUnitSources units;  ///< --cal and the unit options: how the real file's bridges are read
   bool no_pairs = false;
   double block_s = 0.5;
   int threads = 0;
@@ -83,8 +85,10 @@ int RunDiagnose(const DiagnoseArgs& args) {
           "ftdiag diagnose: give exactly one of --sim SIM.csv or --model SENSOR.json");
     }
     if (!(args.block_s > 0)) throw DiagInputError("ftdiag diagnose: --block-s must be positive");
-    DiagData data = args.sim.empty() ? LoadModelReal(args.model, args.real, &DrawBar, &bar)
-                                     : LoadSimReal(args.sim, args.real, &DrawBar, &bar);
+    DiagData data =
+        args.sim.empty()
+            ? LoadModelReal(args.model, args.real, &DrawBar, &bar, args.units)
+            : LoadSimReal(args.sim, args.real, &DrawBar, &bar, MakeRealUnits(args.units));
     DiagnoseOptions opt;
     opt.pairs = !args.no_pairs;
     opt.block_s = args.block_s;
@@ -181,6 +185,10 @@ int main(int argc, char** argv) {
   d->add_option("--model", diagnose.model,
                 "sensor description (JSON, or 'builtin'): predict the real file's bridges");
   d->add_option("--real", diagnose.real, "real recording")->required();
+  d->add_option("--cal", diagnose.units.cal_path,
+                "the real sensor's calibration: the real file's bridges are read in the unit and "
+                "converter it was fitted from unless the file or an option declares one");
+  ftstack::tools::AddUnitOptions(d, &diagnose.units.cli);
   d->add_option("--json", diagnose.json, "JSON report (schema ftdiag-report/1)")->required();
   d->add_option("--html", diagnose.html, "self-contained HTML report with plots");
   d->add_flag("--no-pairs", diagnose.no_pairs, "consider single effects only");
