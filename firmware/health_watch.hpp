@@ -34,6 +34,7 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   static constexpr std::size_t kRingSlice = 128;    ///< capture samples analysed per Step
   static constexpr std::size_t kLevelRing = 128;    ///< sub-block means of the 0.1 s level
   static constexpr std::uint32_t kCreepHolds = 3;   ///< still holds that must agree on a creep
+  static constexpr std::size_t kToneBlocks = 8;     ///< judged blocks a tone or noise is read over
 
   /// Rate and rated range per axis (LSB, each > 0). False (the watch stays off) otherwise, or at
   /// a rate below 100 Hz.
@@ -142,6 +143,10 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   std::int32_t max_diff_ = 0;            ///< first differences are clamped to ± this
   std::array<ToneDetector, kAxes> tone50_{}, tone60_{};
   std::array<std::int64_t, kAxes> sum_d_{}, sum_d2_{};
+  // Interference and a noise rise last: each is read as the median of the last kToneBlocks blocks
+  // taken, so a transient the moving gate let through (a contact bounce) spoils one block, not
+  // the reading. Per block: 50 Hz, 60 Hz amplitude and noise per axis, Q8 LSB, in a ring.
+  std::array<std::array<std::array<std::int32_t, kToneBlocks>, kAxes>, 3> block_ring_{};
   std::array<std::int64_t, kAxes> a50_q8_{}, a60_q8_{}, sigma_q8_{};
   std::uint32_t blocks_seen_ = 0;
   std::array<std::int64_t, kAxes> sigma_ref_sum_q8_{}, sigma_ref_q8_{};
