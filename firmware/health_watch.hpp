@@ -80,6 +80,7 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   void FinishAxis(std::size_t axis);
   void FinishRinging();
   void UpdateCreep(const HealthInput& in, bool moving);
+  void TrackHoldLevel();
   void FinishCreep();
   void SetFinding(HealthCause cause, bool on, const WrenchLsb& error);
   /// The watch judged `cause` at this sample (its coverage).
@@ -175,6 +176,9 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   std::array<std::array<std::int64_t, kAxes>, 3> seg_sum_{};
   std::uint32_t creep_count_ = 0;
   std::uint32_t seg_len_ = 0;
+  // The hold's 0.1 s level (ring sums, every 0.1 s): its extremes and the largest way back from
+  // each, so that a load wandering under the moving gate is not read as creep.
+  std::array<std::int64_t, kAxes> hold_max_{}, hold_min_{}, retreat_up_{}, retreat_down_{};
   // Independent holds that read as creep, in a row, with the same sign (relative to their step)
   // and time constants within a factor 2 (d2/d1 of the segments: e^(−2 s/τ), Q16).
   std::uint32_t creep_streak_ = 0;

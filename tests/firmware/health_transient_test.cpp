@@ -1,6 +1,7 @@
-// The interference and noise watch against transients the load-change gate lets through: a
-// contact bounce (a decaying oscillation whose 0.1 s mean stays under the gate) is broadband and
-// fills one block's 50/60 Hz bins and noise; a steady tone or noise rise fills every block.
+// The watch against load changes too small or too fast for the load-change gate: a contact
+// bounce (a decaying oscillation whose 0.1 s mean stays under the gate) is broadband and fills one
+// block's 50/60 Hz bins and noise, where a steady tone or noise rise fills every block; a load
+// that sways during a hold is not a still hold, and its slow approach is not judged as creep.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -40,6 +41,36 @@ TEST(HealthTransient, ATonePersistsThroughTheBounces) {
   EXPECT_NEAR(fd->error_lsb[2], 0.001 * kRated[2], 0.05 * 0.001 * kRated[2]);
   EXPECT_FALSE(Has(run.report(), HealthCause::kMains60));
   EXPECT_FALSE(Has(run.report(), HealthCause::kNoiseFloor));
+}
+
+/// Fz steps between 0 and 15 % of rated every 10 s; after each step an approach of 0.3 % of rated
+/// in the step's direction (τ 4 s: creep-like); with `sway`, a 1 Hz sway of 1 % of rated all the
+/// time (whole periods in the 2 s segments, so their means see only the approach; 0.63 % of rated
+/// per 0.1 s at most: under the 1 % gate).
+Scene SwayingHolds(bool sway) {
+  Scene s;
+  s.load = [sway](double t, std::array<double, 6>& y, double&) {
+    const int k = static_cast<int>(t / 10.0);
+    const double since = t - 10.0 * k;
+    const double dir = k % 2 == 0 ? -1.0 : 1.0;  // odd periods step up to 15 %, even back down
+    y[2] = (k % 2 == 1 ? 0.15 : 0.0) * kRated[2];
+    if (k > 0) y[2] += dir * 0.003 * kRated[2] * (1.0 - std::exp(-since / 4.0));
+    if (sway) y[2] += 0.01 * kRated[2] * std::sin(2 * M_PI * 1.0 * t);
+  };
+  return s;
+}
+
+TEST(HealthTransient, AnApproachInStillHoldsIsCreep) {
+  Runner run(SwayingHolds(false));
+  run.Run(60);
+  EXPECT_TRUE(Has(run.report(), HealthCause::kCreep));
+}
+
+TEST(HealthTransient, TheSameApproachUnderASwayIsNotJudged) {
+  Runner run(SwayingHolds(true));
+  bool creep = false;
+  run.Run(120, [&](double) { creep = creep || Has(run.report(), HealthCause::kCreep); });
+  EXPECT_FALSE(creep);
 }
 
 }  // namespace
