@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 
 namespace ftstack::fw::health_int {
@@ -24,6 +25,19 @@ namespace ftstack::fw::health_int {
   if ((a <= b && b <= c) || (c <= b && b <= a)) return b;
   if ((b <= a && a <= c) || (c <= a && a <= b)) return a;
   return c;
+}
+
+/// The median of the first `n` (1 ≤ n ≤ N) values (the mean of the middle two for an even n),
+/// by insertion sort of a copy: meant for a handful of values.
+template <std::size_t N>
+[[nodiscard]] std::int64_t Median(std::array<std::int32_t, N> v, std::size_t n) {
+  for (std::size_t i = 1; i < n; ++i) {
+    const std::int32_t x = v[i];
+    std::size_t j = i;
+    for (; j > 0 && v[j - 1] > x; --j) v[j] = v[j - 1];
+    v[j] = x;
+  }
+  return (std::int64_t{v[(n - 1) / 2]} + v[n / 2]) / 2;
 }
 
 }  // namespace ftstack::fw::health_int

@@ -390,17 +390,16 @@ void HealthWatch::FinishBlock() {
 }
 
 void HealthWatch::TakeBlock(const BlockResult& b) {
+  const std::size_t slot = blocks_seen_ % kToneBlocks;
+  const std::size_t n = std::min<std::size_t>(blocks_seen_ + 1, kToneBlocks);
   for (std::size_t r = 0; r < kAxes; ++r) {
-    if (blocks_seen_ == 0) {
-      a50_q8_[r] = b.a50[r];
-      a60_q8_[r] = b.a60[r];
-      sigma_q8_[r] = b.sigma[r];
-    } else {  // averages over ≈ 8 blocks
-      a50_q8_[r] += (b.a50[r] - a50_q8_[r]) / 8;
-      a60_q8_[r] += (b.a60[r] - a60_q8_[r]) / 8;
-      sigma_q8_[r] += (b.sigma[r] - sigma_q8_[r]) / 8;
-    }
-    if (commission_blocks_ > 0) sigma_ref_sum_q8_[r] += b.sigma[r];
+    block_ring_[0][r][slot] = Sat32(b.a50[r]);
+    block_ring_[1][r][slot] = Sat32(b.a60[r]);
+    block_ring_[2][r][slot] = Sat32(b.sigma[r]);
+    a50_q8_[r] = health_int::Median(block_ring_[0][r], n);
+    a60_q8_[r] = health_int::Median(block_ring_[1][r], n);
+    sigma_q8_[r] = health_int::Median(block_ring_[2][r], n);
+    if (commission_blocks_ > 0) sigma_ref_sum_q8_[r] += sigma_q8_[r];
   }
   ++blocks_seen_;
   if (commission_blocks_ > 0 && --commission_blocks_ == 0) {
@@ -408,7 +407,7 @@ void HealthWatch::TakeBlock(const BlockResult& b) {
       sigma_ref_q8_[r] = sigma_ref_sum_q8_[r] / kCommissionBlocks;
     }
   }
-  if (blocks_seen_ < 8) return;  // the averages need 8 blocks
+  if (blocks_seen_ < kToneBlocks) return;  // the medians need kToneBlocks blocks
   Judged(HealthCause::kMains50);
   Judged(HealthCause::kMains60);
   if (commission_blocks_ == 0) Judged(HealthCause::kNoiseFloor);

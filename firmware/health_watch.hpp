@@ -34,6 +34,7 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   static constexpr std::size_t kRingSlice = 128;    ///< capture samples analysed per Step
   static constexpr std::size_t kLevelRing = 128;    ///< sub-block means of the 0.1 s level
   static constexpr std::uint32_t kCreepHolds = 3;   ///< still holds that must agree on a creep
+  static constexpr std::size_t kToneBlocks = 8;     ///< judged blocks a tone or noise is read over
 
   /// Rate and rated range per axis (LSB, each > 0). False (the watch stays off) otherwise, or at
   /// a rate below 100 Hz.
@@ -79,6 +80,7 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   void FinishAxis(std::size_t axis);
   void FinishRinging();
   void UpdateCreep(const HealthInput& in, bool moving);
+  void TrackHoldLevel();
   void FinishCreep();
   void SetFinding(HealthCause cause, bool on, const WrenchLsb& error);
   /// The watch judged `cause` at this sample (its coverage).
@@ -142,6 +144,10 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   std::int32_t max_diff_ = 0;            ///< first differences are clamped to ± this
   std::array<ToneDetector, kAxes> tone50_{}, tone60_{};
   std::array<std::int64_t, kAxes> sum_d_{}, sum_d2_{};
+  // Interference and a noise rise last: each is read as the median of the last kToneBlocks blocks
+  // taken, so a transient the moving gate let through (a contact bounce) spoils one block, not
+  // the reading. Per block: 50 Hz, 60 Hz amplitude and noise per axis, Q8 LSB, in a ring.
+  std::array<std::array<std::array<std::int32_t, kToneBlocks>, kAxes>, 3> block_ring_{};
   std::array<std::int64_t, kAxes> a50_q8_{}, a60_q8_{}, sigma_q8_{};
   std::uint32_t blocks_seen_ = 0;
   std::array<std::int64_t, kAxes> sigma_ref_sum_q8_{}, sigma_ref_q8_{};
@@ -170,6 +176,9 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   std::array<std::array<std::int64_t, kAxes>, 3> seg_sum_{};
   std::uint32_t creep_count_ = 0;
   std::uint32_t seg_len_ = 0;
+  // The hold's 0.1 s level (ring sums, every 0.1 s): its extremes and the largest way back from
+  // each, so that a load wandering under the moving gate is not read as creep.
+  std::array<std::int64_t, kAxes> hold_max_{}, hold_min_{}, retreat_up_{}, retreat_down_{};
   // Independent holds that read as creep, in a row, with the same sign (relative to their step)
   // and time constants within a factor 2 (d2/d1 of the segments: e^(−2 s/τ), Q16).
   std::uint32_t creep_streak_ = 0;

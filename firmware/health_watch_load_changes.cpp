@@ -112,6 +112,11 @@ void HealthWatch::UpdateCreep(const HealthInput& in, bool moving) {
       } else if (--creep_count_ == 0) {
         creep_phase_ = CreepPhase::kHold;
         seg_sum_ = {};
+        for (std::size_t r = 0; r < kAxes; ++r) {
+          hold_max_[r] = hold_min_[r] = level_sum_[r];
+        }
+        retreat_up_ = {};
+        retreat_down_ = {};
       }
       return;
     case CreepPhase::kHold:
@@ -126,8 +131,21 @@ void HealthWatch::UpdateCreep(const HealthInput& in, bool moving) {
         const std::size_t seg = creep_count_ / seg_len_;
         for (std::size_t r = 0; r < kAxes; ++r) seg_sum_[seg][r] += in.tared[r];
       }
+      if (creep_count_ % block_ == 0) TrackHoldLevel();
       if (++creep_count_ == 3 * seg_len_) FinishCreep();
       return;
+  }
+}
+
+void HealthWatch::TrackHoldLevel() {
+  // In the ring's sum (level × level_len_): how far the 0.1 s level came back from its highest
+  // and from its lowest so far in this hold.
+  for (std::size_t r = 0; r < kAxes; ++r) {
+    const std::int64_t v = level_sum_[r];
+    hold_max_[r] = std::max(hold_max_[r], v);
+    hold_min_[r] = std::min(hold_min_[r], v);
+    retreat_down_[r] = std::max(retreat_down_[r], hold_max_[r] - v);
+    retreat_up_[r] = std::max(retreat_up_[r], v - hold_min_[r]);
   }
 }
 
@@ -171,6 +189,17 @@ void HealthWatch::FinishCreep() {
   // A ramp, or a load change that starts or stops inside the hold, is the load moving: no
   // verdict either way.
   if (!decays) return;
+  // A creep approaches its end monotonically: the 0.1 s level (sampled every 0.1 s) never comes
+  // back against the creep's direction by more than its noise (6 σ of a 0.1 s mean) and a
+  // quarter of what crept. A load that wanders under the moving gate (a contact force varying
+  // within ±10 %) comes back by its own size: not still, no verdict.
+  {
+    const std::int64_t retreat = ((seen > 0 ? retreat_down_[dom] : retreat_up_[dom]) +
+                                  static_cast<std::int64_t>(level_len_) / 2) /
+                                 static_cast<std::int64_t>(level_len_);
+    const std::int64_t level_noise = ((6 * sigma_q8_[dom] * inv_sqrt_block_q16_) >> 16) / 256 + 1;
+    if (retreat > level_noise + Abs(seen) / 4) return;
+  }
   // The load's own trend: axes that did not step (under a tenth of the main step's share) creep
   // by a tenth of its creep at most; more there is the load moving (a part re-oriented).
   const std::int64_t quiet_bp = Abs(seen) * 10000 / rated_[dom] / 2;

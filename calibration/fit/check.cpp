@@ -15,6 +15,9 @@ namespace {
 
 constexpr const char* kAxis[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
 constexpr const char* kUnit[6] = {"N", "N", "N", "N·m", "N·m", "N·m"};
+/// A rotation about an axis is named only beyond this many σ: at 3 σ, one component in ~400
+/// without a rotation would still be named (a false axis), at 4 σ one in ~16 000.
+constexpr double kResolvedSigmas = 4.0;
 
 /// K₀: how the tool's wrench follows gravity, rows Fx…Mz, columns gx gy gz.
 Eigen::Matrix<double, 6, 3> ToolResponse(const CheckTool& tool) {
@@ -30,6 +33,19 @@ Eigen::Matrix<double, 6, 3> ToolResponse(const CheckTool& tool) {
 /// σ of the linear form vᵀk given the covariance of k.
 double FormSigma(const Eigen::Vector3d& v, const Eigen::Matrix3d& cov) {
   return std::sqrt(std::max(0.0, v.dot(cov * v)));
+}
+
+/// Student's t two-sided 99 % quantile over the normal one (2.576) for ν degrees of freedom: the
+/// factor that makes a σ read from ν residual degrees of freedom cover as a known σ would.
+double StudentWidening(std::size_t dof) {
+  static constexpr double kT995[] = {63.657, 9.925, 5.841, 4.604, 4.032, 3.707, 3.499, 3.355,
+                                     3.250,  3.169, 3.106, 3.055, 3.012, 2.977, 2.947, 2.921,
+                                     2.898,  2.878, 2.861, 2.845, 2.831, 2.819, 2.807, 2.797,
+                                     2.787,  2.779, 2.771, 2.763, 2.756, 2.750};
+  constexpr double kZ995 = 2.5758;
+  if (dof == 0) return 1e6;
+  if (dof <= 30) return kT995[dof - 1] / kZ995;
+  return 1.0 + 2.8 / static_cast<double>(dof);  // the quantile's 1/ν approach to 1
 }
 
 std::string Fmt(const char* f, double v) {
@@ -126,10 +142,18 @@ CheckResult CheckCalibration(const std::vector<CheckPose>& poses, const CheckToo
   res.bias = theta.row(0).transpose();
   std::array<Eigen::Matrix3d, 6> cov{};
   std::ostringstream failed;
+  const auto dof = static_cast<std::size_t>(std::max<Eigen::Index>(0, n - 4));
+  res.residual_dof = dof;
+  // What a pose-angle error θ does to a reading: F moves by m·|g|·θ, M by m·|c|·|g|·θ.
+  const double angle_sd[2] = {tool.mass_kg * gmag * tool.pose_angle_sigma_rad,
+                              tool.mass_kg * tool.com_m.norm() * gmag * tool.pose_angle_sigma_rad};
   for (int a = 0; a < 6; ++a) {
     AxisCheck& ax = res.axes[static_cast<std::size_t>(a)];
-    const double var =
-        resid.col(a).squaredNorm() / static_cast<double>(std::max<Eigen::Index>(1, n - 4));
+    const double scatter =
+        resid.col(a).squaredNorm() / static_cast<double>(std::max<std::size_t>(1, dof));
+    const double prior = angle_sd[a / 3] * angle_sd[a / 3];
+    const double widen = StudentWidening(dof);
+    const double var = scatter > prior ? scatter * widen * widen : prior;
     cov[static_cast<std::size_t>(a)] = var * inv.bottomRightCorner<3, 3>();
     const Eigen::Matrix3d& c = cov[static_cast<std::size_t>(a)];
     const Eigen::Vector3d k = theta.block<3, 1>(1, a);
@@ -140,13 +164,24 @@ CheckResult CheckCalibration(const std::vector<CheckPose>& poses, const CheckToo
     Eigen::Vector3d cross_part = d;
     if (ax.gain_excited) {
       ax.gain_error = d.dot(e) / e.squaredNorm();
-      ax.gain_sigma = FormSigma(e, c) / e.squaredNorm();
+      // The stated mass scales every row of K₀; a centre-of-mass error moves a moment row by
+      // m·δc, of which the part along the row is a gain error.
+      const double rel_mass = tool.mass_sigma_kg / tool.mass_kg;
+      const double rel_com = a >= 3 ? tool.mass_kg * tool.com_sigma_m / e.norm() : 0.0;
+      ax.gain_sigma = std::sqrt(std::pow(FormSigma(e, c) / e.squaredNorm(), 2) +
+                                rel_mass * rel_mass + rel_com * rel_com);
       cross_part = d - ax.gain_error * e;
     }
     ax.crosstalk = cross_part.norm() * gmag;
     ax.crosstalk_sigma = cross_part.norm() > 0 ? FormSigma(cross_part.normalized(), c) * gmag : 0;
     ax.worst_error = d.norm() * gmag;
     ax.worst_sigma = d.norm() > 0 ? FormSigma(d.normalized(), c) * gmag : 0;
+    const double stated = gmag * (a < 3 ? tool.mass_sigma_kg
+                                        : std::hypot(tool.mass_sigma_kg * tool.com_m.norm(),
+                                                     tool.mass_kg * tool.com_sigma_m));
+    ax.worst_sigma = std::hypot(ax.worst_sigma, stated);
+    ax.crosstalk_sigma =
+        std::hypot(ax.crosstalk_sigma, a < 3 ? 0.0 : gmag * tool.mass_kg * tool.com_sigma_m);
     ax.allowed = 2.0 * stated_uncertainty[static_cast<std::size_t>(a)];
     const bool beyond = ax.worst_error - 3.0 * ax.worst_sigma > ax.allowed;
     const bool misfit = ax.allowed > 0 && ax.residual_rms > ax.allowed;
@@ -169,6 +204,10 @@ CheckResult CheckCalibration(const std::vector<CheckPose>& poses, const CheckToo
   res.rotation_sigma_rad = {std::sqrt(var_of(2, 1) + var_of(1, 2)) / 2,
                             std::sqrt(var_of(0, 2) + var_of(2, 0)) / 2,
                             std::sqrt(var_of(1, 0) + var_of(0, 1)) / 2};
+  for (int i = 0; i < 3; ++i) {
+    res.rotation_resolved[static_cast<std::size_t>(i)] =
+        std::abs(res.rotation_rad(i)) > kResolvedSigmas * res.rotation_sigma_rad(i);
+  }
   res.verdict = res.pass ? "PASS: every axis within 2 x the calibration's stated uncertainty"
                          : "FAIL: " + failed.str();
   return res;
@@ -199,7 +238,18 @@ std::string CheckSummary(const CheckResult& r, const CheckTool& tool) {
     << Fmt("%+.3f", r.rotation_rad.y() * kDeg) << " ± "
     << Fmt("%.3f", r.rotation_sigma_rad.y() * kDeg) << ", "
     << Fmt("%+.3f", r.rotation_rad.z() * kDeg) << " ± "
-    << Fmt("%.3f", r.rotation_sigma_rad.z() * kDeg) << " deg about x, y, z\n";
+    << Fmt("%.3f", r.rotation_sigma_rad.z() * kDeg) << " deg about x, y, z";
+  std::string named;
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (r.rotation_resolved[i]) named += std::string(named.empty() ? "" : ", ") + "xyz"[i];
+  }
+  o << (named.empty() ? " (no rotation resolved beyond 4 sigma)"
+                      : " (resolved about " + named + ")")
+    << "\n";
+  if (r.residual_dof < 8) {
+    o << "only " << r.poses << " poses: sigmas read from " << r.residual_dof
+      << " residual degrees of freedom, widened by Student's t\n";
+  }
   o << r.verdict << "\n";
   return o.str();
 }

@@ -22,6 +22,11 @@ struct CheckPose {
 struct CheckTool {
   double mass_kg = 0;
   Eigen::Vector3d com_m = Eigen::Vector3d::Zero();
+  /// Standard uncertainties of what is stated (0: exact): the tool's mass and each coordinate of
+  /// its centre of mass, and the robot's orientation of each pose (rad, about each axis).
+  double mass_sigma_kg = 0;
+  double com_sigma_m = 0;
+  double pose_angle_sigma_rad = 0;
 };
 
 /// Result for one axis.
@@ -49,6 +54,9 @@ struct CheckResult {
   /// force response), rad, about x, y, z, and its standard uncertainty.
   Eigen::Vector3d rotation_rad = Eigen::Vector3d::Zero();
   Eigen::Vector3d rotation_sigma_rad = Eigen::Vector3d::Zero();
+  /// Per axis: the rotation about it is resolved (beyond 4 σ); only those are named as an axis.
+  std::array<bool, 3> rotation_resolved{};
+  std::size_t residual_dof = 0;  ///< poses − 4: the degrees of freedom the scatter is read with
   double gravity_condition = 0;  ///< condition number of [1, g] over the poses
   std::size_t poses = 0;
   bool pass = true;
@@ -56,7 +64,12 @@ struct CheckResult {
 };
 
 /// Fits reading = bias + K·g over the poses (least squares; needs ≥ 6 poses whose gravity
-/// directions span three dimensions) and compares K with the tool's K₀ = [m·I; m·[c]×]. An axis
+/// directions span three dimensions) and compares K with the tool's K₀ = [m·I; m·[c]×].
+/// Every σ is honest with few poses: the scatter per axis is the larger of the residuals' and
+/// what the pose angles' uncertainty predicts; read from the residuals with ν = poses − 4 degrees
+/// of freedom it is widened by t_ν(99 %)/z(99 %) (Student's t; ×3.9 at 6 poses, ×1.8 at 8), so
+/// that 3 σ covers what a known σ would; the tool's mass and centre-of-mass uncertainties add
+/// in quadrature (they are systematic: no number of poses averages them out). An axis
 /// fails when its worst error minus 3 σ exceeds `allowed` (2 × stated_uncertainty), or when its
 /// residual RMS exceeds a non-zero `allowed` (the reading does not follow gravity linearly).
 /// Throws std::invalid_argument for too few poses, gravity directions that do not span three

@@ -200,6 +200,9 @@ CheckResult RunCheck(const CheckRequest& req, std::string* text) {
   } else {
     throw std::invalid_argument("check needs the tool: --payload FILE or --mass-kg M [--com-m]");
   }
+  tool.mass_sigma_kg = req.mass_sigma_kg;
+  tool.com_sigma_m = req.com_sigma_m;
+  tool.pose_angle_sigma_rad = req.pose_angle_sigma_rad;
   ReadOptions opt;
   opt.require_bridges = true;
   Recording rec = ReadRecording(req.in_path, opt);

@@ -82,6 +82,11 @@ struct CheckRequest {
   std::string payload_path;
   std::optional<double> mass_kg;
   std::optional<std::array<double, 3>> com_m;
+  /// Standard uncertainties of the tool's mass (kg), of each coordinate of its centre of mass
+  /// (m) and of each pose's orientation from the robot (rad); 0: exact.
+  double mass_sigma_kg = 0.0;
+  double com_sigma_m = 0.0;
+  double pose_angle_sigma_rad = 0.0;
   UnitOverrides units;
 };
 

@@ -226,6 +226,28 @@ TEST(CalCheck, CommandLineGivesAVerdictAndAnExitCodeAScriptCanUse) {
     EXPECT_NE(out.find(c.word), std::string::npos) << out;
     EXPECT_NE(out.find("gain error"), std::string::npos) << out;
   }
+  // The Fy fault (1 % of 24.5 N) is no longer beyond 3 σ when the tool or the poses are stated
+  // this loosely: the mass to 0.5 kg (4.9 N on every force), the pose angles to 5° (2.1 N per
+  // pose); a centre of mass known only to 0.1 m widens the moments, not the forces' σ.
+  for (const std::string loose : {" --mass-sigma-kg 0.5", " --pose-angle-sigma-deg 5"}) {
+    std::string text;
+    EXPECT_EQ(ftstack::test::RunFtcal("check --cal " + cal_path + " --in " +
+                                          (dir / "poses.csv").string() + tool + loose,
+                                      &text),
+              0)
+        << loose << "\n"
+        << text;
+  }
+  {
+    std::string text;
+    EXPECT_EQ(
+        ftstack::test::RunFtcal("check --cal " + cal_path + " --in " +
+                                    (dir / "poses.csv").string() + tool + " --com-sigma-m 0.1",
+                                &text),
+        4)
+        << text;  // the forces still see the fault
+    EXPECT_NE(text.find("FAIL: Fy"), std::string::npos) << text;
+  }
   // No tool given: one line, exit 1.
   std::string out;
   EXPECT_EQ(ftstack::test::RunFtcal(

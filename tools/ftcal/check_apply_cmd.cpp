@@ -25,6 +25,18 @@ CLI::App* AddCheckCommand(CLI::App* app, CheckCli* cli) {
   check->add_option("--com-m", cli->com_m, "the tool's centre of mass X,Y,Z, m (sensor frame)")
       ->delimiter(',')
       ->expected(3);
+  check
+      ->add_option("--mass-sigma-kg", cli->request.mass_sigma_kg,
+                   "standard uncertainty of the tool's mass, kg")
+      ->check(CLI::NonNegativeNumber);
+  check
+      ->add_option("--com-sigma-m", cli->request.com_sigma_m,
+                   "standard uncertainty of each centre-of-mass coordinate, m")
+      ->check(CLI::NonNegativeNumber);
+  check
+      ->add_option("--pose-angle-sigma-deg", cli->pose_angle_sigma_deg,
+                   "standard uncertainty of each pose's orientation from the robot, deg")
+      ->check(CLI::NonNegativeNumber);
   AddUnitOptions(check, &cli->request.units);
   return check;
 }
@@ -34,6 +46,7 @@ FtcalExit RunCheckCommand(CheckCli cli) {
   if (cli.com_m.size() == 3) {
     cli.request.com_m = std::array<double, 3>{cli.com_m[0], cli.com_m[1], cli.com_m[2]};
   }
+  cli.request.pose_angle_sigma_rad = cli.pose_angle_sigma_deg * 3.14159265358979323846 / 180.0;
   std::string text;
   const cal::CheckResult r = cal::RunCheck(cli.request, &text);
   std::printf("%s", text.c_str());

@@ -24,6 +24,7 @@ struct CheckCli {
   cal::CheckRequest request;
   double mass_kg = 0.0;
   std::vector<double> com_m;
+  double pose_angle_sigma_deg = 0.0;
   CLI::Option* mass_option = nullptr;
 };
 /// Adds `check` and its options to `app`.

@@ -1,0 +1,77 @@
+// The watch against load changes too small or too fast for the load-change gate: a contact
+// bounce (a decaying oscillation whose 0.1 s mean stays under the gate) is broadband and fills one
+// block's 50/60 Hz bins and noise, where a steady tone or noise rise fills every block; a load
+// that sways during a hold is not a still hold, and its slow approach is not judged as creep.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tests/firmware/health_scene.hpp"
+
+namespace ftstack::fw {
+namespace {
+
+/// A bounce on Fz every 4.3 s from 6 s on: 10 % of rated, 33 Hz, decaying with τ = 20 ms
+/// (zero mean over the bounce within 0.3 % of rated: below the 1 % load-change gate), plus a
+/// 50 Hz tone of `tone` × rated on Fz from the start.
+Scene Bounces(double tone) {
+  Scene s;
+  s.load = [tone](double t, std::array<double, 6>& y, double&) {
+    y[2] = tone * kRated[2] * std::sin(2 * M_PI * 50.0 * t + 0.3);
+    if (t < 6.0) return;
+    const double since = std::fmod(t - 6.0, 4.3);
+    y[2] += 0.1 * kRated[2] * std::exp(-since / 0.02) * std::sin(2 * M_PI * 33.0 * since);
+  };
+  return s;
+}
+
+TEST(HealthTransient, ContactBouncesAreNoToneAndNoNoiseRise) {
+  Runner run(Bounces(0.0));
+  bool any = false;
+  run.Run(60, [&](double) { any = any || run.report().findings != 0; });
+  EXPECT_FALSE(any) << "findings 0x" << std::hex << run.report().findings;
+}
+
+TEST(HealthTransient, ATonePersistsThroughTheBounces) {
+  Runner run(Bounces(0.001));
+  run.Run(60);
+  ASSERT_TRUE(Has(run.report(), HealthCause::kMains50));
+  const HealthFinding* fd = Slot(run.report(), HealthCause::kMains50);
+  ASSERT_NE(fd, nullptr);
+  EXPECT_NEAR(fd->error_lsb[2], 0.001 * kRated[2], 0.05 * 0.001 * kRated[2]);
+  EXPECT_FALSE(Has(run.report(), HealthCause::kMains60));
+  EXPECT_FALSE(Has(run.report(), HealthCause::kNoiseFloor));
+}
+
+/// Fz steps between 0 and 15 % of rated every 10 s; after each step an approach of 0.3 % of rated
+/// in the step's direction (τ 4 s: creep-like); with `sway`, a 1 Hz sway of 1 % of rated all the
+/// time (whole periods in the 2 s segments, so their means see only the approach; 0.63 % of rated
+/// per 0.1 s at most: under the 1 % gate).
+Scene SwayingHolds(bool sway) {
+  Scene s;
+  s.load = [sway](double t, std::array<double, 6>& y, double&) {
+    const int k = static_cast<int>(t / 10.0);
+    const double since = t - 10.0 * k;
+    const double dir = k % 2 == 0 ? -1.0 : 1.0;  // odd periods step up to 15 %, even back down
+    y[2] = (k % 2 == 1 ? 0.15 : 0.0) * kRated[2];
+    if (k > 0) y[2] += dir * 0.003 * kRated[2] * (1.0 - std::exp(-since / 4.0));
+    if (sway) y[2] += 0.01 * kRated[2] * std::sin(2 * M_PI * 1.0 * t);
+  };
+  return s;
+}
+
+TEST(HealthTransient, AnApproachInStillHoldsIsCreep) {
+  Runner run(SwayingHolds(false));
+  run.Run(60);
+  EXPECT_TRUE(Has(run.report(), HealthCause::kCreep));
+}
+
+TEST(HealthTransient, TheSameApproachUnderASwayIsNotJudged) {
+  Runner run(SwayingHolds(true));
+  bool creep = false;
+  run.Run(120, [&](double) { creep = creep || Has(run.report(), HealthCause::kCreep); });
+  EXPECT_FALSE(creep);
+}
+
+}  // namespace
+}  // namespace ftstack::fw
