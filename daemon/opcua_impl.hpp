@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "daemon/opcua_send_batch.hpp"
 #include "daemon/opcua_server.hpp"
 
 namespace ftstack::daemon {
@@ -89,6 +90,7 @@ struct OpcuaServer::Impl {
   std::chrono::steady_clock::time_point in_at{};
   bool clock_anchored = false;
   UA_DateTime clock_base = 0;  ///< UTC of sample clock 0
+  OpcuaSendBatch send_batch;   ///< the server thread's sends, one per connection and iteration
   std::atomic<std::uint64_t> method_calls{0};
   std::atomic<std::uint64_t> method_refused{0};
 };
