@@ -214,9 +214,11 @@ void OpcuaServer::Run(const std::atomic<bool>& stop) {
   const auto round = std::chrono::milliseconds(static_cast<int>(kOpcuaMinIntervalMs));
   impl_->send_batch.Begin();
   while (!stop.load(std::memory_order_relaxed)) {
+    impl_->iteration.fetch_add(1, std::memory_order_relaxed);
     const UA_UInt16 next_ms = UA_Server_run_iterate(impl_->server, false);
     impl_->send_batch.Flush();
     if (next_ms >= round.count()) {
+      impl_->iteration.fetch_add(1, std::memory_order_relaxed);
       UA_Server_run_iterate(impl_->server, true);
       impl_->send_batch.Flush();
       continue;
