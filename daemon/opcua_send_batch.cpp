@@ -18,6 +18,8 @@ std::atomic<SendFn> g_send{nullptr};
 std::atomic<CloseFn> g_close{nullptr};
 std::atomic<OpenFn> g_open{nullptr};
 std::atomic<UA_ConnectionManager_connectionCallback> g_callback{nullptr};
+std::atomic<void*> g_application{nullptr};
+std::atomic<UA_EventLoop*> g_event_loop{nullptr};
 
 thread_local OpcuaSendBatch* t_batch = nullptr;
 
@@ -81,10 +83,16 @@ void ConnectionEvent(UA_ConnectionManager* cm, std::uintptr_t id, void* applicat
 UA_StatusCode BatchedOpen(UA_ConnectionManager* cm, const UA_KeyValueMap* params, void* application,
                           void* context, UA_ConnectionManager_connectionCallback callback) {
   g_callback.store(callback);
+  g_application.store(application);
+  g_event_loop.store(cm->eventSource.eventLoop);
   return g_open.load()(cm, params, application, context, ConnectionEvent);
 }
 
 }  // namespace
+
+OpcuaServerEntry OpcuaServerEntryPoint() {
+  return {g_callback.load(), g_application.load(), g_event_loop.load()};
+}
 
 bool OpcuaSendBatch::Install(UA_Server* server) {
   UA_ServerConfig* config = UA_Server_getConfig(server);

@@ -9,6 +9,16 @@
 
 namespace ftstack::daemon {
 
+/// The server's connection callback as the TCP layer was given it at start-up, with its context:
+/// what a connection without a socket is fed through (fuzz/opcua_fuzz.cpp).
+struct OpcuaServerEntry {
+  UA_ConnectionManager_connectionCallback callback = nullptr;
+  void* application = nullptr;
+  UA_EventLoop* event_loop = nullptr;
+};
+/// The entry of the server started last in this process (empty before one started).
+[[nodiscard]] OpcuaServerEntry OpcuaServerEntryPoint();
+
 /// Installed on a server's TCP connection manager before the server starts; active on the thread
 /// that called Begin until End. While active, messages are collected per connection in order and
 /// sent by Flush; a connection's messages are sent before it is closed and dropped when the peer
