@@ -1,5 +1,8 @@
 #include "daemon/opcua_send_batch.hpp"
 
+#include <sys/socket.h>
+#include <sys/types.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cstring>
@@ -64,13 +67,23 @@ UA_StatusCode BatchedClose(UA_ConnectionManager* cm, std::uintptr_t id) {
   return g_close.load()(cm, id);
 }
 
-/// The server's connection callback, seen first: a closed connection's waiting messages are
-/// dropped before its socket number can be given to a new connection.
+/// The server's connection callback, seen first. A connection the peer ended (or that failed) is
+/// closing: what waits for it is sent as far as the socket takes it without blocking (a client
+/// that half-closes after its request still gets the answer, as when every message left at once),
+/// then forgotten before the socket number can be given to a new connection. The TCP manager's
+/// connection id is the socket, and the socket is still open during this callback.
 void ConnectionEvent(UA_ConnectionManager* cm, std::uintptr_t id, void* application, void** context,
                      UA_ConnectionState state, const UA_KeyValueMap* params, UA_ByteString msg) {
   if (state == UA_CONNECTIONSTATE_CLOSING) {
     if (OpcuaSendBatch* b = t_batch) {
       if (OpcuaSendBatch::Pending* p = Find(b, cm, id)) {
+        std::size_t sent = 0;
+        while (sent < p->bytes.size()) {
+          const ssize_t n = ::send(static_cast<int>(id), p->bytes.data() + sent,
+                                   p->bytes.size() - sent, MSG_NOSIGNAL | MSG_DONTWAIT);
+          if (n <= 0) break;
+          sent += static_cast<std::size_t>(n);
+        }
         p->bytes.clear();
         p->cm = nullptr;
         p->id = 0;
