@@ -254,3 +254,15 @@ if [ -x "$BUILD/bin/ftd" ] && [ -f "$BUILD/python/sparkplug_b_pb2.py" ] &&
     /usr/bin/python3 "$(dirname "$0")/mqtt_fleet.py" 1 10 50 ||
     echo "  (the fleet benchmark failed)"
 fi
+
+# --- OPC UA subscriptions (issue 44): two paced ftds at 8 kHz side by side, one serving 10
+# subscriptions x 6 wrench items at 10 ms to one node-opcua client, the other none; whole-process
+# CPU over the same windows and the serving ftd's server thread alone (about 45 s; node-opcua from
+# ./ftstack.sh deps). BENCH_OPCUA_REPS / BENCH_OPCUA_WINDOW for the longer runs of docs/opcua.md.
+if [ -x "$BUILD/bin/ftd" ] && command -v node >/dev/null 2>&1 &&
+   [ -d "$(dirname "$0")/../tests/opcua/node_modules/node-opcua-client" ]; then
+  section "OPC UA: ftd at 8 kHz, 10 subscriptions x 6 items at 10 ms vs none (CPU % of one core, same run)"
+  node "$(dirname "$0")/opcua_load.mjs" "$BUILD/bin/ftd" --subs 10 --items 6 \
+      --reps "${BENCH_OPCUA_REPS:-3}" --window "${BENCH_OPCUA_WINDOW:-10}" 2>&1 |
+    grep -E '^(  rep|ftd CPU)' || echo "  (the OPC UA load benchmark failed)"
+fi

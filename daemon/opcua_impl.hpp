@@ -6,12 +6,12 @@
 
 #include <array>
 #include <atomic>
-#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "daemon/opcua_send_batch.hpp"
 #include "daemon/opcua_server.hpp"
 
 namespace ftstack::daemon {
@@ -49,8 +49,9 @@ struct OpcuaServer::Impl {
       : opt(o), map(m), info(std::move(i)) {}
   ~Impl();
 
-  /// The input table of one published sample, copied at most once per millisecond (a burst of
-  /// monitored-item samples shares one copy); nullptr when the map could not be read.
+  /// The input table of one published sample, copied once per server iteration (all values
+  /// served in one iteration, e.g. every monitored item of a round, come from one sample);
+  /// nullptr when the map could not be read.
   const std::uint16_t* Snapshot();
   /// The UTC time of the sample clock's `sample_us` (anchored at the first read: the newest
   /// sample is taken as converted then).
@@ -86,9 +87,11 @@ struct OpcuaServer::Impl {
   std::vector<std::unique_ptr<OpcuaMethod>> methods;
   std::vector<std::uint16_t> in = std::vector<std::uint16_t>(fw::kInputAddressSpan, 0);
   bool in_ok = false;
-  std::chrono::steady_clock::time_point in_at{};
+  std::uint64_t in_iteration = 0;           ///< the iteration `in` was copied in
+  std::atomic<std::uint64_t> iteration{1};  ///< counts the server's iterations
   bool clock_anchored = false;
   UA_DateTime clock_base = 0;  ///< UTC of sample clock 0
+  OpcuaSendBatch send_batch;   ///< the server thread's sends, one per connection and iteration
   std::atomic<std::uint64_t> method_calls{0};
   std::atomic<std::uint64_t> method_refused{0};
 };

@@ -136,10 +136,10 @@ OpcuaServer::Impl::~Impl() {
 }
 
 const std::uint16_t* OpcuaServer::Impl::Snapshot() {
-  const auto now = std::chrono::steady_clock::now();
-  if (in_ok && now - in_at < std::chrono::milliseconds(1)) return in.data();
+  const std::uint64_t now = iteration.load(std::memory_order_relaxed);
+  if (in_ok && in_iteration == now) return in.data();
   in_ok = map->ReadInput(0, fw::kInputAddressSpan, in.data()) == fw::ModbusException::kNone;
-  in_at = now;
+  in_iteration = now;
   return in_ok ? in.data() : nullptr;
 }
 

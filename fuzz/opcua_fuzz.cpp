@@ -1,25 +1,57 @@
-// libFuzzer harness: ftd's OPC UA server as ftd wires it (OpcuaServer over a real RegisterMap and
-// Device, its own thread, security None on loopback) fed one TCP connection per input. The first
-// byte's bit 0 prepends a valid Hello, so that the input reaches the secure channel and the
-// service decoding; the rest is sent as it is, the connection half-closed, and the reply read
-// until the server closes it (a finding in the server thread is reported on this input).
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <sys/time.h>
-#include <unistd.h>
-
+// libFuzzer harness: ftd's OPC UA server as ftd builds it (OpcuaServer over a real RegisterMap and
+// Device, serving on its own thread) fed one connection per input. The input goes straight into
+// the server's connection callback, the one its TCP layer calls with received bytes, from a
+// connection manager that keeps no socket: no kernel round trip per input, so thousands of inputs
+// a second. The first byte: bit 0 prepends a valid Hello; bits 1-3 choose the piece size the rest
+// arrives in (0: whole; else 2^(n+2) bytes, so a message split across reads is reassembled); bit 4
+// gives each message the security token the server issued; the connection is then closed. open62541
+// is built for fuzzing (FUZZING_BUILD_MODE_UNSAFE_FOR_ PRODUCTION: no channel id, sequence number
+// and session token checks), so a recorded session (fuzz/opcua_seed.mjs) replays past CreateSession
+// into the services.
 #include <atomic>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "daemon/opcua_send_batch.hpp"
 #include "daemon/opcua_server.hpp"
 #include "fuzz/constant_device.hpp"
 
 namespace {
+
+/// The connection the server last asked to close (it is fed no more).
+std::atomic<std::uintptr_t> g_closed{0};
+
+/// The security token the server gave the last channel it opened (its OpenSecureChannel response).
+std::atomic<std::uint32_t> g_token{0};
+
+std::uint32_t GetU32(const std::uint8_t* p) {
+  return p[0] | (p[1] << 8) | (p[2] << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
+}
+
+/// What the server sends is dropped but for the token of an OpenSecureChannel response: with
+/// security None the response ends with the token (channel, token id, created at, lifetime) and
+/// an empty server nonce.
+UA_StatusCode Discard(UA_ConnectionManager*, std::uintptr_t, const UA_KeyValueMap*,
+                      UA_ByteString* buf) {
+  if (buf->length >= 40 && std::memcmp(buf->data, "OPNF", 4) == 0 &&
+      static_cast<std::int32_t>(GetU32(buf->data + buf->length - 4)) <= 0) {
+    g_token = GetU32(buf->data + buf->length - 20);
+  }
+  UA_ByteString_clear(buf);
+  return UA_STATUSCODE_GOOD;
+}
+UA_StatusCode Close(UA_ConnectionManager*, std::uintptr_t id) {
+  g_closed = id;
+  return UA_STATUSCODE_GOOD;
+}
+UA_StatusCode Alloc(UA_ConnectionManager*, std::uintptr_t, UA_ByteString* buf, size_t size) {
+  return UA_ByteString_allocBuffer(buf, size);
+}
+void Free(UA_ConnectionManager*, std::uintptr_t, UA_ByteString* buf) { UA_ByteString_clear(buf); }
 
 struct Bench {
   Bench() {
@@ -32,8 +64,24 @@ struct Bench {
     server = std::make_unique<ftstack::daemon::OpcuaServer>(options, &map, info);
     server->Open();
     thread = std::thread([this] { server->Run(stop); });
+    entry = ftstack::daemon::OpcuaServerEntryPoint();
+    if (entry.callback == nullptr) std::abort();
+    cm.eventSource.eventSourceType = UA_EVENTSOURCETYPE_CONNECTIONMANAGER;
+    cm.eventSource.eventLoop = entry.event_loop;
+    cm.protocol = UA_STRING(const_cast<char*>("tcp"));
+    cm.sendWithConnection = Discard;
+    cm.closeConnection = Close;
+    cm.allocNetworkBuffer = Alloc;
+    cm.freeNetworkBuffer = Free;
+    // The server registers a listening socket on its first callback; connections inherit that.
+    entry.callback(&cm, 1, entry.application, &listen_context, UA_CONNECTIONSTATE_ESTABLISHED,
+                   &UA_KEYVALUEMAP_NULL, UA_BYTESTRING_NULL);
+    if (listen_context == nullptr) std::abort();
   }
   ~Bench() {
+    // The server's shutdown waits until every socket it knows is closed, the made-up one too.
+    entry.callback(&cm, 1, entry.application, &listen_context, UA_CONNECTIONSTATE_CLOSING,
+                   &UA_KEYVALUEMAP_NULL, UA_BYTESTRING_NULL);
     stop = true;
     thread.join();
   }
@@ -45,6 +93,10 @@ struct Bench {
   std::unique_ptr<ftstack::daemon::OpcuaServer> server;
   std::atomic<bool> stop{false};
   std::thread thread;
+  ftstack::daemon::OpcuaServerEntry entry;
+  UA_ConnectionManager cm{};
+  void* listen_context = nullptr;
+  std::uintptr_t next_id = 2;
 };
 
 void PutU32(std::vector<std::uint8_t>* b, std::uint32_t v) {
@@ -74,25 +126,39 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::vector<std::uint8_t> msg;
   if ((data[0] & 1) != 0) msg = Hello(bench.server->port());
   msg.insert(msg.end(), data + 1, data + size);
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  if (fd < 0) std::abort();
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(bench.server->port());
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) std::abort();
-  const timeval timeout{2, 0};  // the server answers or closes well within this
-  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
-  std::size_t sent = 0;
-  while (sent < msg.size()) {
-    const ssize_t n = send(fd, msg.data() + sent, msg.size() - sent, MSG_NOSIGNAL);
-    if (n <= 0) break;  // the server closed on an error early
-    sent += static_cast<std::size_t>(n);
+  const unsigned split = (data[0] >> 1) & 7u;
+  const std::size_t piece = split == 0 ? msg.size() : std::size_t{1} << (split + 2);
+  const bool renew_token = (data[0] & 16) != 0;
+  const std::uintptr_t id = bench.next_id++;
+  void* context = bench.listen_context;
+  std::size_t at = 0;
+  while (at < msg.size() && g_closed != id) {
+    // Bit 4: message by message, each MSG and CLO given the token the server issued (a recorded
+    // session carries the token of the run it was recorded in).
+    std::size_t end = msg.size();
+    if (renew_token && msg.size() - at >= 16) {
+      std::uint8_t* m = msg.data() + at;
+      const std::uint32_t len = GetU32(m + 4);
+      if (len >= 16 && len <= msg.size() - at) {
+        end = at + len;
+        if (std::memcmp(m, "MSG", 3) == 0 || std::memcmp(m, "CLO", 3) == 0) {
+          const std::uint32_t t = g_token;
+          for (int i = 0; i < 4; ++i) m[12 + i] = static_cast<std::uint8_t>(t >> (8 * i));
+        }
+      }
+    }
+    for (; at < end && g_closed != id; at += std::min(piece, end - at)) {
+      bench.entry.callback(&bench.cm, id, bench.entry.application, &context,
+                           UA_CONNECTIONSTATE_ESTABLISHED, &UA_KEYVALUEMAP_NULL,
+                           UA_ByteString{std::min(piece, end - at), msg.data() + at});
+    }
+    at = end;
   }
-  shutdown(fd, SHUT_WR);
-  std::uint8_t buf[4096];
-  while (recv(fd, buf, sizeof buf, 0) > 0) {
+  if (msg.empty()) {  // the connection opens and closes without a byte
+    bench.entry.callback(&bench.cm, id, bench.entry.application, &context,
+                         UA_CONNECTIONSTATE_ESTABLISHED, &UA_KEYVALUEMAP_NULL, UA_BYTESTRING_NULL);
   }
-  close(fd);
+  bench.entry.callback(&bench.cm, id, bench.entry.application, &context, UA_CONNECTIONSTATE_CLOSING,
+                       &UA_KEYVALUEMAP_NULL, UA_BYTESTRING_NULL);
   return 0;
 }
