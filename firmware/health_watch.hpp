@@ -162,7 +162,9 @@ class HealthWatch {  // NOLINT(clang-analyzer-optin.performance.Padding)
   std::uint32_t refractory_ = 0;
   std::size_t analysing_ = kAxes;  ///< the capture's axis under analysis (kAxes: none pending)
   RingingScan ring_scan_{};        ///< that axis's analysis, a slice per sample
-  std::int32_t ring_h_ = 0;        ///< its hysteresis, LSB
+  std::int32_t ring_h_ = 0;        ///< its hysteresis, LSB: noise bands plus the tones' peaks
+  std::int32_t ring_noise_h_ = 0;  ///< the noise's part of it, LSB
+  std::int32_t ring_tone_ = 0;     ///< the tones' part of it, LSB
   std::array<RingingResult, kAxes> ring_axis_{};
   std::array<std::int32_t, 3> ring_last_mhz_{};
   std::uint32_t ring_measured_ = 0;

@@ -50,16 +50,23 @@ void HealthWatch::UpdateRinging(const HealthInput& in) {
 }
 
 void HealthWatch::StartAxis(std::size_t r) {
-  // Hysteresis: 4σ of the noise (the commissioning's, or the current one before it is known).
+  // Hysteresis: 4σ of the noise (the commissioning's, or the current one before it is known)
+  // plus the tracked 50 and 60 Hz peaks: a steady tone alone never confirms a crossing, or its
+  // crossings would be read as the mount's ringing.
   const std::int64_t sigma = sigma_ref_q8_[r] > 0 ? sigma_ref_q8_[r] : sigma_q8_[r];
-  ring_h_ = Sat32(((4 * sigma) >> 8) + 1);
+  ring_noise_h_ = Sat32(((4 * sigma) >> 8) + 1);
+  ring_tone_ = Sat32((a50_q8_[r] + a60_q8_[r]) >> 8);
+  ring_h_ = Sat32(std::int64_t{ring_noise_h_} + ring_tone_);
   ring_scan_.Start(capture_[r].data(), kRingCapture, rate_ / capture_stride_, ring_h_);
 }
 
 void HealthWatch::FinishAxis(std::size_t r) {
   ring_axis_[r] = ring_scan_.result();
-  // A ringing well clear of the noise only (8 hysteresis bands): the count is then clean.
-  if (ring_axis_[r].amplitude < 8 * ring_h_) ring_axis_[r].freq_mhz = 0;
+  // A ringing well clear of the noise (8 noise bands) and of the tone (its peak counts three
+  // times: a tone under half the ringing moves a crossing by at most 1/12 period): the count is
+  // then clean.
+  const std::int64_t clear = 8 * std::int64_t{ring_noise_h_} + 3 * std::int64_t{ring_tone_};
+  if (ring_axis_[r].amplitude < clear) ring_axis_[r].freq_mhz = 0;
 }
 
 void HealthWatch::FinishRinging() {

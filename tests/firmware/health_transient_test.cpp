@@ -1,7 +1,8 @@
 // The watch against load changes too small or too fast for the load-change gate: a contact
 // bounce (a decaying oscillation whose 0.1 s mean stays under the gate) is broadband and fills one
 // block's 50/60 Hz bins and noise, where a steady tone or noise rise fills every block; a load
-// that sways during a hold is not a still hold, and its slow approach is not judged as creep.
+// that sways during a hold is not a still hold, and its slow approach is not judged as creep; a
+// steady tone's crossings after a step are not the mount's ringing.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -71,6 +72,50 @@ TEST(HealthTransient, TheSameApproachUnderASwayIsNotJudged) {
   bool creep = false;
   run.Run(120, [&](double) { creep = creep || Has(run.report(), HealthCause::kCreep); });
   EXPECT_FALSE(creep);
+}
+
+/// Fz steps through 0, 40, 0 and 10 % of rated every 7.77 s (the tone's phase differs at every
+/// step), each followed by a ringing of `ring_hz` (1 % of the step, ζ = 0.04) and, in its first
+/// second, a slow drift of 0, 1 or 2 × `drift` of rated per s (the load still moving under the
+/// gate, as a re-orienting arm), under a steady 50 Hz tone of `tone` × rated on every axis.
+Scene RingingStepsUnderATone(double ring_hz, double tone, double drift) {
+  Scene s;
+  s.load = [=](double t, std::array<double, 6>& y, double&) {
+    const int k = static_cast<int>(t / 7.77);
+    const double since = t - k * 7.77;
+    const double levels[4] = {0.0, 0.4, 0.0, 0.1};
+    const double step = (levels[k % 4] - levels[(k + 3) % 4]) * kRated[2];
+    const double wn = 2 * M_PI * ring_hz, zeta = 0.04;
+    for (std::size_t r = 0; r < 6; ++r) {
+      y[r] = tone * kRated[r] * std::sin(2 * M_PI * 50.0 * t + 0.7 * static_cast<double>(r));
+    }
+    const double moved = drift * (k % 3) * (k % 2 == 1 ? 1.0 : -1.0);
+    y[2] += levels[k % 4] * kRated[2] + moved * kRated[2] * std::min(since, 1.0) +
+            (k == 0 ? 0.0 : 0.01 * step * std::exp(-zeta * wn * since) * std::cos(wn * since));
+  };
+  return s;
+}
+
+TEST(HealthTransient, ALargeToneIsNoRingingOfTheMount) {
+  // 0.5 % of rated: larger than the largest step's ringing (0.4 %), which the drifts after the
+  // steps bias differently; the mount has not changed.
+  Runner run(RingingStepsUnderATone(25.0, 0.005, 0.02));
+  bool mount = false;
+  run.Run(120, [&](double) { mount = mount || Has(run.report(), HealthCause::kResonanceShift); });
+  EXPECT_FALSE(mount) << "ringing read at " << run.report().ring_mhz << " mHz";
+  EXPECT_TRUE(Has(run.report(), HealthCause::kMains50));
+}
+
+TEST(HealthTransient, AMountShiftIsStillSeenUnderASmallTone) {
+  // A tone at the mains limit (0.05 % of rated: an eighth of the large step's ringing);
+  // commissioned at 25 Hz, the mount now rings 10 % higher. The tone moves the dated crossings:
+  // read within 4 % (without the tone within 1.5 %), the 10 % shift stays clear of the 5 % limit.
+  HealthThresholds th;
+  th.ring_ref_dhz = 250;
+  Runner run(RingingStepsUnderATone(27.5, 0.0005, 0.0), th);
+  run.Run(60);
+  EXPECT_TRUE(Has(run.report(), HealthCause::kResonanceShift));
+  EXPECT_NEAR(run.report().ring_mhz, 27500, 0.04 * 27500);
 }
 
 }  // namespace
