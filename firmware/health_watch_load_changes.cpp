@@ -55,7 +55,11 @@ void HealthWatch::StartAxis(std::size_t r) {
   // crossings would be read as the mount's ringing.
   const std::int64_t sigma = sigma_ref_q8_[r] > 0 ? sigma_ref_q8_[r] : sigma_q8_[r];
   ring_noise_h_ = Sat32(((4 * sigma) >> 8) + 1);
-  ring_tone_ = Sat32((a50_q8_[r] + a60_q8_[r]) >> 8);
+  // Only what stands above the bin's reading on noise alone (the mains rule's floor) is a tone.
+  const std::int64_t floor_q8 = (4 * sigma_q8_[r] * inv_sqrt_block_q16_) >> 16;
+  ring_tone_ = Sat32((std::max<std::int64_t>(a50_q8_[r] - floor_q8, 0) +
+                      std::max<std::int64_t>(a60_q8_[r] - floor_q8, 0)) >>
+                     8);
   ring_h_ = Sat32(std::int64_t{ring_noise_h_} + ring_tone_);
   ring_scan_.Start(capture_[r].data(), kRingCapture, rate_ / capture_stride_, ring_h_);
 }
