@@ -13,7 +13,8 @@ BUILD_DIR=${FTSTACK_BUILD_DIR:-$ROOT/build}
 # Every Debian package the project needs (build, tests, reports, real Modbus/serial clients, MQTT:
 # the broker, libmosquitto, protobuf-c for Sparkplug B and the tests' independent Python decoder;
 # numpy for the independent real-recording generator and analysis under tests/; CalculiX and
-# gmsh for the design explorer's FE check; rt-tests' cyclictest as the host's latency reference
+# gmsh for the design explorer's FE check, libgmsh-dev for its CAD export (ftsim design --step);
+# rt-tests' cyclictest as the host's latency reference
 # in bench/web_load.py).
 PACKAGES=(build-essential cmake ninja-build pkg-config ccache
   libeigen3-dev libmodbus-dev libgpiod-dev gpiod
@@ -22,7 +23,7 @@ PACKAGES=(build-essential cmake ninja-build pkg-config ccache
   mbpoll socat gnuplot-nox chromium libcpp-httplib-dev
   mosquitto mosquitto-clients libmosquitto-dev libprotobuf-c-dev protobuf-c-compiler
   protobuf-compiler python3-paho-mqtt python3-protobuf python3-numpy openssl
-  calculix-ccx gmsh python3-gmsh valgrind rt-tests)
+  calculix-ccx gmsh python3-gmsh libgmsh-dev valgrind rt-tests)
 
 log() { printf '[ftstack] %s\n' "$*" >&2; }
 

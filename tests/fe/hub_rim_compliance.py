@@ -11,6 +11,9 @@ face). It also solves the members-only body (beam end faces on rigid bodies) wit
 difference of element types. A floating rim joint is not modelled (the rim ends are bonded).
 
 usage: hub_rim_compliance.py DESIGN.json WORKDIR [--size-m S] [--refine R] [--out RESULT.json]
+                             [--step BODY.step]
+With --step the body as drawn is the STEP file `ftsim design --step` wrote (its mounting holes
+included) instead of the script's own drawing.
 DESIGN.json: `ftsim design --eval hub-spoke:… --json` (or `--sensor … --json`). Two meshes, the
 second `--refine` times finer, so the figures' mesh dependence is visible. Minutes, not seconds:
 a script, not a ctest.
@@ -32,7 +35,7 @@ from independent_fe import AXES, DELTA, end_face_bodies, members_from_parameters
 GMSH_TO_CCX_TET = [0, 1, 2, 3, 4, 5, 6, 7, 9, 8]
 
 
-def mesh_tets(add_geometry, fine, coarse, region):
+def mesh_tets(add_geometry, fine, coarse, region, straight=False):
     gmsh.initialize()
     gmsh.option.setNumber("General.Terminal", 0)
     gmsh.model.add("body")
@@ -43,6 +46,9 @@ def mesh_tets(add_geometry, fine, coarse, region):
     gmsh.model.mesh.setSizeCallback(lambda dim, tag, x, y, z, *lc: fine if region(x, y, z) else coarse)
     gmsh.option.setNumber("Mesh.ElementOrder", 2)
     gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
+    # Mid-edge nodes on the straight edge: tets at the imported body's small imprinted gauge pads
+    # and hole edges otherwise fold when their nodes are moved onto the curved faces.
+    gmsh.option.setNumber("Mesh.SecondOrderLinear", 1 if straight else 0)
     gmsh.model.mesh.generate(3)
     tags, coords, _ = gmsh.model.mesh.getNodes()
     nodes = dict(zip((int(t) for t in tags), coords.reshape(-1, 3)))
@@ -91,7 +97,7 @@ def write_and_solve(workdir, nodes, tets, material, platform, clamped):
     return 0.5 * (k + k.T)
 
 
-def solve_pair(design, workdir, fine):
+def solve_pair(design, workdir, fine, step=""):
     p = design["parameters"]
     members = members_from_parameters(design)
     members = [(a, b, ya, w, za, h, 1, 0) for (a, b, ya, w, za, h, _, _) in members]  # rim bonded
@@ -136,7 +142,11 @@ def solve_pair(design, workdir, fine):
         ring, _ = occ.cut([(3, outer)], [(3, inner)])
         occ.fuse(parts[:1], parts[1:] + ring)
 
-    nodes, tets = mesh_tets(as_drawn, fine, coarse, near_beams)
+    def exported(occ):  # the body `ftsim design --step` wrote (millimetres), in metres
+        occ.importShapes(step)
+        occ.dilate(occ.getEntities(3), 0, 0, 0, 1e-3, 1e-3, 1e-3)
+
+    nodes, tets = mesh_tets(exported if step else as_drawn, fine, coarse, near_beams, straight=bool(step))
     platform = [n for n, q in nodes.items() if abs(q[2] - h / 2) < 1e-9 and math.hypot(q[0], q[1]) <= r_hub + 1e-9]
     clamped = [n for n, q in nodes.items() if abs(q[2] + h / 2) < 1e-9 and math.hypot(q[0], q[1]) >= r_rim - 1e-9]
     print("  hub and rim elastic: %d nodes, %d C3D10, flange %d nodes, mount %d nodes; solving…"
@@ -156,14 +166,15 @@ def main():
     ap.add_argument("--size-m", type=float, default=0.0)
     ap.add_argument("--refine", type=float, default=1.5)
     ap.add_argument("--out", default="")
+    ap.add_argument("--step", default="", help="mesh this STEP file (ftsim design --step) as the body as drawn")
     a = ap.parse_args()
     design = json.load(open(a.design))
     if design["family"] != "hub-spoke":
         raise SystemExit("only the hub-spoke family has a hub and a rim to draw")
     p = design["parameters"]
     size = a.size_m or min(p["beam_width_m"], p["beam_height_m"]) / 3
-    runs = [solve_pair(design, os.path.join(a.workdir, "m1"), size),
-            solve_pair(design, os.path.join(a.workdir, "m2"), size / a.refine)]
+    runs = [solve_pair(design, os.path.join(a.workdir, "m1"), size, a.step),
+            solve_pair(design, os.path.join(a.workdir, "m2"), size / a.refine, a.step)]
     model = np.array(design["stiffness_si"])
     rows = []
     print("%-6s %12s %12s %12s %10s %10s %10s" % ("term", "model", "members FE", "as drawn FE", "drawn/memb",

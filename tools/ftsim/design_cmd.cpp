@@ -198,6 +198,9 @@ void AddDesignCommand(CLI::App& app, int* exit_code) {
   cmd->add_flag("--fe-check", a->one.fe_check,
                 "solid FE check with gmsh + CalculiX (the --eval design, --sensor, or the goal "
                 "winner of a --require sweep)");
+  cmd->add_option("--step", a->one.step_path,
+                  "--eval/--sensor/goal winner: write the body as drawn as STEP (mm)");
+  cmd->add_option("--stl", a->one.stl_path, "with --step: also its surface mesh as STL (mm)");
   cmd->add_option("--fe-dir", a->one.fe.work_dir, "FE files go here (default fe-check)");
   cmd->add_option("--fe-size-m", a->one.fe.element_size_m,
                   "first FE mesh's element size, m (default: shortest member / 8)");
