@@ -144,6 +144,13 @@ std::string PiecesWords(const EffectFit& fit, const ParamSpec& r) {
              hi);
 }
 
+/// The parameters `spec` declares for `fit`: its variant's where it searches narrower ranges.
+std::vector<ParamSpec> DeclaredOf(const Context& cx, const EffectFit& fit, const EffectSpec& spec) {
+  if (spec.fit_ranges != nullptr) return spec.fit_ranges(cx, fit);
+  if (spec.ranges != nullptr) return spec.ranges(cx);
+  return {};
+}
+
 }  // namespace
 
 std::string NotResolved(const Context& cx, const EffectFit& fit) {
@@ -152,8 +159,7 @@ std::string NotResolved(const Context& cx, const EffectFit& fit) {
 }
 
 std::string NotResolved(const Context& cx, const EffectFit& fit, const EffectSpec& spec) {
-  if (spec.ranges == nullptr) return "";
-  const std::vector<ParamSpec> declared = spec.ranges(cx);
+  const std::vector<ParamSpec> declared = DeclaredOf(cx, fit, spec);
   for (const ParamSpec& r : declared) {
     std::string words = BoundWords(fit, r);
     if (!words.empty()) return words;
@@ -174,8 +180,7 @@ nlohmann::json TypedParameters(const Context& cx, const EffectFit& fit) {
 
 nlohmann::json TypedParameters(const Context& cx, const EffectFit& fit, const EffectSpec& plugin) {
   const EffectSpec* spec = plugin.kind == EffectKind::kNone ? nullptr : &plugin;
-  std::vector<ParamSpec> declared;
-  if (plugin.ranges != nullptr) declared = plugin.ranges(cx);
+  const std::vector<ParamSpec> declared = DeclaredOf(cx, fit, plugin);
   auto out = nlohmann::json::array();
   for (auto it = fit.params.begin(); it != fit.params.end(); ++it) {
     const std::string& key = it.key();
