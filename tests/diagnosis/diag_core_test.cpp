@@ -284,7 +284,9 @@ TEST(DiagHonesty, RingingPerChangeIsCheckedAgainstItsOwnDeclaredRange) {
   EXPECT_NE(NotResolved(cx, r).find("at its upper bound"), std::string::npos);
   const auto p = TypedParameters(cx, r);
   for (const auto& q : p) {
-    if (q["key"] == "damping_ratio") EXPECT_EQ(q["range"][1].get<double>(), 0.05);
+    if (q["key"] == "damping_ratio") {
+      EXPECT_EQ(q["range"][1].get<double>(), 0.05);
+    }
   }
 }
 
