@@ -86,10 +86,15 @@ inline constexpr std::array kZeroDrift = {
       ""},
     P{"levels_mvv", T::kList, "mV/V", "every fitted level, per channel (stepped variant)",
       kReported, ""},
+    P{"levels", T::kNumber, "", "how many levels the stepped variant fitted", kDescribed, ""},
+    P{"knots", T::kNumber, "", "knots of the fitted wander's spline", kDescribed, ""},
     kChannels};
 inline constexpr std::array kThermalZeroDrift = {
     P{"coef_per_K", T::kList, "mV/V/K", "offset per kelvin, per channel", kBoth, ""},
-    P{"t0_c", T::kNumber, "°C", "temperature of zero offset", kInjected, ""}, kChannels};
+    P{"t0_c", T::kNumber, "°C", "temperature of zero offset", kInjected, ""},
+    P{"lag_s", T::kNumber, "s", "lag of the bridge's temperature behind the recorded one",
+      kDescribed, ""},
+    kChannels};
 inline constexpr std::array kThermalSpanDrift = {
     P{"coef_per_K", T::kNumber, "1/K", "relative sensitivity change per kelvin", kBoth, ""},
     P{"t0_c", T::kNumber, "°C", "temperature of nominal sensitivity", kInjected, ""},
@@ -103,7 +108,8 @@ inline constexpr std::array kExcitationDrift = {
     P{"factor_min", T::kNumber, "", "least fitted sensitivity factor over the record", kDescribed,
       ""},
     P{"factor_max", T::kNumber, "", "largest fitted sensitivity factor over the record", kDescribed,
-      ""}};
+      ""},
+    P{"knots", T::kNumber, "", "knots of the fitted wander's spline", kDescribed, ""}};
 inline constexpr std::array kCreep = {
     P{"tau_s", T::kNumber, "s", "first-order creep time constant", kBoth, ""},
     P{"fraction", T::kNumber, "", "share of a load change that creeps in (report: per channel)",
@@ -121,7 +127,9 @@ inline constexpr std::array kHysteresis = {
       kDescribed, ""},
     P{"half_width_mvv", T::kList, "mV/V", "loop half width, per channel", kDescribed, ""},
     P{"loop_half_height_mvv", T::kList, "mV/V", "loop half height, per channel", kDescribed, ""},
-    P{"relay_levels", T::kNumber, "", "load levels of the relay grid", kDescribed, ""}};
+    P{"relay_levels", T::kNumber, "", "load levels of the relay grid", kDescribed, ""},
+    P{"loop_half_height", T::kList, "N or N·m",
+      "loop half height in the load's units, per wrench axis (load-path variant)", kDescribed, ""}};
 inline constexpr std::array kBridgeNonlinearity = {
     P{"channels", T::kChannels, "", "bridges with a quadratic term", kBoth, ""},
     P{"coef", T::kNumber, "1/(mV/V)", "quadratic coefficient: b += coef·b²", kInjected, ""},
@@ -138,7 +146,8 @@ inline constexpr std::array kLoadStiffening = {
       ""},
     P{"fz_peak_n", T::kNumber, "N", "largest |Fz| of the record", kDescribed, ""},
     P{"kappa_at_peak_Fz", T::kList, "", "relative sensitivity change at the peak Fz, per channel",
-      kDescribed, ""}};
+      kDescribed, ""},
+    P{"terms", T::kNumber, "", "the load products fitted (a label)", kDescribed, ""}};
 inline constexpr std::array kMisalignment = {
     P{"axis", T::kRotAxis, "", "rotation axis (x, y, z)", kBoth, ""},
     P{"angle_deg", T::kNumber, "deg", "rotation of the sensor frame", kBoth, ""}};
@@ -191,6 +200,8 @@ inline constexpr std::array kResonance = {
     P{"participation2", T::kNumber, "",
       "mode 2's share of the output, per channel (two-mode variant)", kReported, ""},
     P{"damped_freq_hz", T::kNumber, "Hz", "damped frequency the record rings at", kDescribed, ""},
+    P{"load_changes", T::kNumber, "", "load changes the ringing restarts at (per-change variant)",
+      kDescribed, ""},
     kChannels};
 inline constexpr std::array kConverterGlitch = {
     P{"count", T::kNumber, "", "isolated wrong codes (report: how many were found)", kBoth, ""},

@@ -560,12 +560,13 @@ std::vector<ParamSpec> CreepRanges(const Context& cx) {
   const char* lo_what = "3 samples, 0.2 s or 3 times the load changes' settling";
   const char* hi_what = "a third of the record";
   const ParamScale lin = ParamScale::kLinear;
+  const char* per_channel = "none: per channel, only |fraction| is bounded";
   return {{"tau_s", lo, hi, lo_what, hi_what, "s"},
           {"tau1_s", lo, hi, lo_what, hi_what, "s"},
           {"tau2_s", lo, hi, lo_what, hi_what, "s"},
-          {"fraction", 0.0, 0.05, "", "5 % of the load", "", lin},
-          {"fraction1", 0.0, 0.05, "", "5 % of the load", "", lin},
-          {"fraction2", 0.0, 0.05, "", "5 % of the load", "", lin}};
+          {"fraction", 0.0, 0.05, per_channel, "5 % of the load", "", lin},
+          {"fraction1", 0.0, 0.05, per_channel, "5 % of the load", "", lin},
+          {"fraction2", 0.0, 0.05, per_channel, "5 % of the load", "", lin}};
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/signal.hpp"
+#include "diagnosis/engine/training_rows.hpp"
 
 namespace ftstack::diag::fx {
 
@@ -36,15 +37,14 @@ std::optional<EffectFit> ExcitationSearch(const Context& cx, const Series& targe
     }
     NormalEq ne(k + 1);
     for (int c = 0; c < cx.nc; ++c) {
-      for (int i = 0; i < cx.n; ++i) {
-        if (!cx.train[static_cast<std::size_t>(i)]) continue;
+      ForTrainingRows(cx, 0, cx.n, [&](int i) {
         const int j = hat_j[static_cast<std::size_t>(i)];
         const double fr = hat_fr[static_cast<std::size_t>(i)];
         const double s = cx.sim_mvv(i, c);
         const int idx[2] = {j, j + 1};
         const double val[2] = {(1.0 - fr) * s, fr * s};
         ne.AddSparse(idx, val, 2, target(i, c), cx.weight(c));
-      }
+      });
     }
     const auto r = ne.Solve();
     const int p = k + 1;

@@ -121,11 +121,15 @@ std::vector<int> LoadChangeStarts(const Context& cx);
 inline constexpr const char* kZeroStepsAtChanges = "steps at load changes";
 /// resonance's variant name for RingingPerChange.
 inline constexpr const char* kRingingPerChange = "ringing per load change";
+/// The declared parameters of resonance's variant kRingingPerChange: (f, ζ) from 3 periods of the
+/// median stretch between load changes to 0.98 × Nyquist, ζ 1e-3 … 0.05.
+std::vector<ParamSpec> RingingSpecs(const Context& cx);
 /// resonance, variant kRingingPerChange (effects/ringing_per_change.cpp): a lightly damped mode
 /// (ζ 1e-3 … 0.05) restarted at every load change the conditioning found with a free amplitude and
 /// phase per change and channel (two decaying quadrature columns, linear given f and ζ); (f, ζ)
-/// shared, searched from the residual's median-periodogram lines (or from near's). nullopt without
-/// load changes or lines, or when the search ends on its bounds.
+/// shared, searched from the residual's median-periodogram lines (or from near's) inside
+/// RingingSpecs; a line resolved inside them preferred to one on a bound. nullopt without load
+/// changes or lines.
 std::optional<EffectFit> RingingPerChange(const Context& cx, const Series& target,
                                           const EffectFit* near, bool uncertainty);
 /// The two-mode variant of a one-mode resonance fit *e at (f1_hz, zeta1) (effects/resonance.cpp):

@@ -7,6 +7,7 @@
 
 #include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/signal.hpp"
+#include "diagnosis/engine/training_rows.hpp"
 
 namespace ftstack::diag::fx {
 
@@ -33,14 +34,13 @@ std::optional<EffectFit> FitGeometric(const Context& cx, const Series& target) {
     NormalEq ne(6);
     double x[6];
     for (int c = 0; c < cx.nc; ++c) {
-      for (int i = 0; i < cx.n; ++i) {
-        if (!cx.train[static_cast<std::size_t>(i)]) continue;
+      ForTrainingRows(cx, 0, cx.n, [&](int i) {
         for (int k = 0; k < 6; ++k) {
           const double u = cx.data->wrench(i, k) / scale(k);
           x[k] = cx.sens(c, k) * scale(k) * u * u * u;
         }
         ne.Add(x, target(i, c), cx.weight(c));
-      }
+      });
     }
     const auto r = ne.Solve();
     kb = r.beta;

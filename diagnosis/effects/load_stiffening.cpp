@@ -7,6 +7,7 @@
 
 #include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/signal.hpp"
+#include "diagnosis/engine/training_rows.hpp"
 
 namespace ftstack::diag::fx {
 
@@ -20,12 +21,11 @@ std::optional<EffectFit> FitLoadStiffening(const Context& cx, const Series& targ
   NormalEq ne(4);
   double x[4];
   for (int c = 0; c < cx.nc; ++c) {
-    for (int i = 0; i < cx.n; ++i) {
-      if (!cx.train[static_cast<std::size_t>(i)]) continue;
+    ForTrainingRows(cx, 0, cx.n, [&](int i) {
       const double fz = w(i, 2) / scale(2);
       for (int j = 0; j < 4; ++j) x[j] = fz * cx.sens(c, ks[j]) * w(i, ks[j]);
       ne.Add(x, target(i, c), cx.weight(c));
-    }
+    });
   }
   const auto ra = ne.Solve();
   // Variant B: free coefficients of Fz·w_k per channel.

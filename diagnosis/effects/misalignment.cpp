@@ -7,6 +7,7 @@
 
 #include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/signal.hpp"
+#include "diagnosis/engine/training_rows.hpp"
 
 namespace ftstack::diag::fx {
 
@@ -59,8 +60,7 @@ RotationSums SumRotation(const Context& cx, const Series& target, int axis) {
   RotationSums m;
   Vec6 u;
   Vec6 v;
-  for (int i = 0; i < cx.n; ++i) {
-    if (!cx.train[static_cast<std::size_t>(i)]) continue;
+  ForTrainingRows(cx, 0, cx.n, [&](int i) {
     RotationBasis(cx.data->wrench, axis, i, &u, &v);
     for (int c = 0; c < cx.nc; ++c) {
       const double p1 = cx.sens.row(c).dot(u);
@@ -74,7 +74,7 @@ RotationSums SumRotation(const Context& cx, const Series& target, int axis) {
       m.q22 += wc * p2 * p2;
       m.q12 += wc * p1 * p2;
     }
-  }
+  });
   return m;
 }
 

@@ -8,6 +8,7 @@
 #include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/nonlinear_search.hpp"
 #include "diagnosis/engine/signal.hpp"
+#include "diagnosis/engine/training_rows.hpp"
 
 namespace ftstack::diag::fx {
 
@@ -19,9 +20,7 @@ bool FindOnset(const Context& cx, const Series& target, double* onset, double* t
                double* t_after) {
   const auto& d = *cx.data;
   std::vector<int> rows;
-  for (int i = 0; i < cx.n; ++i) {
-    if (cx.train[static_cast<std::size_t>(i)]) rows.push_back(i);
-  }
+  ForTrainingRows(cx, 0, cx.n, [&](int i) { rows.push_back(i); });
   const auto m = rows.size();
   if (m < 40) return false;
   // Suffix sums per channel: a step from 0 to a_c after the split explains Σ_c w_c·S_c²/n_after.
@@ -130,10 +129,9 @@ std::optional<double> RecoveryTau(const Context& cx, const Series& target, doubl
                                   double* log_sigma) {
   const LogBounds b = RecoveryBounds(cx, onset);
   std::vector<int> after;
-  for (int i = 0; i < cx.n; ++i) {
-    if (cx.train[static_cast<std::size_t>(i)] && cx.data->t_s[static_cast<std::size_t>(i)] >= onset)
-      after.push_back(i);
-  }
+  ForTrainingRows(cx, 0, cx.n, [&](int i) {
+    if (cx.data->t_s[static_cast<std::size_t>(i)] >= onset) after.push_back(i);
+  });
   if (after.size() < 10) return std::nullopt;
   const LogObjective sse = [&](const std::vector<double>& lt) {
     return RecoveryObjective(cx, target, after, onset, std::exp(lt[0]));

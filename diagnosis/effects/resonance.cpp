@@ -11,6 +11,7 @@
 
 #include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/nonlinear_search.hpp"
+#include "diagnosis/engine/plausibility.hpp"
 #include "diagnosis/engine/signal.hpp"
 
 namespace ftstack::diag::fx {
@@ -47,6 +48,11 @@ std::vector<ParamSpec> ResonanceSpecs(const Context& cx) {
           {"damping_ratio", kMinZeta, kMaxZeta, "Q 500", "a step response that rings"},
           {"freq2_hz", kMinFreqHz, f_hi, "0.05 Hz", "0.98 × Nyquist", "Hz"},
           {"damping_ratio2", kMinZeta, kMaxZeta, "Q 500", "a step response that rings"}};
+}
+
+/// The ranges of one resonance fit: its variant's where that searches narrower ones.
+std::vector<ParamSpec> ResonanceFitSpecs(const Context& cx, const EffectFit& fit) {
+  return fit.variant == kRingingPerChange ? RingingSpecs(cx) : ResonanceSpecs(cx);
 }
 
 /// The coarse frequency grid: ±8 % around each of the 3 strongest lines of the residual spectrum
@@ -230,12 +236,13 @@ std::string RingingEvidence(const Context& cx, const Series& target, const Effec
 bool FirstModeOnBound(const Context& cx, const EffectFit& e);
 
 /// The ringing kept between the mode locked to the reference's steps and the one restarted per
-/// load change: a fit whose mode ended on a bound loses to one that did not; else the lower
+/// load change: a per-change fit the engine does not resolve loses to any locked fit, a locked fit
+/// whose mode ended on a bound to any per-change fit; else the lower
 /// penalised training SSE (BIC: the per-change variant pays for its 2 coefficients per change and
 /// channel).
 std::optional<EffectFit> BetterRinging(const Context& cx, std::optional<EffectFit> locked,
                                        std::optional<EffectFit> per_change) {
-  if (!per_change) return locked;
+  if (!per_change || (locked && !NotResolved(cx, *per_change).empty())) return locked;
   if (!locked || FirstModeOnBound(cx, *locked)) return per_change;
   const auto bic = [&](const EffectFit& e) { return e.train_sse_w + e.n_params * Penalty(cx); };
   return bic(*per_change) < bic(*locked) ? per_change : locked;
@@ -554,7 +561,8 @@ EffectSpec ResonancePlugin() {
           .fit = &fx::FitBy<&fx::ResonanceSearch>,
           .refit = &fx::RefitBy<&fx::ResonanceSearch>,
           .cost = 8,
-          .ranges = &fx::ResonanceSpecs};
+          .ranges = &fx::ResonanceSpecs,
+          .fit_ranges = &fx::ResonanceFitSpecs};
 }
 
 }  // namespace ftstack::diag

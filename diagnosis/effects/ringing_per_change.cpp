@@ -17,7 +17,7 @@ namespace ftstack::diag::fx {
 
 namespace {
 
-/// Search bounds of the variant (inside resonance's stated range, ParamSpec): light damping only
+/// The variant's physical range, narrower than resonance's (ResonanceSpecs): light damping only
 /// (heavier "ringing" with a free start per change would mimic per-hold offsets and creep), and at
 /// least kMinPeriods periods in the median stretch between changes.
 constexpr double kMinZeta = 1e-3;
@@ -27,17 +27,16 @@ constexpr double kMinPeriods = 3.0;
 /// hand letting go and the hanger's bounce are not this mode's ringing, and would pull ζ up.
 constexpr double kSettlePeriods = 3.0;
 
-/// The ringing's search bounds in (log f, log ζ) on this record.
-std::vector<LogBounds> RingBounds(const Context& cx, const std::vector<int>& starts) {
-  std::vector<double> len;
-  for (std::size_t k = 0; k < starts.size(); ++k) {
-    const int b = k + 1 < starts.size() ? starts[k + 1] : cx.n;
-    len.push_back((b - starts[k]) * cx.dt);
-  }
-  std::nth_element(len.begin(), len.begin() + std::ssize(len) / 2, len.end());
-  const double f_lo = std::max(0.05, kMinPeriods / std::max(len[len.size() / 2], 1e-9));
-  return {{std::log(f_lo), std::log(0.98 * 0.5 * cx.rate_hz)},
-          {std::log(kMinZeta), std::log(kMaxZeta)}};
+/// The ringing's search bounds in (log f, log ζ): its declared ranges.
+std::vector<LogBounds> RingBounds(const std::vector<ParamSpec>& specs) {
+  return {{std::log(specs[0].lo), std::log(specs[0].hi)},
+          {std::log(specs[1].lo), std::log(specs[1].hi)}};
+}
+
+/// Whether the ringing at (log f, log ζ) ended inside its declared ranges (the engine's rule).
+bool Resolved(const std::vector<ParamSpec>& specs, const std::vector<double>& x) {
+  return StatusOf(specs[0], std::exp(x[0])) == ParamStatus::kResolved &&
+         StatusOf(specs[1], std::exp(x[1])) == ParamStatus::kResolved;
 }
 
 /// The two quadrature columns e^{−ζωt}·(cos ω_d t, sin ω_d t) of the ringing started at row a.
@@ -213,7 +212,7 @@ Vec Participation(const Context& cx, const std::vector<int>& starts, const RingF
 
 /// The ringing's (log f, log ζ) searched near one line, on the target detrended over 4 of the
 /// line's periods: the coarse grid (±1.5 % × ζ 0.001 … 0.03) or `warm`, then golden rounds.
-/// False when the search ends on a bound (not a resolved ringing of this kind).
+/// False when no start point has a finite objective.
 bool SearchNearLine(const Context& cx, const Series& detrended, const std::vector<int>& starts,
                     const std::vector<LogBounds>& bounds, double line_hz, const double* warm,
                     std::vector<double>* best) {
@@ -235,16 +234,43 @@ bool SearchNearLine(const Context& cx, const Series& detrended, const std::vecto
     }
     if (!std::isfinite(JointStart(sse, points, best))) return false;
   }
-  const std::vector<ParamStatus> status = JointRefine(
+  (void)JointRefine(
       sse, bounds, {0.01, 0.4}, warm != nullptr ? 1 : 0, 2,
       [&](int round) {
         if (round == 1) row_step = 1;
       },
       best);
-  return status[0] == ParamStatus::kResolved && status[1] == ParamStatus::kResolved;
+  return true;
 }
 
 }  // namespace
+
+std::vector<ParamSpec> RingingSpecs(const Context& cx) {
+  const std::vector<int> starts = LoadChangeStarts(cx);
+  double median_s = std::numeric_limits<double>::infinity();
+  if (!starts.empty()) {
+    std::vector<double> len;
+    for (std::size_t k = 0; k < starts.size(); ++k) {
+      const int b = k + 1 < starts.size() ? starts[k + 1] : cx.n;
+      len.push_back((b - starts[k]) * cx.dt);
+    }
+    std::nth_element(len.begin(), len.begin() + std::ssize(len) / 2, len.end());
+    median_s = std::max(len[len.size() / 2], 1e-9);
+  }
+  return {
+      {.key = "freq_hz",
+       .lo = std::max(0.05, kMinPeriods / median_s),
+       .hi = 0.98 * 0.5 * cx.rate_hz,
+       .lo_what = "3 periods in the median stretch between load changes (or 0.05 Hz)",
+       .hi_what = "0.98 × Nyquist",
+       .unit = "Hz"},
+      {.key = "damping_ratio",
+       .lo = kMinZeta,
+       .hi = kMaxZeta,
+       .lo_what = "Q 500",
+       .hi_what = "light damping (heavier ringing restarted per change mimics per-hold offsets)",
+       .unit = ""}};
+}
 
 std::vector<int> LoadChangeStarts(const Context& cx) {
   std::vector<int> s;
@@ -261,12 +287,16 @@ std::optional<EffectFit> RingingPerChange(const Context& cx, const Series& targe
                                           const EffectFit* near, bool uncertainty) {
   const std::vector<int> starts = LoadChangeStarts(cx);
   if (starts.empty() || cx.data == nullptr || std::ssize(cx.data->t_s) != cx.n) return std::nullopt;
-  const std::vector<LogBounds> bounds = RingBounds(cx, starts);
+  const std::vector<ParamSpec> specs = RingingSpecs(cx);
+  const std::vector<LogBounds> bounds = RingBounds(specs);
   const bool warm = near != nullptr && near->search_state.size() == 3;
   const std::vector<double> lines = warm ? std::vector<double>{std::exp(near->search_state[2])}
                                          : RingLines(cx, target, bounds[0]);
-  // Per line: the search on the detrended target, the coefficients from it, scored on the target.
+  // Per line: the search on the detrended target, the coefficients from it, scored on the target;
+  // a line resolved inside the declared ranges beats one on a bound (which the engine then
+  // reports not resolved).
   double best_sse = std::numeric_limits<double>::infinity();
+  bool best_resolved = false;
   std::vector<double> best;
   Series detrended;
   for (double line : lines) {
@@ -277,12 +307,15 @@ std::optional<EffectFit> RingingPerChange(const Context& cx, const Series& targe
     if (!SearchNearLine(cx, d, starts, bounds, line, warm ? near->search_state.data() : nullptr,
                         &x))
       continue;
+    const bool resolved = Resolved(specs, x);
+    if (best_resolved && !resolved) continue;
     const RingFit r =
         FitRing(cx, d, starts, std::exp(x[0]), std::exp(x[1]), settle_s, AllChannels(cx), 1);
     const double s =
         TrainSse(cx, target, PredictRing(cx, starts, std::exp(x[0]), std::exp(x[1]), r));
-    if (s < best_sse) {
+    if (s < best_sse || (resolved && !best_resolved)) {
       best_sse = s;
+      best_resolved = resolved;
       best = {x[0], x[1], std::log(line)};
       detrended = std::move(d);
     }

@@ -135,13 +135,19 @@ std::vector<ParamSpec> SaturationSpecs(const Context& cx) {
   for (int c = 0; c < cx.nc; ++c) {
     for (int i = 0; i < cx.n; ++i) peak = std::max(peak, std::fabs(cx.sim_mvv(i, c)));
   }
-  return {{.key = "limit",
-           .lo = 0.0,
-           .hi = peak,
-           .lo_what = "zero",
-           .hi_what = "the sim's largest reading",
-           .unit = "mV/V",
-           .scale = ParamScale::kLinear}};
+  const auto level = [peak](const char* key, double lo, const char* lo_what) {
+    return ParamSpec{.key = key,
+                     .lo = lo,
+                     .hi = peak,
+                     .lo_what = lo_what,
+                     .hi_what = "the sim's largest reading",
+                     .unit = "mV/V",
+                     .scale = ParamScale::kLinear};
+  };
+  // Each side's level is searched near the real file's extreme, inside these.
+  return {level("limit", 0.0, "zero"),
+          level("limit_high", -peak, "minus the sim's largest reading"),
+          level("limit_low", -peak, "minus the sim's largest reading")};
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/signal.hpp"
+#include "diagnosis/engine/training_rows.hpp"
 
 namespace ftstack::diag::fx {
 
@@ -17,12 +18,11 @@ std::optional<EffectFit> FitThermalSpan(const Context& cx, const Series& target)
   e.name = "thermal_span_drift";
   NormalEq ne(2);
   for (int c = 0; c < cx.nc; ++c) {
-    for (int i = 0; i < cx.n; ++i) {
-      if (!cx.train[static_cast<std::size_t>(i)]) continue;
+    ForTrainingRows(cx, 0, cx.n, [&](int i) {
       const double l = cx.load(i, c);
       const double x[2] = {cx.dtemp[static_cast<std::size_t>(i)] * l, l};
       ne.Add(x, target(i, c), cx.weight(c));
-    }
+    });
   }
   const auto rc = ne.Solve();
   Series pa(cx.n, cx.nc);

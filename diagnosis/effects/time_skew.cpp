@@ -7,6 +7,7 @@
 
 #include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/signal.hpp"
+#include "diagnosis/engine/training_rows.hpp"
 
 namespace ftstack::diag::fx {
 
@@ -54,14 +55,13 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Series& target) {
   double num = 0.0;
   double den = 0.0;
   for (int c = 0; c < cx.nc; ++c) {
-    for (int i = 1; i + 1 < cx.n; ++i) {
-      if (!cx.train[static_cast<std::size_t>(i)]) continue;
+    ForTrainingRows(cx, 1, cx.n - 1, [&](int i) {
       const double ds =
           (cx.sim_mvv(i + 1, c) - cx.sim_mvv(i - 1, c)) /
           (d.t_s[static_cast<std::size_t>(i + 1)] - d.t_s[static_cast<std::size_t>(i - 1)]);
       num += -target(i, c) * ds * cx.weight(c);
       den += ds * ds * cx.weight(c);
-    }
+    });
   }
   if (den <= 0) return std::nullopt;
   const double d0 = num / den;

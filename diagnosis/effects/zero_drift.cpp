@@ -9,6 +9,7 @@
 
 #include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/signal.hpp"
+#include "diagnosis/engine/training_rows.hpp"
 
 namespace ftstack::diag::fx {
 
@@ -32,15 +33,17 @@ std::optional<SmoothDrift> FitSmoothDrift(const Context& cx, const Series& targe
     beta->clear();
     for (int c = 0; c < cx.nc; ++c) {
       NormalEq ne(k + 1);
-      for (int i = 0; i < cx.n; i += row_step) {
-        if (!cx.train[static_cast<std::size_t>(i)]) continue;
-        int j = 0;
-        double fr = 0.0;
-        hb.At(cx.data->t_s[static_cast<std::size_t>(i)], &j, &fr);
-        const int idx[2] = {j, j + 1};
-        const double val[2] = {1.0 - fr, fr};
-        ne.AddSparse(idx, val, 2, target(i, c));
-      }
+      ForTrainingRows(
+          cx, 0, cx.n,
+          [&](int i) {
+            int j = 0;
+            double fr = 0.0;
+            hb.At(cx.data->t_s[static_cast<std::size_t>(i)], &j, &fr);
+            const int idx[2] = {j, j + 1};
+            const double val[2] = {1.0 - fr, fr};
+            ne.AddSparse(idx, val, 2, target(i, c));
+          },
+          row_step);
       const auto r = ne.Solve();
       sse_w += r.sse * cx.weight(c) * row_step;
       beta->push_back(r.beta);
@@ -149,11 +152,10 @@ std::optional<HoldLevels> FitHoldLevels(const Context& cx, const Series& target)
     for (int c = 0; c < cx.nc; ++c) {
       double sum = 0.0;
       int rows = 0;
-      for (int i = starts[k]; i < StretchEnd(starts, k, cx.n); ++i) {
-        if (!cx.train[static_cast<std::size_t>(i)]) continue;
+      ForTrainingRows(cx, starts[k], StretchEnd(starts, k, cx.n), [&](int i) {
         sum += target(i, c);
         ++rows;
-      }
+      });
       if (rows == 0) return std::nullopt;
       h.level_mvv(static_cast<Eigen::Index>(k), c) = static_cast<float>(sum / rows);
     }
@@ -161,11 +163,10 @@ std::optional<HoldLevels> FitHoldLevels(const Context& cx, const Series& target)
   for (int c = 0; c < cx.nc; ++c) {
     for (std::size_t k = 0; k < starts.size(); ++k) {
       const float level = h.level_mvv(static_cast<Eigen::Index>(k), c);
-      for (int i = starts[k]; i < StretchEnd(starts, k, cx.n); ++i) {
-        if (!cx.train[static_cast<std::size_t>(i)]) continue;
+      ForTrainingRows(cx, starts[k], StretchEnd(starts, k, cx.n), [&](int i) {
         const double r = target(i, c) - level;
         h.sse_w += r * r * cx.weight(c);
-      }
+      });
     }
   }
   return h;

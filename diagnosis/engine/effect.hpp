@@ -56,6 +56,8 @@ struct ParamSpec {
 };
 /// The declared parameters of an effect on a context (sample interval, record length, Nyquist).
 using ParamSpecsFn = std::vector<ParamSpec> (*)(const Context&);
+/// The declared parameters of one fit of an effect (for a variant searched in narrower ranges).
+using FitSpecsFn = std::vector<ParamSpec> (*)(const Context&, const EffectFit&);
 
 using FitFn = std::optional<EffectFit> (*)(const Context&, const Series& target);
 /// Refits an effect near an earlier fit of the same effect: `near`'s nonlinear parameters start a
@@ -120,6 +122,9 @@ struct EffectSpec {
   RefineFn refine_claim = nullptr;  ///< nullptr: a claim is reported as ranked
   /// Its nonlinear parameters (and scales with a physical range); nullptr: linear parameters only.
   ParamSpecsFn ranges = nullptr;
+  /// Where a variant searches narrower ranges than `ranges`: the declared parameters of a given fit
+  /// (they replace `ranges` for it); nullptr: `ranges` hold for every fit.
+  FitSpecsFn fit_ranges = nullptr;
   /// The vocabulary's name of `kind` (the report's and the confounders' key).
   const char* name = EffectOf(kind).name.data();
 

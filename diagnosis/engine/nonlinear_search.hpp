@@ -5,6 +5,8 @@
 #pragma once
 
 #include <functional>
+#include <mutex>
+#include <string>
 #include <vector>
 
 namespace ftstack::diag {
@@ -30,5 +32,31 @@ double BestPoint(const LogObjective& f, const std::vector<std::vector<double>>& 
 void GoldenRounds(const LogObjective& f, const std::vector<LogBounds>& bounds,
                   const std::vector<double>& step, int first, int last,
                   const std::function<void(int)>& before, std::vector<double>* x);
+
+/// One range an engine search covered, in value units: a one-parameter solve's declared key and
+/// range (SolveParameter), or a joint search's coordinate bounds (GoldenRounds: key "").
+struct SearchedRange {
+  std::string key;
+  double lo = 0.0;
+  double hi = 0.0;
+};
+
+/// While one is alive, every engine search notes the range it covered here (one log at a time):
+/// what lets a test walk the registry and see which effects search and inside which ranges.
+class SearchLog {
+ public:
+  SearchLog();
+  ~SearchLog();
+  SearchLog(const SearchLog&) = delete;
+  SearchLog& operator=(const SearchLog&) = delete;
+  /// The ranges noted so far, in the order searched.
+  [[nodiscard]] std::vector<SearchedRange> Ranges() const;
+  /// Notes a search on the live log, if any (a relaxed atomic load otherwise).
+  static void Note(const char* key, double lo, double hi);
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<SearchedRange> ranges_;
+};
 
 }  // namespace ftstack::diag

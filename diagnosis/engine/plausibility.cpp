@@ -45,6 +45,33 @@ std::vector<double> Values(const nlohmann::json& v) {
   return out;
 }
 
+/// The numbers of a parameter at any depth (per level and channel, say), in order; empty when any
+/// element is not a number.
+std::vector<double> FlatValues(const nlohmann::json& v) {
+  if (!v.is_array()) return Values(v);
+  std::vector<double> out;
+  for (const auto& x : v) {
+    const std::vector<double> inner = FlatValues(x);
+    if (inner.empty() && !(x.is_array() && x.empty())) return {};
+    out.insert(out.end(), inner.begin(), inner.end());
+  }
+  return out;
+}
+
+/// The typed entry of a value the fit chose rather than fitted: a count (a model order, a tally)
+/// or a label. No σ, range or spread: not_identified by the engine's rule.
+nlohmann::json ChosenNotFitted(const std::string& key, const nlohmann::json& unit,
+                               const nlohmann::json& v) {
+  return {{"key", key},
+          {"unit", unit},
+          {"value", v},
+          {"sigma", nullptr},
+          {"range", nullptr},
+          {"spread", nullptr},
+          {"spread_why", "a count or label the fit chose, not a fitted number"},
+          {"status", StatusName(ParamStatus::kNotIdentified)}};
+}
+
 /// Restricts cx's training rows to the piece [t_lo, t_hi) of the record (and back: `train`).
 void SelectPiece(Context* cx, const std::vector<std::uint8_t>& train, double t_lo, double t_hi) {
   const auto& t = cx->data->t_s;
@@ -146,14 +173,20 @@ std::string PiecesWords(const EffectFit& fit, const ParamSpec& r) {
 
 }  // namespace
 
+std::vector<ParamSpec> DeclaredParams(const Context& cx, const EffectFit& fit,
+                                      const EffectSpec& spec) {
+  if (spec.fit_ranges != nullptr) return spec.fit_ranges(cx, fit);
+  if (spec.ranges != nullptr) return spec.ranges(cx);
+  return {};
+}
+
 std::string NotResolved(const Context& cx, const EffectFit& fit) {
   const EffectSpec* spec = FindEffect(fit.name);
   return spec == nullptr ? "" : NotResolved(cx, fit, *spec);
 }
 
 std::string NotResolved(const Context& cx, const EffectFit& fit, const EffectSpec& spec) {
-  if (spec.ranges == nullptr) return "";
-  const std::vector<ParamSpec> declared = spec.ranges(cx);
+  const std::vector<ParamSpec> declared = DeclaredParams(cx, fit, spec);
   for (const ParamSpec& r : declared) {
     std::string words = BoundWords(fit, r);
     if (!words.empty()) return words;
@@ -174,15 +207,11 @@ nlohmann::json TypedParameters(const Context& cx, const EffectFit& fit) {
 
 nlohmann::json TypedParameters(const Context& cx, const EffectFit& fit, const EffectSpec& plugin) {
   const EffectSpec* spec = plugin.kind == EffectKind::kNone ? nullptr : &plugin;
-  std::vector<ParamSpec> declared;
-  if (plugin.ranges != nullptr) declared = plugin.ranges(cx);
+  const std::vector<ParamSpec> declared = DeclaredParams(cx, fit, plugin);
   auto out = nlohmann::json::array();
   for (auto it = fit.params.begin(); it != fit.params.end(); ++it) {
     const std::string& key = it.key();
     const nlohmann::json& v = it.value();
-    if (v.is_number_integer() || v.is_boolean()) continue;  // a count: a model order, not fitted
-    const std::vector<double> values = Values(v);
-    if (values.empty()) continue;
     const ParamSpec* d = nullptr;
     for (const ParamSpec& p : declared) {
       if (key == p.key) d = &p;
@@ -194,6 +223,11 @@ nlohmann::json TypedParameters(const Context& cx, const EffectFit& fit, const Ef
       unit = std::string(vocab->unit);
     } else if (d != nullptr) {
       unit = d->unit;
+    }
+    const std::vector<double> values = FlatValues(v);
+    if (v.is_number_integer() || v.is_boolean() || values.empty()) {
+      out.push_back(ChosenNotFitted(key, unit, v));
+      continue;
     }
     const nlohmann::json sigma = fit.sigma.contains(key) ? fit.sigma[key] : nlohmann::json();
     double largest = 0.0;

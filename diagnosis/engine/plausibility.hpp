@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "diagnosis/engine/context.hpp"
 #include "diagnosis/engine/effect.hpp"
@@ -23,6 +24,11 @@ namespace ftstack::diag {
 [[nodiscard]] std::string NotResolved(const Context& cx, const EffectFit& fit,
                                       const EffectSpec& spec);
 
+/// The parameters `spec` declares for `fit`: EffectSpec::fit_ranges (a variant searched in
+/// narrower ranges) where it has them, else EffectSpec::ranges, else none.
+[[nodiscard]] std::vector<ParamSpec> DeclaredParams(const Context& cx, const EffectFit& fit,
+                                                    const EffectSpec& spec);
+
 /// Number of independent pieces PieceSpreads refits on.
 inline constexpr int kSpreadPieces = 4;
 
@@ -41,8 +47,9 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit, const Effec
 /// "τ per piece 28–95 s"-style words for a fit's spreads that disagree, or "".
 [[nodiscard]] std::string SpreadWords(const EffectFit& fit);
 
-/// The report's typed `parameters` of a fit (docs/spec/diagnosis.md): one object per fitted
-/// numeric parameter of fit.params (counts, integers, are model orders and left out) with "key",
+/// The report's typed `parameters` of a fit (docs/spec/diagnosis.md): one object per key of
+/// fit.params (a count or a label the fit chose: sigma, range and spread null, not_identified) with
+/// "key",
 /// "unit" (the vocabulary's, else the effect's declaration, else null), "value", "sigma" (null
 /// without one), "range" ([lo, hi] from the declaration, else null), "spread" (the pieces' σ, or
 /// null) with "spread_why" when null, and "status": at_bound or not_identified by the declared

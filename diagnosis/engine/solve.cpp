@@ -67,6 +67,7 @@ double ValueSigma(const ParamSpec& spec, double value, double coord_sigma) {
 }  // namespace
 
 SolvedParam SolveParameter(const ParamSpec& spec, const Profile& f, const SolveOptions& opt) {
+  SearchLog::Note(spec.key, spec.lo, spec.hi);
   const std::vector<double> grid = opt.start.empty() ? StartGrid(spec) : opt.start;
   const int steps = opt.golden_steps >= 0 ? opt.golden_steps : spec.golden_steps;
   SolvedParam out;

@@ -76,10 +76,13 @@ nlohmann::json FindingsJson(const Report& r) {
     list.push_back({{"t_s", x.t_s}, {"channel", x.channel}, {"offset_mvv", x.offset_mvv}});
   }
   std::sort(channels.begin(), channels.end());
-  out.push_back({{"name", EffectOf(EffectKind::kConverterGlitch).name},
+  EffectFit located;  // located, not fitted: typed by the same rule as any fit
+  located.name = EffectOf(EffectKind::kConverterGlitch).name;
+  located.params = {{"count", g.size()}, {"times_s", times}};
+  out.push_back({{"name", located.name},
                  {"channels", channels},
-                 {"params", {{"count", g.size()}, {"times_s", times}}},
-                 {"parameters", nlohmann::json::array()},  // located, not fitted
+                 {"params", located.params},
+                 {"parameters", TypedParameters(r.cx, located)},
                  {"glitches", list},
                  {"handling",
                   "each sample replaced by the line through its neighbours in the residual and "

@@ -261,6 +261,35 @@ TEST(DiagHonesty, FitOnABoundOrOutsideItsRangeIsNotResolved) {
   EXPECT_NE(NotResolved(cx, r).find("above its range"), std::string::npos);
 }
 
+// resonance's variant "ringing per load change" searches ζ only up to 0.05 (light damping), a
+// narrower range than resonance's 0.5: a variant fit at ζ = 0.05 or above is on its own bound and
+// not resolved, where the same value is resolved for the locked ringing. Nyquist is 100 Hz at 200
+// Hz, so 0.98 × Nyquist = 98 Hz bounds the frequency of both.
+TEST(DiagHonesty, RingingPerChangeIsCheckedAgainstItsOwnDeclaredRange) {
+  const auto fx = testing::MakeFixture({}, 3, 200.0, kNoise, 4.0);
+  const Context cx = MakeContext(fx.data);
+  EffectFit r;
+  r.name = "resonance";
+  r.params["freq_hz"] = 12.0;
+  r.params["damping_ratio"] = 0.05;
+  EXPECT_EQ(NotResolved(cx, r), "");  // the locked ringing: inside 1e-3 … 0.5
+  r.variant = fx::kRingingPerChange;
+  EXPECT_NE(NotResolved(cx, r).find("damping_ratio = 0.05 at its upper bound"), std::string::npos)
+      << NotResolved(cx, r);
+  r.params["damping_ratio"] = 0.2;
+  EXPECT_NE(NotResolved(cx, r).find("above its range"), std::string::npos) << NotResolved(cx, r);
+  r.params["damping_ratio"] = 0.01;
+  EXPECT_EQ(NotResolved(cx, r), "");
+  r.params["freq_hz"] = 97.5;  // 0.5 % below 0.98 × Nyquist: on the bound
+  EXPECT_NE(NotResolved(cx, r).find("at its upper bound"), std::string::npos);
+  const auto p = TypedParameters(cx, r);
+  for (const auto& q : p) {
+    if (q["key"] == "damping_ratio") {
+      EXPECT_EQ(q["range"][1].get<double>(), 0.05);
+    }
+  }
+}
+
 // The pieces rule in closed form: a claim is contradicted when the pieces' values of its largest
 // element straddle zero (here b1's creep fraction −0.01, pieces −0.02…+0.004); b0's pieces
 // straddle zero too but b0 does not carry the effect; pieces of one sign leave the claim standing.
