@@ -95,14 +95,11 @@ std::optional<EffectFit> FitMisalignment(const Context& cx, const Series& target
 std::optional<EffectFit> FitTimeSkew(const Context& cx, const Series& target);
 std::optional<EffectFit> FitSaturation(const Context& cx, const Series& target);
 std::optional<EffectFit> FitOverloadShift(const Context& cx, const Series& target);
+/// mains_interference: the best harmonic series of a supply among the residual's lines; none when
+/// no line belongs to one (effects/mains_interference.cpp).
 std::optional<EffectFit> FitMains(const Context& cx, const Series& target);
-/// mains_interference's declared parameter: the line's frequency.
+/// mains_interference's declared parameter: the supply's fundamental frequency.
 std::vector<ParamSpec> MainsSpecs(const Context& cx);
-/// Adds harmonics 2..5 of the fitted mains fundamental f0 to *e (effects/mains_interference.cpp):
-/// each at h·f0 or, above Nyquist, at its alias, kept when it lowers the training SSE by more than
-/// the BIC penalty of its 2 coefficients per channel; refits pred jointly with the fundamental and
-/// puts h<k>_amplitude_mvv (σ) and h<k>_seen_at_hz. Returns a clause for the evidence.
-std::string AddMainsHarmonics(const Context& cx, const Series& target, double f0, EffectFit* e);
 /// resonance: LockedRingingSearch and RingingPerChange, the better kept (a mode on its search bound
 /// loses, else the lower penalised training SSE); from near, only near's variant is refitted.
 std::optional<EffectFit> ResonanceSearch(const Context& cx, const Series& target,

@@ -83,6 +83,9 @@ void SelectPiece(Context* cx, const std::vector<std::uint8_t>& train, double t_l
   }
 }
 
+/// Pieces whose values differ by less than this fraction of their size read as one value.
+constexpr double kSameValue = 1e-4;
+
 /// The spread of one parameter from its per-piece values (piece × element) and curvature σ.
 nlohmann::json OneSpread(const std::vector<std::vector<double>>& pieces,
                          const nlohmann::json& sigma) {
@@ -109,7 +112,11 @@ nlohmann::json OneSpread(const std::vector<std::vector<double>>& pieces,
     const double sd_piece = std::sqrt(ss / static_cast<double>(m - 1));
     const double s_whole = sd_piece / std::sqrt(static_cast<double>(m));
     const double c = e < curv.size() ? curv[e] : std::numeric_limits<double>::quiet_NaN();
-    if (std::isfinite(c) && sd_piece > 3.0 * std::sqrt(static_cast<double>(m)) * c) agree = false;
+    // Pieces equal to 1e-4 of their size agree whatever their curvature σ: a supply's frequency
+    // wandering by 0.01 % is one frequency, and "98.28–98.28" is not a disagreement.
+    const bool distinct = mx - mn > kSameValue * std::max(std::fabs(mn), std::fabs(mx));
+    if (std::isfinite(c) && distinct && sd_piece > 3.0 * std::sqrt(static_cast<double>(m)) * c)
+      agree = false;
     lo.push_back(mn);
     hi.push_back(mx);
     sd.push_back(s_whole);
@@ -313,7 +320,7 @@ std::string SpreadWords(const EffectFit& fit) {
     const auto& s = it.value();
     if (!s.contains("agree") || !s["agree"].is_boolean() || s["agree"].get<bool>()) continue;
     if (s["min"].is_number()) {
-      out += Fmt("%s%s per piece %.4g–%.4g", out.empty() ? "" : "; ", it.key().c_str(),
+      out += Fmt("%s%s per piece %.6g–%.6g", out.empty() ? "" : "; ", it.key().c_str(),
                  s["min"].get<double>(), s["max"].get<double>());
       continue;
     }
@@ -323,7 +330,7 @@ std::string SpreadWords(const EffectFit& fit) {
     if (e >= s["min"].size() || e >= s["max"].size() || !s["min"][e].is_number() ||
         !s["max"][e].is_number())
       continue;
-    out += Fmt("%s%s on b%zu per piece %.4g–%.4g", out.empty() ? "" : "; ", it.key().c_str(), e,
+    out += Fmt("%s%s on b%zu per piece %.6g–%.6g", out.empty() ? "" : "; ", it.key().c_str(), e,
                s["min"][e].get<double>(), s["max"][e].get<double>());
   }
   return out;
