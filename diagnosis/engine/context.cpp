@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -40,6 +41,8 @@ bool UniformClock(const DiagData& d, double dt) {
 
 /// The whole-record floor over the quiet-hold noise beyond which the floor is not noise.
 constexpr double kQuietNoiseRatio = 5.0;
+/// The lag memo's budget: about sixty lags of a search's 12 000 rows × 8 channels.
+constexpr std::size_t kLagCacheBytes = std::size_t{48} << 20;
 
 /// The robust noise per channel (or the given one) and its weights.
 void EstimateNoise(Context& cx, const Eigen::VectorXd* sigma) {
@@ -121,6 +124,7 @@ void SplitSim(Context& cx, const DiagData& d, Mat sim) {
   }
   sim.rowwise() -= cx.zero.transpose();
   cx.load = std::move(sim);
+  cx.lag_cache = std::make_shared<LagCache>(kLagCacheBytes);
   cx.load_range.resize(cx.nc);
   for (int c = 0; c < cx.nc; ++c)
     cx.load_range(c) = cx.load.col(c).maxCoeff() - cx.load.col(c).minCoeff();

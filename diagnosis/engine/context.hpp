@@ -4,10 +4,12 @@
 
 #include <Eigen/Dense>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "diagnosis/engine/conditioning.hpp"
 #include "diagnosis/engine/data.hpp"
+#include "diagnosis/engine/lag_cache.hpp"
 
 namespace ftstack::diag {
 
@@ -48,6 +50,8 @@ struct Context {
   std::vector<std::uint8_t> restart;
   int segments = 1;             ///< number of joined recordings
   std::vector<double> peak_hz;  ///< prominent lines of the residual spectrum, strongest first
+  /// The load's lags the searches computed (lag_cache.hpp); shared by the fits on this context.
+  std::shared_ptr<LagCache> lag_cache;
   std::vector<double> peak_ratio;
 
   /// Whether row i is a held-out row (not trained on, not excluded).

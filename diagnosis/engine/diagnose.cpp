@@ -494,6 +494,11 @@ Report DiagnoseWith(Context context, const DiagnoseOptions& options) {
   DebugTime("claims", "claims and confounders", t0);
   LocateByModel(r);
   DebugTime("stage", "claims", t0);
+  if (DebugOn() && r.cx.lag_cache) {
+    std::fprintf(stderr, "lag memo: %llu found, %llu filtered\n",
+                 static_cast<unsigned long long>(r.cx.lag_cache->hits()),
+                 static_cast<unsigned long long>(r.cx.lag_cache->misses()));
+  }
   Progress(options, 1.0, "done");
   return r;
 }

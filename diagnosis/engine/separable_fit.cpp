@@ -4,6 +4,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <limits>
+#include <memory>
 
 namespace ftstack::diag::fx {
 
@@ -117,7 +118,10 @@ std::vector<int> StrideRows(const Context& cx) {
   return rows;
 }
 
-void LowPassLoadRows(const Context& cx, double tau, const std::vector<int>& rows, Mat* out) {
+namespace {
+
+/// LowPassLoadRows without the memo: the filter itself.
+void FilterLoadRows(const Context& cx, double tau, const std::vector<int>& rows, Mat* out) {
   const std::vector<const double*> in = LoadColumns(cx);
   out->resize(static_cast<Eigen::Index>(rows.size()), cx.nc);
   FirstOrderLowPassStream s(cx.data->t_s.data(), static_cast<std::size_t>(cx.n), tau, in.data(),
@@ -132,6 +136,19 @@ void LowPassLoadRows(const Context& cx, double tau, const std::vector<int>& rows
       }
     }
   }
+}
+
+}  // namespace
+
+void LowPassLoadRows(const Context& cx, double tau, const std::vector<int>& rows, Mat* out) {
+  if (cx.lag_cache) {
+    if (const auto kept = cx.lag_cache->Find(tau, rows)) {
+      *out = *kept;
+      return;
+    }
+  }
+  FilterLoadRows(cx, tau, rows, out);
+  if (cx.lag_cache) cx.lag_cache->Insert(tau, rows, std::make_shared<const Mat>(*out));
 }
 
 ChannelFit ChannelSums::Solve(const Context& cx) const {

@@ -153,7 +153,7 @@ double SearchSse(const Context& cx, const Series& target, const Mat& feature, bo
 std::vector<int> StrideRows(const Context& cx);
 /// out(r, c) = LP_τ[load_c] at row rows[r] (rows increasing): the first-order lag of the load,
 /// restarting per segment, kept only at `rows` (memory: rows × N instead of n × N; the same values
-/// as the whole filter).
+/// as the whole filter). Kept in the context's lag memo (lag_cache.hpp) and taken from it.
 void LowPassLoadRows(const Context& cx, double tau, const std::vector<int>& rows, Mat* out);
 
 /// Visits equally long streams over the context's rows (one column per channel) row by row:
