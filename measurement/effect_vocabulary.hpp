@@ -187,6 +187,13 @@ inline constexpr std::array kMainsInterference = {
     P{"h5_amplitude_mvv", T::kList, "mV/V", "harmonic 5's peak amplitude, per channel", kDescribed,
       ""},
     P{"h5_seen_at_hz", T::kNumber, "Hz", "where harmonic 5 was found", kDescribed, ""},
+    P{"seen_at_hz", T::kNumber, "Hz", "where a fundamental above Nyquist was found (its alias)",
+      kDescribed, ""},
+    P{"even_harmonic_energy_fraction", T::kNumber, "",
+      "the series' energy in its even harmonics (large: a rectified or switched supply)",
+      kDescribed, ""},
+    P{"dominant_harmonic", T::kNumber, "",
+      "the order that carries most of the series' energy (1: the fundamental)", kDescribed, ""},
     kChannels};
 inline constexpr std::array kResonance = {
     P{"freq_hz", T::kNumber, "Hz", "undamped natural frequency", kBoth, ""},

@@ -59,7 +59,8 @@ std::vector<double> FlatValues(const nlohmann::json& v) {
 }
 
 /// The typed entry of a value the fit chose rather than fitted: a count (a model order, a tally)
-/// or a label. No σ, range or spread: not_identified by the engine's rule.
+/// or a label. No σ, range or spread, and status "chosen": not a parameter the fit resolved or
+/// failed to resolve (a claim's numbers are judged by the others).
 nlohmann::json ChosenNotFitted(const std::string& key, const nlohmann::json& unit,
                                const nlohmann::json& v) {
   return {{"key", key},
@@ -69,7 +70,7 @@ nlohmann::json ChosenNotFitted(const std::string& key, const nlohmann::json& uni
           {"range", nullptr},
           {"spread", nullptr},
           {"spread_why", "a count or label the fit chose, not a fitted number"},
-          {"status", StatusName(ParamStatus::kNotIdentified)}};
+          {"status", StatusName(ParamStatus::kChosen)}};
 }
 
 /// Restricts cx's training rows to the piece [t_lo, t_hi) of the record (and back: `train`).

@@ -48,7 +48,7 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit, const Effec
 [[nodiscard]] std::string SpreadWords(const EffectFit& fit);
 
 /// The report's typed `parameters` of a fit (docs/spec/diagnosis.md): one object per key of
-/// fit.params (a count or a label the fit chose: sigma, range and spread null, not_identified) with
+/// fit.params (a count or a label the fit chose: sigma, range and spread null, "chosen") with
 /// "key",
 /// "unit" (the vocabulary's, else the effect's declaration, else null), "value", "sigma" (null
 /// without one), "range" ([lo, hi] from the declaration, else null), "spread" (the pieces' σ, or

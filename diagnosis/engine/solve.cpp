@@ -18,6 +18,8 @@ const char* StatusName(ParamStatus s) {
       return "pieces_disagree";
     case ParamStatus::kNotIdentified:
       return "not_identified";
+    case ParamStatus::kChosen:
+      return "chosen";
   }
   return "not_identified";
 }

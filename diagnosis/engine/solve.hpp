@@ -21,8 +21,10 @@ enum class ParamStatus {
   kAtBound,         ///< within kOnBound of a bound of its declared range, or outside it
   kPiecesDisagree,  ///< independent pieces of the record give it different signs or > 3 σ apart
   kNotIdentified,   ///< the profile is flat there (no finite curvature σ) or the value not finite
+  kChosen,  ///< a count or label the fit chose (a model order, a tally), not a fitted number
 };
-/// The report's word for a status: "resolved", "at_bound", "pieces_disagree", "not_identified".
+/// The report's word for a status: "resolved", "at_bound", "pieces_disagree", "not_identified",
+/// "chosen".
 [[nodiscard]] const char* StatusName(ParamStatus s);
 
 /// A value in spec's search coordinate (log of the value for ParamScale::kLog) and back.

@@ -151,7 +151,7 @@ TEST(CalCheck, DetectsAOnePercentGainErrorOnOneAxis) {
   for (const double m : kMasses) {
     for (const int axis : {0, 2, 3}) {
       for (unsigned seed = 1; seed <= 5; ++seed) {
-        const CheckResult r = RunCheckOn(cal, Tool(m), {axis, 0.01, {}}, seed);
+        const CheckResult r = RunCheckOn(cal, Tool(m), {axis, 0.01, Eigen::Vector3d::Zero()}, seed);
         EXPECT_FALSE(r.pass) << m << " kg, axis " << axis << ", seed " << seed;
         const auto& ax = r.axes[static_cast<std::size_t>(axis)];
         EXPECT_FALSE(ax.pass) << r.verdict;
@@ -214,7 +214,7 @@ TEST(CalCheck, CommandLineGivesAVerdictAndAnExitCodeAScriptCanUse) {
     int code;
     std::string word;
   };
-  const Case cases[] = {{{}, 0, "PASS"}, {{1, 0.01, {}}, 4, "FAIL: Fy"}};
+  const Case cases[] = {{{}, 0, "PASS"}, {{1, 0.01, Eigen::Vector3d::Zero()}, 4, "FAIL: Fy"}};
   for (const Case& c : cases) {
     const std::string in = (dir / "poses.csv").string();
     ftstack::WriteRecording(in, Generate(cal, Tool(2.5), c.fault, 11));

@@ -23,7 +23,7 @@ sys.path.insert(0, os.path.join(ROOT, "tests", "support"))
 from ftdiag_runs import diagnose, generate  # noqa: E402
 
 FIELDS = ("key", "unit", "value", "sigma", "range", "spread", "status")
-STATUSES = {"resolved", "at_bound", "pieces_disagree", "not_identified"}
+STATUSES = {"resolved", "at_bound", "pieces_disagree", "not_identified", "chosen"}
 
 
 def vocabulary_units():
