@@ -71,6 +71,8 @@ struct Report {
 
 /// Runs the whole diagnosis on aligned data. `data` must outlive the report.
 [[nodiscard]] Report Diagnose(const DiagData& data, const DiagnoseOptions& options = {});
+/// A temporary would die before the report that refers to it.
+Report Diagnose(DiagData&& data, const DiagnoseOptions& options = {}) = delete;
 /// The same, taking the memory of data->sim_mvv and data->real_mvv (left empty) for the context's
 /// load and residual: two n × N matrices fewer (MakeContext(DiagData*)). The result is the same.
 [[nodiscard]] Report Diagnose(DiagData* data, const DiagnoseOptions& options = {});
@@ -78,5 +80,7 @@ struct Report {
 /// once more with the refined noise when the claimed model shows the first estimate too high.
 [[nodiscard]] Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
                                   const Eigen::VectorXd* sigma);
+Report DiagnoseOnce(DiagData&& data, const DiagnoseOptions& options,
+                    const Eigen::VectorXd* sigma) = delete;
 
 }  // namespace ftstack::diag

@@ -118,7 +118,8 @@ TEST(DiagIdentify, AGenuineDriftOnRevisitedLoadsIsStillNamed) {
   o.segment_offsets = false;
   o.segment_column = false;
   o.drift = true;
-  const Report r = Diagnose(Make(o, 3));
+  const DiagData data = Make(o, 3);
+  const Report r = Diagnose(data);
   EXPECT_EQ(r.verdict, "zero_drift") << ToJson(r)["effects"].dump(1);
   ASSERT_FALSE(r.effects.empty());
   EXPECT_TRUE(r.effects.front().confounded_with.empty()) << r.effects.front().confounding;

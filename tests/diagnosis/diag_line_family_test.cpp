@@ -86,7 +86,8 @@ const LineCase kLone{"a lone line", 1000.0, 20.0, 37.3, {{1, 3e-3}}};
 /// typed parameter resolved, the energy split; returns the fit for the class's own checks.
 EffectFit ExpectSupply(const LineCase& lc, unsigned seed) {
   double f0 = 0.0;
-  const Report r = Diagnose(Lines(lc, seed, &f0));
+  const DiagData data = Lines(lc, seed, &f0);
+  const Report r = Diagnose(data);
   const nlohmann::json j = ToJson(r);
   EXPECT_EQ(r.verdict, "mains_interference") << lc.what << " seed " << seed << j["candidates"];
   if (r.effects.empty() || r.verdict != "mains_interference") return {};
@@ -138,7 +139,8 @@ TEST_P(LineFamily, MainsAboveNyquistIsNamedAtItsTrueFrequency) {
 
 TEST_P(LineFamily, ALoneLineOfNoSupplyIsNotNamedMains) {
   double f0 = 0.0;
-  const Report r = Diagnose(Lines(kLone, GetParam(), &f0));
+  const DiagData data = Lines(kLone, GetParam(), &f0);
+  const Report r = Diagnose(data);
   for (const auto& e : r.effects) {
     EXPECT_NE(e.fit.name, "mains_interference") << e.fit.evidence;
   }

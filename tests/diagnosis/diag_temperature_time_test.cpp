@@ -95,7 +95,8 @@ bool CheckNoTimeStory(const Report& r, const char* what, unsigned seed) {
 class TemperatureTime : public ::testing::TestWithParam<unsigned> {};
 
 TEST_P(TemperatureTime, MonotoneTemperatureIsNotClaimedAsADriftInTime) {
-  const Report r = Diagnose(SpanOverTemperature({20.0, 21.0, 22.0, 23.0, 24.0}, GetParam()));
+  const DiagData data = SpanOverTemperature({20.0, 21.0, 22.0, 23.0, 24.0}, GetParam());
+  const Report r = Diagnose(data);
   ASSERT_FALSE(r.effects.empty());
   CheckNoTimeStory(r, "monotone", GetParam());
   EXPECT_NE(r.verdict, "excitation_drift");
@@ -103,7 +104,8 @@ TEST_P(TemperatureTime, MonotoneTemperatureIsNotClaimedAsADriftInTime) {
 }
 
 TEST_P(TemperatureTime, TemperatureNotMonotoneInTimeIsNamedWithItsCoefficient) {
-  const Report r = Diagnose(SpanOverTemperature({21.0, 24.0, 20.0, 23.0, 22.0}, GetParam()));
+  const DiagData data = SpanOverTemperature({21.0, 24.0, 20.0, 23.0, 22.0}, GetParam());
+  const Report r = Diagnose(data);
   ASSERT_FALSE(r.effects.empty());
   EXPECT_TRUE(CheckNoTimeStory(r, "not monotone", GetParam()));
   EXPECT_EQ(r.verdict, "thermal_span_drift");
