@@ -12,6 +12,7 @@
 #include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/plausibility.hpp"
 #include "diagnosis/engine/signal.hpp"
+#include "diagnosis/engine/training_rows.hpp"
 
 namespace ftstack::diag::fx {
 
@@ -116,12 +117,11 @@ double PickOneTau(const Context& cx, const Series& target, double lt,
                   EffectFit* best, ChannelFit* best_f, bool* best_gamma) {
   const double tau = std::exp(lt);
   ChannelSums sums[2] = {ChannelSums(cx, 1), ChannelSums(cx, 2)};
-  ForLaggedLoad(cx, &tau, 1, [&](int i, int c, const double* lag) {
-    if (!cx.train[static_cast<std::size_t>(i)]) return;
-    const double x[2] = {lag[0], cx.load(i, c)};
-    sums[0].Add(c, x, target(i, c));
-    sums[1].Add(c, x, target(i, c));
-  });
+  ForLaggedLoad(cx, &tau, 1, OnTrainingRows(cx, [&](int i, int c, const double* lag) {
+                  const double x[2] = {lag[0], cx.load(i, c)};
+                  sums[0].Add(c, x, target(i, c));
+                  sums[1].Add(c, x, target(i, c));
+                }));
   double best_bic = std::numeric_limits<double>::infinity();
   for (bool gamma : {false, true}) {
     const int p = cx.nc * (gamma ? 2 : 1) + 1;
@@ -301,10 +301,7 @@ void CoarsePair(const Context& cx, const Series& target, double lo, double hi, d
   const int row_step = std::max(cx.search_stride, static_cast<int>(cx.n_train / 20000));
   std::vector<double> grid;
   for (int j = 0; j <= 12; ++j) grid.push_back(lo + (hi - lo) * j / 12.0);
-  std::vector<int> rows;
-  for (int i = 0; i < cx.n; i += row_step) {
-    if (cx.train[static_cast<std::size_t>(i)]) rows.push_back(i);
-  }
+  const std::vector<int> rows = TrainingRowList(cx, row_step);
   const auto m = static_cast<Eigen::Index>(rows.size());
   std::vector<Mat> g(grid.size());
   for (std::size_t j = 0; j < grid.size(); ++j) LowPassLoadRows(cx, std::exp(grid[j]), rows, &g[j]);
@@ -486,12 +483,11 @@ bool FitCreepTwo(const Context& cx, const Series& target, double log_tau1, doubl
   // Both variants' fits over every row in one streamed pass of the two lags.
   const double t12[2] = {std::exp(l1), std::exp(l2)};
   ChannelSums sums[2] = {ChannelSums(cx, 2), ChannelSums(cx, 3)};
-  ForLaggedLoad(cx, t12, 2, [&](int i, int c, const double* lag) {
-    if (!cx.train[static_cast<std::size_t>(i)]) return;
-    const double x[3] = {lag[0], lag[1], cx.load(i, c)};
-    sums[0].Add(c, x, target(i, c));
-    sums[1].Add(c, x, target(i, c));
-  });
+  ForLaggedLoad(cx, t12, 2, OnTrainingRows(cx, [&](int i, int c, const double* lag) {
+                  const double x[3] = {lag[0], lag[1], cx.load(i, c)};
+                  sums[0].Add(c, x, target(i, c));
+                  sums[1].Add(c, x, target(i, c));
+                }));
   bool won = false;
   for (bool gamma : {false, true}) {
     const int p = cx.nc * (gamma ? 3 : 2) + 2;

@@ -11,6 +11,7 @@
 #include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/effect.hpp"
 #include "diagnosis/engine/signal.hpp"
+#include "diagnosis/engine/training_rows.hpp"
 
 namespace ftstack::diag {
 
@@ -195,15 +196,18 @@ std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Series& 
     NormalEq ne(p);
     double x[p];
     RelayGrid g = start;
-    for (std::size_t i = 0; i < n; ++i) {  // streamed: no n × relays matrix is held
+    // Streamed: no n × relays matrix is held. Weights from every k-th training row on long
+    // records (k = the search stride, ~12 000 rows): the relay states change only at threshold
+    // crossings, so little is lost.
+    const auto stride = static_cast<std::size_t>(cx.search_stride);
+    ForRowsWithTraining(cx, 0, static_cast<int>(n), [&](int row, bool train) {
+      const auto i = static_cast<std::size_t>(row);
       if (!cx.restart.empty() && cx.restart[i] != 0) g.Reset();
       g.StepBand(load[i]);
-      // Weights from every k-th training row on long records (k = the search stride, ~12 000
-      // rows): the relay states change only at threshold crossings, so little is lost.
-      if (cx.train[i] == 0 || i % static_cast<std::size_t>(cx.search_stride) != 0) continue;
+      if (!train || i % stride != 0) return;
       for (int j = 0; j < kRelays; ++j) x[j] = g.state[static_cast<std::size_t>(j)];
-      ne.Add(x, target(static_cast<Eigen::Index>(i), c));
-    }
+      ne.Add(x, target(row, c));
+    });
     const NormalEq::Result r = ne.Solve();
     const double var = r.rows > p ? r.sse / (r.rows - p) : 0.0;
     nlohmann::json w = nlohmann::json::array();

@@ -10,6 +10,7 @@
 #include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/effect.hpp"
 #include "diagnosis/engine/signal.hpp"
+#include "diagnosis/engine/training_rows.hpp"
 #include "measurement/wrench.hpp"
 
 namespace ftstack::diag {
@@ -79,14 +80,14 @@ Runs MakeRuns(const Context& cx, const Series& target, int stride) {
   Runs r;
   r.stride = stride;
   std::vector<double> acc;
-  for (int i = 0; i < cx.n; ++i) {
+  ForRowsWithTraining(cx, 0, cx.n, [&](int i, bool train) {
     const bool restart = !cx.restart.empty() && cx.restart[static_cast<std::size_t>(i)] != 0;
     if (i == 0 || restart || w.row(i) != w.row(i - 1)) {
       r.first.push_back(i);
       r.count.push_back(0.0);
       acc.resize(acc.size() + 6, 0.0);
     }
-    if (!cx.train[static_cast<std::size_t>(i)] || i % stride != 0) continue;
+    if (!train || i % stride != 0) return;
     double* sw = acc.data() + acc.size() - 6;
     for (int c = 0; c < cx.nc; ++c) {
       const double wy = cx.weight(c) * target(i, c);
@@ -95,7 +96,7 @@ Runs MakeRuns(const Context& cx, const Series& target, int stride) {
     }
     r.count.back() += 1.0;
     r.rows += 1.0;
-  }
+  });
   r.swy = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>>(
       acc.data(), static_cast<Eigen::Index>(r.first.size()), 6);
   return r;

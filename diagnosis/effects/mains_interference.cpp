@@ -13,6 +13,7 @@
 
 #include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/signal.hpp"
+#include "diagnosis/engine/training_rows.hpp"
 
 namespace ftstack::diag::fx {
 
@@ -132,10 +133,9 @@ class LineGains {
     double before = 0.0;
     for (int c = 0; c < cx_.nc; ++c) {
       double sum = 0.0;
-      for (int i = 0; i < cx_.n; i += step) {
-        if (cx_.train[static_cast<std::size_t>(i)])
-          sum += static_cast<double>(target_(i, c)) * target_(i, c);
-      }
+      ForTrainingRows(
+          cx_, 0, cx_.n, [&](int i) { sum += static_cast<double>(target_(i, c)) * target_(i, c); },
+          step);
       before += sum * cx_.weight(c);
     }
     const double gain = (before - FitLines(cx_, target_, {f}, nullptr, step).sse_w) * step;
@@ -217,17 +217,19 @@ std::vector<double> LinePower(const Context& cx, const Series& target, double f_
   const auto nc = static_cast<std::size_t>(cx.nc);
   std::vector<std::complex<double>> acc(static_cast<std::size_t>(count) * nc);
   const auto& t = cx.data->t_s;
-  for (int i = 0; i < cx.n; i += stride) {
-    const auto k = static_cast<std::size_t>(i);
-    if (!cx.train[k]) continue;
-    std::complex<double> ph = std::polar(1.0, -2.0 * M_PI * f_lo * t[k]);
-    const std::complex<double> rot = std::polar(1.0, -2.0 * M_PI * step * t[k]);
-    for (std::size_t j = 0; j < static_cast<std::size_t>(count); ++j, ph *= rot) {
-      for (std::size_t c = 0; c < nc; ++c) {
-        acc[j * nc + c] += static_cast<double>(target(i, static_cast<int>(c))) * ph;
-      }
-    }
-  }
+  ForTrainingRows(
+      cx, 0, cx.n,
+      [&](int i) {
+        const auto k = static_cast<std::size_t>(i);
+        std::complex<double> ph = std::polar(1.0, -2.0 * M_PI * f_lo * t[k]);
+        const std::complex<double> rot = std::polar(1.0, -2.0 * M_PI * step * t[k]);
+        for (std::size_t j = 0; j < static_cast<std::size_t>(count); ++j, ph *= rot) {
+          for (std::size_t c = 0; c < nc; ++c) {
+            acc[j * nc + c] += static_cast<double>(target(i, static_cast<int>(c))) * ph;
+          }
+        }
+      },
+      stride);
   std::vector<double> power(static_cast<std::size_t>(count), 0.0);
   for (std::size_t j = 0; j < power.size(); ++j) {
     for (std::size_t c = 0; c < nc; ++c) {

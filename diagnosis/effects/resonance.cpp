@@ -13,6 +13,7 @@
 #include "diagnosis/engine/nonlinear_search.hpp"
 #include "diagnosis/engine/plausibility.hpp"
 #include "diagnosis/engine/signal.hpp"
+#include "diagnosis/engine/training_rows.hpp"
 
 namespace ftstack::diag::fx {
 
@@ -117,14 +118,13 @@ double WindowSse(const Context& cx, const Series& target, const Mat& h,
     double hh = 0.0;
     double hy = 0.0;
     double yy = 0.0;
-    for (int i = w0; i < w1; ++i) {
-      if (!cx.train[static_cast<std::size_t>(i)]) continue;
+    ForTrainingRows(cx, w0, w1, [&](int i) {
       const double y = target(i, c);
       const double hv = hk[i - w0];
       hh += hv * hv;
       hy += hv * y;
       yy += y * y;
-    }
+    });
     s += std::max(0.0, yy - (hh > 0 ? hy * hy / hh : 0.0)) * cx.weight(c);
   }
   return s;
@@ -135,9 +135,9 @@ double WindowSse(const Context& cx, const Series& target, const Mat& h,
 double FitRingingAll(const Context& cx, const Series& target, double f, double z, ChannelFit* cf,
                      Series* pred) {
   ChannelSums sums(cx, 1);
-  ForRinging(cx, &f, &z, 1, [&](int i, int c, const double* hv) {
-    if (cx.train[static_cast<std::size_t>(i)]) sums.Add(c, hv, target(i, c));
-  });
+  ForRinging(cx, &f, &z, 1, OnTrainingRows(cx, [&](int i, int c, const double* hv) {
+               sums.Add(c, hv, target(i, c));
+             }));
   *cf = sums.Solve(cx);
   PredictStreamed(
       cx, *cf, 1, [&](auto visit) { ForRinging(cx, &f, &z, 1, visit); },
@@ -466,12 +466,11 @@ void ModeCurvatures(const Context& cx, const Series& target, const double* log_f
     auto sse_all = [&](double f_hz, double zeta) {
       if (!ModeInRange(cx, f_hz, zeta, f_held)) return std::numeric_limits<double>::infinity();
       ChannelSums sums(cx, 2);
-      ForRinging(cx, &f_hz, &zeta, 1, [&](int i, int c, const double* hv) {
-        if (!cx.train[static_cast<std::size_t>(i)]) return;
-        const double other = held(i, c);
-        const double x[2] = {m == 0 ? hv[0] : other, m == 0 ? other : hv[0]};
-        sums.Add(c, x, target(i, c));
-      });
+      ForRinging(cx, &f_hz, &zeta, 1, OnTrainingRows(cx, [&](int i, int c, const double* hv) {
+                   const double other = held(i, c);
+                   const double x[2] = {m == 0 ? hv[0] : other, m == 0 ? other : hv[0]};
+                   sums.Add(c, x, target(i, c));
+                 }));
       return sums.Solve(cx).sse_w;
     };
     slf[m] = ProfileSigma([&](double v) { return sse_all(std::exp(v), std::exp(log_zeta[m])); },
@@ -504,12 +503,11 @@ std::string AddResonanceMode(const Context& cx, const Series& target, double f1_
   const double z12[2] = {std::exp(log_zeta[0]), std::exp(log_zeta[1])};
   ChannelSums sums(cx, 2);
   Mat hh = Mat::Zero(2, cx.nc);  // Σ h_j² over the training rows per channel
-  ForRinging(cx, f12, z12, 2, [&](int i, int c, const double* hv) {
-    if (!cx.train[static_cast<std::size_t>(i)]) return;
-    sums.Add(c, hv, target(i, c));
-    hh(0, c) += hv[0] * hv[0];
-    hh(1, c) += hv[1] * hv[1];
-  });
+  ForRinging(cx, f12, z12, 2, OnTrainingRows(cx, [&](int i, int c, const double* hv) {
+               sums.Add(c, hv, target(i, c));
+               hh(0, c) += hv[0] * hv[0];
+               hh(1, c) += hv[1] * hv[1];
+             }));
   const ChannelFit cf = sums.Solve(cx);
   const auto mode_energy = [&](int j) {  // whitened energy of β_j·h_j, summed over channels
     double energy = 0.0;

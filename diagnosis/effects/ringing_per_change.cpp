@@ -12,6 +12,7 @@
 
 #include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/nonlinear_search.hpp"
+#include "diagnosis/engine/training_rows.hpp"
 
 namespace ftstack::diag::fx {
 
@@ -71,10 +72,12 @@ RingFit FitRing(const Context& cx, const Series& target, const std::vector<int>&
   RingFit out;
   out.beta.assign(starts.size() * static_cast<std::size_t>(cx.nc), Eigen::Vector2d::Zero());
   const auto& t = cx.data->t_s;
-  for (int i = 0; i < (starts.empty() ? cx.n : starts[0]); i += row_step) {
-    if (!cx.train[static_cast<std::size_t>(i)]) continue;
-    for (int c : chans) out.sse_w += double(target(i, c)) * target(i, c) * cx.weight(c);
-  }
+  ForTrainingRows(
+      cx, 0, starts.empty() ? cx.n : starts[0],
+      [&](int i) {
+        for (int c : chans) out.sse_w += double(target(i, c)) * target(i, c) * cx.weight(c);
+      },
+      row_step);
   for (std::size_t k = 0; k < starts.size(); ++k) {
     const int a = starts[k];
     const int b = k + 1 < starts.size() ? starts[k + 1] : cx.n;
@@ -84,18 +87,20 @@ RingFit FitRing(const Context& cx, const Series& target, const std::vector<int>&
       Eigen::Vector2d ay = Eigen::Vector2d::Zero();
       double yy = 0.0;
       double x[2];
-      for (int i = a; i < b; i += row_step) {
-        if (!cx.train[static_cast<std::size_t>(i)] || t[static_cast<std::size_t>(i)] < settled)
-          continue;
-        q.At(t[static_cast<std::size_t>(i)] - t[static_cast<std::size_t>(a)], x);
-        const double y = target(i, c);
-        aa(0, 0) += x[0] * x[0];
-        aa(0, 1) += x[0] * x[1];
-        aa(1, 1) += x[1] * x[1];
-        ay(0) += x[0] * y;
-        ay(1) += x[1] * y;
-        yy += y * y;
-      }
+      ForTrainingRows(
+          cx, a, b,
+          [&](int i) {
+            if (t[static_cast<std::size_t>(i)] < settled) return;
+            q.At(t[static_cast<std::size_t>(i)] - t[static_cast<std::size_t>(a)], x);
+            const double y = target(i, c);
+            aa(0, 0) += x[0] * x[0];
+            aa(0, 1) += x[0] * x[1];
+            aa(1, 1) += x[1] * x[1];
+            ay(0) += x[0] * y;
+            ay(1) += x[1] * y;
+            yy += y * y;
+          },
+          row_step);
       aa(1, 0) = aa(0, 1);
       Eigen::Vector2d beta = Eigen::Vector2d::Zero();
       if (aa.determinant() > 1e-12 * std::max(1.0, aa.trace() * aa.trace()))
@@ -157,12 +162,11 @@ Series Detrended(const Context& cx, const Series& target, const std::vector<int>
   std::vector<double> sum(static_cast<std::size_t>(cx.n) + 1);
   std::vector<int> cnt(static_cast<std::size_t>(cx.n) + 1);
   for (int c = 0; c < cx.nc; ++c) {
-    for (int i = 0; i < cx.n; ++i) {
-      const bool tr = cx.train[static_cast<std::size_t>(i)] != 0;
+    ForRowsWithTraining(cx, 0, cx.n, [&](int i, bool tr) {
       sum[static_cast<std::size_t>(i) + 1] =
           sum[static_cast<std::size_t>(i)] + (tr ? target(i, c) : 0.0);
       cnt[static_cast<std::size_t>(i) + 1] = cnt[static_cast<std::size_t>(i)] + (tr ? 1 : 0);
-    }
+    });
     for (std::size_t k = 0; k <= starts.size(); ++k) {
       const int a = k == 0 ? 0 : starts[k - 1];
       const int b = k < starts.size() ? starts[k] : cx.n;
@@ -175,21 +179,6 @@ Series Detrended(const Context& cx, const Series& target, const std::vector<int>
     }
   }
   return out;
-}
-
-/// Whitened training SSE of target − pred on every row.
-double TrainSse(const Context& cx, const Series& target, const Series& pred) {
-  double s = 0.0;
-  for (int c = 0; c < cx.nc; ++c) {
-    double sc = 0.0;
-    for (int i = 0; i < cx.n; ++i) {
-      if (!cx.train[static_cast<std::size_t>(i)]) continue;
-      const double r = double(target(i, c)) - pred(i, c);
-      sc += r * r;
-    }
-    s += sc * cx.weight(c);
-  }
-  return s;
 }
 
 /// Participation per channel: Σ onset amplitude / Σ |load change| over the changes (a share of the
@@ -311,8 +300,8 @@ std::optional<EffectFit> RingingPerChange(const Context& cx, const Series& targe
     if (best_resolved && !resolved) continue;
     const RingFit r =
         FitRing(cx, d, starts, std::exp(x[0]), std::exp(x[1]), settle_s, AllChannels(cx), 1);
-    const double s =
-        TrainSse(cx, target, PredictRing(cx, starts, std::exp(x[0]), std::exp(x[1]), r));
+    const Series pred = PredictRing(cx, starts, std::exp(x[0]), std::exp(x[1]), r);
+    const double s = Score(cx, target, &pred).train_sse;
     if (s < best_sse || (resolved && !best_resolved)) {
       best_sse = s;
       best_resolved = resolved;

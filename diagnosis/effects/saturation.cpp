@@ -8,6 +8,7 @@
 
 #include "diagnosis/effects/families.hpp"
 #include "diagnosis/engine/signal.hpp"
+#include "diagnosis/engine/training_rows.hpp"
 
 namespace ftstack::diag::fx {
 
@@ -64,12 +65,12 @@ std::optional<EffectFit> FitSaturation(const Context& cx, const Series& target) 
     double sse = 0.0;
     for (int c = 0; c < cx.nc; ++c) {
       double acc = 0.0;
-      for (int i = 0; i < cx.n; ++i) {
+      ForRowsWithTraining(cx, 0, cx.n, [&](int i, bool train) {
         const double s = cx.sim_mvv(i, c);
         const double v = std::clamp(s, l, h) - s;
         if (out != nullptr) (*out)(i, c) = v;
-        if (cx.train[static_cast<std::size_t>(i)]) acc += (target(i, c) - v) * (target(i, c) - v);
-      }
+        if (train) acc += (target(i, c) - v) * (target(i, c) - v);
+      });
       sse += acc * cx.weight(c);
     }
     return sse;

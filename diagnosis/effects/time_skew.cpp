@@ -37,16 +37,18 @@ std::optional<EffectFit> FitTimeSkew(const Context& cx, const Series& target) {
     for (int c = 0; c < cx.nc; ++c) {
       const double* s = cx.load.col(c).data();  // load = sim − zero: the same differences
       double acc = 0.0;
-      for (int i = 0; i < cx.n; i += row_step) {
-        const bool tr = cx.train[static_cast<std::size_t>(i)] != 0;
-        if (!tr && out == nullptr) continue;
-        const double v = InterpolateNear(d.t_s.data(), s, static_cast<std::size_t>(cx.n),
-                                         d.t_s[static_cast<std::size_t>(i)] - delay, cx.uniform,
-                                         static_cast<std::size_t>(i)) -
-                         s[i];
-        if (out != nullptr) (*out)(i, c) = static_cast<float>(v);
-        if (tr) acc += (target(i, c) - v) * (target(i, c) - v);
-      }
+      ForRowsWithTraining(
+          cx, 0, cx.n,
+          [&](int i, bool tr) {
+            if (!tr && out == nullptr) return;
+            const double v = InterpolateNear(d.t_s.data(), s, static_cast<std::size_t>(cx.n),
+                                             d.t_s[static_cast<std::size_t>(i)] - delay, cx.uniform,
+                                             static_cast<std::size_t>(i)) -
+                             s[i];
+            if (out != nullptr) (*out)(i, c) = static_cast<float>(v);
+            if (tr) acc += (target(i, c) - v) * (target(i, c) - v);
+          },
+          row_step);
       sse += acc * cx.weight(c) * row_step;
     }
     return sse;
