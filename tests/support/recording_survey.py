@@ -110,8 +110,7 @@ def supply_match(f_hz, rate_hz, resolution_hz):
             seen = folded(true_f, rate_hz)
             if abs(seen - f_hz) <= resolution_hz:
                 where = "" if true_f < rate_hz / 2 else f" (folded from {true_f:g} Hz)"
-                names.append(f"{k}x{base:g} Hz{where}")
-                break
+                names.append(f"{k}x{base:g} Hz{where}")  # every alias: the rate may not decide
     return names
 
 

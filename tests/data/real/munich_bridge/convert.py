@@ -20,12 +20,16 @@ The time stamps say 2022-11-04, the file names and the temperature log 11.04.202
 month were swapped by the authors' export; only the time of day is used.
 
 Usage: convert.py OUTDIR [--test load_01|load_02]   (default: both)
+       convert.py --check   (convert into a temporary folder and compare every written row with
+                             the archives read again by the csv module, row by row)
 """
 
 import argparse
+import csv
 import io
 import os
 import sys
+import tempfile
 import zipfile
 
 import numpy as np
@@ -109,7 +113,39 @@ def write(path, key, rec):
                       f"{rec['frc01_kn'][i]:.9g},{rec['frc02_kn'][i]:.9g}\n")
 
 
+def check():
+    """Every converted row against the original rows, read here by another parser."""
+    bad = 0
+    with tempfile.TemporaryDirectory() as tmp:
+        for key, (stem, _) in sorted(TESTS.items()):
+            path = os.path.join(tmp, key + ".csv")
+            write(path, key, load_test(key))
+            with open(path, encoding="utf-8") as f:
+                rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]
+            names, rows = rows[0], rows[1:]
+            strain = list(csv.reader(io.StringIO(read_zipped_text(stem + "DMS_CNAt100Hz.csv.zip"))))[1:]
+            force = list(csv.reader(io.StringIO(read_zipped_text(stem + "ForceAt100Hz.csv.zip"))))[1:]
+            if not len(rows) == len(strain) == len(force) == 72000:
+                print(f"{key}: {len(rows)} rows written, {len(strain)} / {len(force)} in the archives")
+                bad += 1
+                continue
+            col = {n: i for i, n in enumerate(names)}
+            for i, (row, s_row, f_row) in enumerate(zip(rows, strain, force)):
+                fz = (float(f_row[1]) + float(f_row[2])) * 1000.0
+                b0 = float(s_row[1]) * 0.5e-3
+                if (abs(float(row[col["Fz"]]) - fz) > 1e-3 or abs(float(row[col["b0"]]) - b0) > 1e-10
+                        or abs(float(row[col["t"]]) - 0.01 * i) > 0.002):
+                    print(f"{key}: row {i + 2} differs: {row[:8]} vs {s_row} {f_row}")
+                    bad += 1
+                    break
+            else:
+                print(f"{key}: {len(rows)} rows checked against the archives")
+    return 1 if bad else 0
+
+
 def main():
+    if sys.argv[1:] == ["--check"]:
+        return check()
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("outdir")
     parser.add_argument("--test", choices=sorted(TESTS), action="append")
