@@ -56,6 +56,12 @@ def running_median(x, width):
     return np.median(windows[:: max(1, width // 8)], axis=1), max(1, width // 8)
 
 
+def runs(mask):
+    """(first, last) index of every run of consecutive True values."""
+    edges = np.diff(np.concatenate(([0], np.asarray(mask, dtype=np.int8), [0])))
+    return list(zip(np.nonzero(edges == 1)[0].tolist(), (np.nonzero(edges == -1)[0] - 1).tolist()))
+
+
 def load_changes(t, f, rate_hz):
     span = float(np.ptp(f))
     if span <= 0:
@@ -64,18 +70,8 @@ def load_changes(t, f, rate_hz):
     tm = t[::stride][: len(med)]
     lag = max(1, int(round(2.0 * rate_hz / stride)))
     moved = np.abs(med[lag:] - med[:-lag]) > 0.05 * span
-    changes = []
-    i = 0
-    while i < len(moved):
-        if moved[i]:
-            j = i
-            while j + 1 < len(moved) and moved[j + 1]:
-                j += 1
-            changes.append((float(tm[i]), float(tm[j + lag]), float(med[i]), float(med[j + lag])))
-            i = j + 1
-        else:
-            i += 1
-    return changes
+    return [(float(tm[i]), float(tm[j + lag]), float(med[i]), float(med[j + lag]))
+            for i, j in runs(moved)]
 
 
 def welch(x, rate_hz):

@@ -22,7 +22,7 @@ sys.dont_write_bytecode = True  # keep the source tree clean
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "..", "support"))
 from recording_io import read_recording  # noqa: E402
-from recording_survey import print_report, survey  # noqa: E402
+from recording_survey import print_report, runs, survey  # noqa: E402
 
 UM_M_PER_MVV = 1.0 / 0.5e-3  # the converter's nominal quarter-bridge scale, inverted
 BLOCK_S = 2.0
@@ -35,14 +35,7 @@ def holds(t, force_n, strain_um_m):
     fm = force_n[: n * per].reshape(n, per).mean(axis=1)
     steady = np.abs(np.diff(fm)) < 500.0
     out = []
-    i = 0
-    while i < len(steady):
-        if not steady[i]:
-            i += 1
-            continue
-        j = i
-        while j + 1 < len(steady) and steady[j + 1]:
-            j += 1
+    for i, j in runs(steady):
         if (j - i + 2) * BLOCK_S >= 20.0:
             rows = slice(i * per, (j + 2) * per)
             tt = t[rows]
@@ -56,7 +49,6 @@ def holds(t, force_n, strain_um_m):
                         "strain_slope_um_m_per_min": float(np.polyfit(tt / 60.0, eps, 1)[0]),
                         "strain_2s_spread_um_m": float(np.ptp(block_means)),
                         "load_slope_kn_per_min": float(np.polyfit(tt / 60.0, f, 1)[0]) / 1e3})
-        i = j + 1
     return out
 
 
