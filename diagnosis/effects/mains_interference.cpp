@@ -190,19 +190,35 @@ LineSeries ChooseSeries(const Context& cx, LineGains* gains, double f0) {
   return s;
 }
 
+/// Whether a line seen at `rate` can tell the h-th harmonic of supply s from other lines: not when
+/// that harmonic's span is a whole sampling rate wide or wider, for then it folds onto every
+/// frequency of the band (a slow logger: every line is an alias of some mains frequency, with a
+/// new candidate every rate/h).
+bool Distinguishable(const Supply& s, int h, double rate) {
+  return h * (s.hi_hz - s.lo_hz) < rate;
+}
+
 /// Supply fundamentals one of whose harmonics 1..5 is seen at `seen` (directly or folded from
-/// above Nyquist), each once.
+/// above Nyquist), each once; harmonics that are not Distinguishable at this rate are not
+/// candidates (none at all on a logger slower than every span).
 std::vector<double> Fundamentals(double seen, double rate) {
+  double top = 0.0;
+  for (const Supply& s : kSupplies) {
+    for (int h = 1; h <= kMaxOrder; ++h) {
+      if (Distinguishable(s, h, rate)) top = std::max(top, h * s.hi_hz);
+    }
+  }
   std::vector<double> out;
-  const double top = kMaxOrder * kSupplies.back().hi_hz;
   for (int m = 0; m * rate - seen <= top; ++m) {
     for (double f : {m * rate + seen, m * rate - seen}) {
       if (f <= 0.0) continue;
       for (int h = 1; h <= kMaxOrder; ++h) {
         const double f0 = f / h;
+        const Supply* s = SupplyOf(f0);
+        if (s == nullptr || !Distinguishable(*s, h, rate)) continue;
         const bool known = std::any_of(out.begin(), out.end(),
                                        [&](double g) { return std::fabs(g - f0) < 1e-9 * f0; });
-        if (SupplyOf(f0) != nullptr && !known) out.push_back(f0);
+        if (!known) out.push_back(f0);
       }
     }
   }

@@ -1,7 +1,8 @@
 // Lines of electrical supplies from a generator written for this test only (not sim/, not the
 // diagnosis's models): rectifier ripple whose energy sits in the even harmonics of a generator's
 // fundamental just below 50 Hz, magnetic pick-up in the odd harmonics, 16.7 Hz and 400 Hz
-// supplies, mains folded from above Nyquist, and a lone line that belongs to no supply.
+// supplies, mains folded from above Nyquist, a lone line that belongs to no supply, and a line
+// on a logger too slow to tell mains from any other line.
 // Development seeds (1, 2) and validation seeds (11, 12) were fixed before the method changed.
 #include <gtest/gtest.h>
 
@@ -81,6 +82,10 @@ const LineCase kRailway{"16.7 Hz railway", 500.0, 30.0, 16.7, {{1, 4e-3}, {3, 1e
 const LineCase k400{"400 Hz supply", 1000.0, 20.0, 400.0, {{1, 3e-3}, {2, 6e-4}}};
 const LineCase kFolded{"mains above Nyquist", 80.0, 120.0, 50.0, {{1, 4e-3}, {3, 1.5e-3}}};
 const LineCase kLone{"a lone line", 1000.0, 20.0, 37.3, {{1, 3e-3}}};
+// A logger at 2 Hz: every frequency of the 45-65 Hz span (and of 16.2-17.2 Hz: 1 Hz wide, below
+// 2 Hz but 5 Hz wide at its 5th harmonic) folds onto the band, so a 0.3 Hz line is an alias of
+// some mains frequency whatever it is.
+const LineCase kSlowLogger{"a line on a slow logger", 2.0, 900.0, 0.3, {{1, 3e-3}}};
 
 /// Diagnoses the class at one seed; the claimed mains effect named at f0 (within 0.1 %), every
 /// typed parameter resolved, the energy split; returns the fit for the class's own checks.
@@ -145,6 +150,19 @@ TEST_P(LineFamily, ALoneLineOfNoSupplyIsNotNamedMains) {
     EXPECT_NE(e.fit.name, "mains_interference") << e.fit.evidence;
   }
   std::printf("lone line %.2f Hz seed %u: verdict %s\n", f0, GetParam(), r.verdict.c_str());
+}
+
+// A line on a logger so slow that the supplies' spans fold onto its whole band: its frequency
+// cannot tell mains from anything else, so mains is not named.
+TEST_P(LineFamily, ALineOnASlowLoggerIsNotNamedMains) {
+  double f0 = 0.0;
+  const DiagData data = Lines(kSlowLogger, GetParam(), &f0);
+  const Report r = Diagnose(data);
+  for (const auto& e : r.effects) {
+    EXPECT_NE(e.fit.name, "mains_interference") << e.fit.evidence;
+  }
+  std::printf("slow logger, line %.3f Hz seed %u: verdict %s\n", f0, GetParam(),
+              r.verdict.c_str());
 }
 
 INSTANTIATE_TEST_SUITE_P(Development, LineFamily, ::testing::Values(1u, 2u));
