@@ -16,6 +16,7 @@
 
 #include "diagnosis/engine/diagnose.hpp"
 #include "diagnosis/engine/quantisation.hpp"
+#include "diagnosis/report/html_report.hpp"
 #include "diagnosis/report/json_report.hpp"
 #include "tests/diagnosis/random_sensor.hpp"
 
@@ -127,9 +128,9 @@ struct QuantCase {
   double step_frac;
 };
 
-class QuantisedConverter : public ::testing::TestWithParam<QuantCase> {};
+class DiagQuantisedConverter : public ::testing::TestWithParam<QuantCase> {};
 
-TEST_P(QuantisedConverter, CalibrationOnlyClaimsNothing) {
+TEST_P(DiagQuantisedConverter, CalibrationOnlyClaimsNothing) {
   const QuantCase qc = GetParam();
   const QuantisedRecord rec = Quantised(qc.seed, qc.bridges, qc.step_frac, 0.0);
   const Report r = Diagnose(rec.data);
@@ -154,9 +155,10 @@ TEST_P(QuantisedConverter, CalibrationOnlyClaimsNothing) {
     EXPECT_NEAR(j["smallest_claimable_rms_mvv"][c].get<double>(), 3.0 * rec.step_mvv,
                 1e-6 * rec.step_mvv);
   }
+  EXPECT_NE(HtmlReport(rec.data, r).find("Quantised record"), std::string::npos);
 }
 
-TEST_P(QuantisedConverter, CubicWellAboveTheGridIsStillNamed) {
+TEST_P(DiagQuantisedConverter, CubicWellAboveTheGridIsStillNamed) {
   const QuantCase qc = GetParam();
   const QuantisedRecord rec = Quantised(qc.seed, qc.bridges, qc.step_frac, 12.0);
   const Report r = Diagnose(rec.data);
@@ -169,7 +171,7 @@ TEST_P(QuantisedConverter, CubicWellAboveTheGridIsStillNamed) {
 
 /// The grid found in values: levels k·step (with the rounding of a product), none in continuous
 /// values printed to 6 significant digits, none when 2 % of the levels lie off the grid.
-TEST(QuantisationGrid, InferredFromTheValuesOrNone) {
+TEST(DiagQuantisationGrid, InferredFromTheValuesOrNone) {
   testing::RandomSensor rig(5, 1);
   const double step = 0.0037;
   std::vector<double> grid;
@@ -188,7 +190,7 @@ TEST(QuantisationGrid, InferredFromTheValuesOrNone) {
 }
 
 /// A recording in counts of a converter with a known scale declares its step: one code.
-TEST(QuantisationGrid, DeclaredByTheConverter) {
+TEST(DiagQuantisationGrid, DeclaredByTheConverter) {
   DiagData d;
   d.t_s = {0.0, 0.01, 0.02};
   d.real_mvv = Eigen::MatrixXd::Zero(3, 2);
@@ -200,10 +202,10 @@ TEST(QuantisationGrid, DeclaredByTheConverter) {
   EXPECT_DOUBLE_EQ(q.step_mvv(1), 1.0 / 2048.0);
 }
 
-INSTANTIATE_TEST_SUITE_P(Development, QuantisedConverter,
+INSTANTIATE_TEST_SUITE_P(Development, DiagQuantisedConverter,
                          ::testing::Values(QuantCase{1, 6, 0.01}, QuantCase{2, 8, 0.005},
                                            QuantCase{3, 6, 0.02}));
-INSTANTIATE_TEST_SUITE_P(Validation, QuantisedConverter,
+INSTANTIATE_TEST_SUITE_P(Validation, DiagQuantisedConverter,
                          ::testing::Values(QuantCase{11, 8, 0.015}, QuantCase{12, 6, 0.007},
                                            QuantCase{13, 8, 0.012}));
 
