@@ -24,7 +24,8 @@ namespace ftstack::diag {
 [[nodiscard]] std::string NotResolved(const Context& cx, const EffectFit& fit,
                                       const EffectSpec& spec);
 /// The last test of NotResolved: on a quantised record (cx.quantisation), why a fit whose
-/// prediction's RMS on the fitted rows stays within kResolvableSteps steps on every channel is not
+/// prediction's RMS on the fitted rows (about kGridSampleRows of them, evenly
+/// strided) stays within kResolvableSteps steps on every channel is not
 /// claimed, or "" (a record on no grid, or a prediction on a channel without one).
 [[nodiscard]] std::string WithinGrid(const Context& cx, const EffectFit& fit);
 
