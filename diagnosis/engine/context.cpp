@@ -147,8 +147,9 @@ void SetTemperature(Context& cx, const DiagData& d) {
 
 /// The context from the residual and the sim's outputs (n × N each, mV/V): `sim` becomes the load.
 Context Build(const DiagData& d, Series resid, Mat sim, double block_s,
-              const Eigen::VectorXd* sigma) {
+              const Eigen::VectorXd* sigma, Quantisation quantisation) {
   Context cx;
+  cx.quantisation = std::move(quantisation);
   cx.data = &d;
   cx.n = static_cast<int>(d.rows());
   cx.nc = d.channels();
@@ -168,16 +169,18 @@ Context Build(const DiagData& d, Series resid, Mat sim, double block_s,
 }  // namespace
 
 Context MakeContext(const DiagData& d, double block_s, const Eigen::VectorXd* sigma) {
-  return Build(d, (d.real_mvv - d.sim_mvv).cast<float>(), d.sim_mvv, block_s, sigma);
+  return Build(d, (d.real_mvv - d.sim_mvv).cast<float>(), d.sim_mvv, block_s, sigma,
+               FindQuantisation(d));
 }
 
 Context MakeContext(DiagData* d, double block_s, const Eigen::VectorXd* sigma) {
   d->released_channels = d->channels();
   // Real − sim in double, rounded once; the real bridges are released as soon as it is formed.
   Series resid = (d->real_mvv - d->sim_mvv).cast<float>();
+  Quantisation quantisation = FindQuantisation(*d);
   d->real_mvv = Mat();
   Mat sim = std::move(d->sim_mvv);  // both matrices are left empty
-  return Build(*d, std::move(resid), std::move(sim), block_s, sigma);
+  return Build(*d, std::move(resid), std::move(sim), block_s, sigma, std::move(quantisation));
 }
 
 void SetNoise(Context* cx, const Eigen::VectorXd& sigma) {

@@ -10,6 +10,7 @@
 #include "diagnosis/engine/conditioning.hpp"
 #include "diagnosis/engine/data.hpp"
 #include "diagnosis/engine/lag_cache.hpp"
+#include "diagnosis/engine/quantisation.hpp"
 
 namespace ftstack::diag {
 
@@ -32,6 +33,9 @@ struct Context {
   /// the real load lagged: conditioning.hpp); empty when none is.
   std::vector<std::uint8_t> excluded;
   Conditioning conditioning;  ///< glitches, transitions and quiet noise found before the fits
+  /// The real bridges' value grid (declared or inferred): effects within kResolvableSteps of it
+  /// are not claimed (NotResolved).
+  Quantisation quantisation;
   std::size_t n_train = 0;
   std::size_t n_hold = 0;
   double block_s = 0.0;        ///< length of the interleaved hold-out blocks

@@ -203,7 +203,38 @@ std::string NotResolved(const Context& cx, const EffectFit& fit, const EffectSpe
     std::string words = PiecesWords(fit, r);
     if (!words.empty()) return words;
   }
-  return "";
+  return WithinGrid(cx, fit);
+}
+
+std::string WithinGrid(const Context& cx, const EffectFit& fit) {
+  const Quantisation& q = cx.quantisation;
+  if (!q.quantised() || fit.pred.rows() != cx.n || fit.pred.cols() != q.step_mvv.size()) return "";
+  double largest = 0.0;  // the prediction's RMS in steps, on the channel where it is largest
+  int at = 0;
+  // About kGridSampleRows rows estimate an RMS well enough for a threshold (cost on 10^6 rows).
+  const int every = std::max(1, cx.n / static_cast<int>(kGridSampleRows));
+  for (int c = 0; c < cx.nc; ++c) {
+    double s = 0.0;
+    std::size_t rows = 0;
+    for (int i = 0; i < cx.n; i += every) {
+      const auto iu = static_cast<std::size_t>(i);
+      if (cx.train[iu] == 0 || (!cx.excluded.empty() && cx.excluded[iu] != 0)) continue;
+      s += static_cast<double>(fit.pred(i, c)) * fit.pred(i, c);
+      ++rows;
+    }
+    const double rms = rows > 0 ? std::sqrt(s / static_cast<double>(rows)) : 0.0;
+    if (rms > 0 && q.step_mvv(c) <= 0) return "";  // acts where no grid limits what is seen
+    const double steps = rms > 0 ? rms / q.step_mvv(c) : 0.0;
+    if (steps > largest) {
+      largest = steps;
+      at = c;
+    }
+  }
+  if (largest >= kResolvableSteps) return "";
+  return Fmt(
+      "within the converter's grid: its predicted RMS is %.2g steps on b%d (step %.3g mV/V, "
+      "%s), below the %.0f steps a quantised record can show",
+      largest, at, q.step_mvv(at), q.source.c_str(), kResolvableSteps);
 }
 
 nlohmann::json TypedParameters(const Context& cx, const EffectFit& fit) {

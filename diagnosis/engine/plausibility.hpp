@@ -18,11 +18,16 @@ namespace ftstack::diag {
 /// values: the largest |value| above hi), then, once PieceSpreads has filled fit.spread,
 /// pieces_disagree for a parameter of one sign by its physics (lo ≥ 0) whose pieces' values (of
 /// its largest element) straddle zero ("not resolved: pieces disagree (fraction = -0.01, per
-/// piece -0.02–0.004)").
+/// piece -0.02–0.004)"); last, a prediction within the converter's grid (WithinGrid).
 [[nodiscard]] std::string NotResolved(const Context& cx, const EffectFit& fit);
 /// The same against a given plug-in (one the registry need not hold).
 [[nodiscard]] std::string NotResolved(const Context& cx, const EffectFit& fit,
                                       const EffectSpec& spec);
+/// The last test of NotResolved: on a quantised record (cx.quantisation), why a fit whose
+/// prediction's RMS on the fitted rows (about kGridSampleRows of them, evenly
+/// strided) stays within kResolvableSteps steps on every channel is not
+/// claimed, or "" (a record on no grid, or a prediction on a channel without one).
+[[nodiscard]] std::string WithinGrid(const Context& cx, const EffectFit& fit);
 
 /// The parameters `spec` declares for `fit`: EffectSpec::fit_ranges (a variant searched in
 /// narrower ranges) where it has them, else EffectSpec::ranges, else none.

@@ -432,6 +432,15 @@ std::string HtmlConditioning(const DiagData& data, const Report& r) {
     lagging += t.excluded ? 1 : 0;
     if (t.excluded) app_max = std::max(app_max, t.application_s);
   }
+  const Quantisation& q = r.cx.quantisation;
+  if (q.quantised()) {
+    h += "<p><b>Quantised record</b> (grid " + HtmlEscape(q.source) + "): steps of " +
+         Num(q.step_mvv.minCoeff(), "%.3g") + "–" + Num(q.step_mvv.maxCoeff(), "%.3g") +
+         " mV/V. An effect smaller than " + Num(kResolvableSteps, "%.0f") + " steps (RMS " +
+         Num(kResolvableSteps * q.step_mvv.minCoeff(), "%.3g") + "–" +
+         Num(kResolvableSteps * q.step_mvv.maxCoeff(), "%.3g") +
+         " mV/V) is not claimed: the grid's rounding could mimic it.</p>";
+  }
   h += "<p>Load transitions measured: " + std::to_string(k.transitions.size()) + "; " +
        std::to_string(lagging) + " lag the reference" +
        (lagging > 0 ? " (real load applied over up to " + Num(app_max, "%.2g") +
@@ -468,7 +477,8 @@ std::string HtmlCandidates(const Report& r) {
   h += "</table><p>Held-out rows: every third block of " + Num(r.cx.block_s) +
        " s. Score = held-out Δχ² − parameters × ln(held-out samples); an effect is claimed when "
        "its held-out z &gt; 6 and score &gt; 0 and its fit is resolved (no parameter on a search "
-       "bound or outside its physical range).</p>";
+       "bound or outside its physical range; on a quantised record, a prediction of more than " +
+       Num(kResolvableSteps, "%.0f") + " grid steps RMS).</p>";
   return h;
 }
 
@@ -512,8 +522,7 @@ std::string HtmlReport(const DiagData& data, const Report& r) {
     const std::string why = colon == std::string::npos ? "" : d.substr(colon + 2);
     h += "<h2>" + HtmlEscape(name) + " (not claimed)</h2><p class=\"conf\"><b>Not claimed.</b> " +
          HtmlEscape(name) +
-         " improved the held-out rows beside the claimed effect, but one offset per load hold "
-         "explains that improvement as well, so it is left out of the effects and the verdict. " +
+         " improved the held-out rows, but it is left out of the effects and the verdict: " +
          HtmlEscape(why) + "</p>";
   }
   h += HtmlChannels(r);

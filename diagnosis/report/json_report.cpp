@@ -90,6 +90,28 @@ nlohmann::json FindingsJson(const Report& r) {
   return out;
 }
 
+/// The real bridges' value grid and the size of effect it lets the record show.
+nlohmann::json QuantisationJson(const Report& r) {
+  const Quantisation& q = r.cx.quantisation;
+  if (!q.quantised()) return {{"quantised", false}};
+  auto step = nlohmann::json::array();
+  auto smallest = nlohmann::json::array();
+  for (Eigen::Index c = 0; c < q.step_mvv.size(); ++c) {
+    step.push_back(q.step_mvv(c));
+    smallest.push_back(kResolvableSteps * q.step_mvv(c));
+  }
+  return {
+      {"quantised", true},
+      {"source", q.source},
+      {"step_mvv", step},
+      {"smallest_claimable_rms_mvv", smallest},
+      {"rule", "an effect whose predicted RMS on the fitted rows is below " +
+                   std::to_string(static_cast<int>(kResolvableSteps)) +
+                   " steps on every channel is not claimed: an undithered grid's rounding, within "
+                   "half a step of every held load, can mimic a smooth function of the load or a "
+                   "slow drift of that size"}};
+}
+
 }  // namespace
 
 nlohmann::json ToJson(const Report& r) {
@@ -111,6 +133,7 @@ nlohmann::json ToJson(const Report& r) {
     j["mismatch"]["spectral_peaks_hz"] = r.cx.peak_hz;
   }
   j["conditioning"] = ConditioningJson(r);
+  j["quantisation"] = QuantisationJson(r);
   j["findings"] = FindingsJson(r);
   j["verdict"] = r.verdict;
   auto effects = nlohmann::json::array();
