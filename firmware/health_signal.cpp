@@ -74,9 +74,16 @@ void RingingScan::Start(const std::int32_t* x, std::size_t n, std::uint32_t rate
 bool RingingScan::Advance(std::size_t budget) {
   if (phase_ == Phase::kLevel) {
     const std::size_t end = n_ - i_ > budget ? i_ + budget : n_;
-    for (; i_ < end; ++i_) sum_ += x_[i_];
+    const std::size_t late = n_ - tail_ / 2;
+    for (; i_ < end; ++i_) {
+      sum_ += x_[i_];
+      if (i_ >= late) late_sum_ += x_[i_];
+    }
     if (i_ < n_) return false;
     level_ = sum_ / static_cast<std::int64_t>(tail_);
+    const auto late_n = static_cast<std::int64_t>(tail_ / 2);
+    level_moved_ =
+        late_sum_ / late_n - (sum_ - late_sum_) / (static_cast<std::int64_t>(tail_) - late_n);
     prev_ = x_[0] - level_;
     i_ = 0;
     phase_ = Phase::kScan;
@@ -120,6 +127,11 @@ void RingingScan::Finish() {
   phase_ = Phase::kDone;
   r_.amplitude = static_cast<std::int32_t>(peak_);
   if (r_.crossings < 4 || last_q8_ <= first_q8_) return;
+  // A step response ends on a level: a decaying ringing moves its last quarter's halves' means
+  // by a fraction of its largest lobe; beyond a quarter of it (plus the hysteresis) the load
+  // itself still moves (a bounce, a ramp) and its swings are not the mount's ringing.
+  const std::int64_t moved = level_moved_ < 0 ? -level_moved_ : level_moved_;
+  if (moved > hysteresis_ + peak_ / 4) return;
   // (crossings − 1) half periods between the first and the last crossing.
   const std::uint64_t num = static_cast<std::uint64_t>(r_.crossings - 1) * rate_hz_ * 256000u;
   const std::uint64_t span = static_cast<std::uint64_t>(last_q8_ - first_q8_);

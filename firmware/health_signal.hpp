@@ -38,9 +38,11 @@ class ToneDetector {
 };
 
 /// A ringing frequency read from a captured transient: the level is the mean of the capture's last
-/// quarter; zero crossings are counted with a Schmitt trigger of ±hysteresis around it.
+/// quarter; zero crossings are counted with a Schmitt trigger of ±hysteresis around it. No
+/// frequency when that quarter is no level (its halves' means differ by more than the hysteresis
+/// plus a quarter of the amplitude): the load was still moving, and its own swings were counted.
 struct RingingResult {
-  std::int32_t freq_mhz = 0;    ///< 0: fewer than 4 crossings (no ringing measured)
+  std::int32_t freq_mhz = 0;    ///< 0: fewer than 4 crossings or no level (no ringing measured)
   std::int32_t amplitude = 0;   ///< largest |x − level| after the first crossing, LSB
   std::uint16_t crossings = 0;  ///< Schmitt-trigger crossings counted
 };
@@ -68,6 +70,8 @@ class RingingScan {
   std::size_t tail_ = 0;
   std::size_t i_ = 0;
   std::int64_t sum_ = 0;
+  std::int64_t late_sum_ = 0;     // Σ of the last quarter's second half
+  std::int64_t level_moved_ = 0;  // that half's mean less the first half's
   std::int64_t level_ = 0;
   std::int64_t first_q8_ = 0;
   std::int64_t last_q8_ = 0;

@@ -92,12 +92,21 @@ void HealthWatch::FinishRinging() {
   report_.ring_mhz = main.freq_mhz;
   ring_last_mhz_[ring_measured_ % 3] = main.freq_mhz;
   ++ring_measured_;
+  // A mode of the mount rings at one frequency after every step: three readings that scatter by
+  // more than the shift to be found measured something else (the load's own swings), and neither
+  // teach the reference nor judge it.
+  const auto agree = [this](const std::array<std::int32_t, 3>& f) {
+    const std::int64_t spread =
+        std::int64_t{std::max({f[0], f[1], f[2]})} - std::min({f[0], f[1], f[2]});
+    return spread * 1000 <= std::int64_t{Median3(f)} * th_.resonance_shift_pm;
+  };
   if (ring_ref_mhz_ == 0) {
-    ring_learn_mhz_[ring_learned_++] = main.freq_mhz;
-    if (ring_learned_ == 3) ring_ref_mhz_ = Median3(ring_learn_mhz_);
+    ring_learn_mhz_[ring_learned_ % 3] = main.freq_mhz;
+    ++ring_learned_;
+    if (ring_learned_ >= 3 && agree(ring_learn_mhz_)) ring_ref_mhz_ = Median3(ring_learn_mhz_);
     return;
   }
-  if (ring_measured_ < 3) return;
+  if (ring_measured_ < 3 || !agree(ring_last_mhz_)) return;
   Judged(HealthCause::kResonanceShift);
   const std::int64_t now = Median3(ring_last_mhz_);
   const bool shifted =

@@ -79,6 +79,30 @@ TEST(MeasureRinging, DampedSineAfterAStep) {
   }
 }
 
+TEST(MeasureRinging, NoFrequencyWhileTheLoadStillMoves) {
+  // A 25 Hz ringing (ζ 0.04, 3 000 LSB) whose load starts ramping at 25 LSB per sample in the
+  // capture's last quarter: its halves' means differ by 1 600 LSB, more than the hysteresis plus
+  // a quarter of the largest swing about that quarter's mean (≈ 20 + 4 600 / 4 LSB); with the
+  // ramp 10× slower (160 LSB) the ringing is still measured.
+  for (const double slope : {25.0, 2.5}) {
+    const std::uint32_t rate = 1000;
+    const double zeta = 0.04, wn = 2 * M_PI * 25.0, wd = wn * std::sqrt(1 - zeta * zeta);
+    std::vector<std::int32_t> x(512);
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      const double t = static_cast<double>(i) / rate;
+      const double ramp = i < 384 ? 0.0 : slope * static_cast<double>(i - 384);
+      x[i] = static_cast<std::int32_t>(
+          std::lround(50000.0 + ramp + 3000.0 * std::exp(-zeta * wn * t) * std::cos(wd * t)));
+    }
+    const RingingResult r = MeasureRinging(x.data(), x.size(), rate, 20);
+    if (slope > 10.0) {
+      EXPECT_EQ(r.freq_mhz, 0) << "the load's ramp read as " << r.freq_mhz << " mHz";
+    } else {
+      EXPECT_NEAR(r.freq_mhz / 1000.0, wd / (2 * M_PI), wd / (2 * M_PI) * 0.02);
+    }
+  }
+}
+
 TEST(RingingScan, InSlicesMeasuresTheClosedFormAndTheWholeScansResult) {
   const std::uint32_t rate = 1000;
   const double zeta = 0.04, wn = 2 * M_PI * 25.0, wd = wn * std::sqrt(1 - zeta * zeta);
