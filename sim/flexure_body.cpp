@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "sim/beam_root.hpp"
+
 namespace ftstack::sim {
 namespace {
 
@@ -63,8 +65,12 @@ FlexureBody::FlexureBody(const FlexureGeometry& g) : g_(g) {
   }
   section_ = RectangularSection(g.e_pa, g.poisson, g.beam_width_m, g.beam_height_m);
   length_m_ = g.rim_radius_m - g.hub_radius_m;
-  const Mat12 kl = g.shear_deformable ? TimoshenkoElementStiffness(section_, length_m_)
-                                      : FrameElementStiffness(section_, length_m_);
+  const Mat12 kl_member = g.shear_deformable ? TimoshenkoElementStiffness(section_, length_m_)
+                                             : FrameElementStiffness(section_, length_m_);
+  const EndCompliance root = g.elastic_roots
+                                 ? BuiltInRootCompliance(g.e_pa, g.beam_width_m, g.beam_height_m)
+                                 : EndCompliance{};
+  const Mat12 kl = WithEndCompliance(kl_member, length_m_, root, root);
   const Mat6 k11 = kl.topLeftCorner<6, 6>();
   const Mat6 k12 = kl.topRightCorner<6, 6>();
   const Mat6 k22 = kl.bottomRightCorner<6, 6>();

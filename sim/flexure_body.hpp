@@ -32,6 +32,10 @@ struct FlexureGeometry {
   /// Timoshenko beams (shear factor 5/6) instead of Euler–Bernoulli; off for the sensor models
   /// (their calibration does not depend on it), on for the design explorer's stubby beams.
   bool shear_deformable = false;
+  /// The beams' roots in an elastic hub and rim: each beam end rotates in its support by
+  /// O'Donnell's built-in-root compliance (sim/beam_root.hpp) in series with the beam. Off: the
+  /// roots are ideal clamps (hub and rim rigid).
+  bool elastic_roots = false;
 };
 
 /// Faces of a beam: top = local +z, bottom = −z, plus_y = +y side, minus_y = −y side.

@@ -65,6 +65,8 @@ DesignModel FromPhysicalSensor(const PhysicalSensorModel& s, const Material& mat
       {"beams", g.beam_count},          {"rim_compliance_radial_m_per_n", g.rim_compliance[0]},
       {"hub_radius_m", g.hub_radius_m}, {"rim_radius_m", g.rim_radius_m},
       {"beam_width_m", g.beam_width_m}, {"beam_height_m", g.beam_height_m}};
+  if (g.elastic_roots)
+    m.parameters["elastic_roots"] = 1;  // named only when on: specs stay as they were
   m.stiffness = body.Stiffness();
   std::vector<Row6> gauges;
   for (const GaugeSite& site : s.spec().gauges) {
@@ -132,6 +134,7 @@ DesignModel HubSpoke(const HubSpokeParams& p, const Readout& r) {
   spec.body.e_pa = p.material.e_pa;
   spec.body.poisson = p.material.poisson;
   spec.body.shear_deformable = true;
+  spec.body.elastic_roots = p.elastic_roots;
   spec.gauge.resistance_ohm = 350;
   spec.gauge.gauge_factor = r.gauge_factor;
   spec.rated = Wrench::Ones();

@@ -30,6 +30,8 @@ struct HubSpokeParams {
   double beam_width_m = 0.008, beam_height_m = 0.01;
   double gauge_frac = 0.15;
   Material material = Steel174Ph();
+  /// Beam roots compliant in an elastic hub and rim (FlexureGeometry::elastic_roots).
+  bool elastic_roots = false;
 };
 [[nodiscard]] DesignModel HubSpoke(const HubSpokeParams& p, const Readout& r);
 

@@ -112,6 +112,7 @@ FrameSolution::FrameSolution(FrameModel model) : m_(std::move(model)) {
     } else {
       d.k_local = FrameElementStiffness(d.section, d.length);
     }
+    d.k_local = WithEndCompliance(d.k_local, d.length, fe.joint_a, fe.joint_b);
     const Eigen::Matrix3d r = ElementRotation(p, q, fe.z_hint);
     const std::array<Mat6, 2> map{EndMap(fe.a, r), EndMap(fe.b, r)};
     maps.push_back(map);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sim/beam_element.hpp"
+#include "sim/beam_root.hpp"
 
 namespace ftstack::sim::design {
 
@@ -36,6 +37,9 @@ struct FrameElement {
   double buckling_length_m = 0;
   /// Length of the member this element is part of (for the plate factor); 0: the element's own.
   double member_length_m = 0;
+  /// Compliance of the joints at end a and end b (local axes, in series with the element; e.g.
+  /// BuiltInRootCompliance for a root in an elastic block). Zero: ideal clamps.
+  EndCompliance joint_a{}, joint_b{};
 };
 
 /// A linear spring from free node `node` to the ground, global 6×6 stiffness.

@@ -65,7 +65,8 @@ DesignModel ModelFromSpec(const std::string& spec, const Readout& r) {
                 {"rim_radius_m", [&](double v) { p.rim_radius_m = v; }},
                 {"beam_width_m", [&](double v) { p.beam_width_m = v; }},
                 {"beam_height_m", [&](double v) { p.beam_height_m = v; }},
-                {"gauge_frac", [&](double v) { p.gauge_frac = v; }}});
+                {"gauge_frac", [&](double v) { p.gauge_frac = v; }},
+                {"elastic_roots", [&](double v) { p.elastic_roots = v != 0; }}});
     if (beams != 3 && beams != 4) throw std::invalid_argument("design spec: beams must be 3 or 4");
     p.beams = static_cast<int>(beams);
     return HubSpoke(p, r);

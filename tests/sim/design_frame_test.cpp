@@ -190,6 +190,53 @@ TEST(DesignFrame, HubSpokeTimoshenkoAndSlenderFlag) {
   EXPECT_EQ(Guided(q, r).beam_validity, "z stage leaves: L/b = 0.20 < 0.5");
 }
 
+// Elastic roots through the frame's element joints: each beam split at a free node, the hub
+// joint on the first element's end a and the rim joint on the second's end b, against the
+// flexure body's own assembly (whose Kzz is checked against the guided-beam closed form in
+// beam_root_test.cpp); strains along the beam follow.
+TEST(DesignFrame, ElementJointsMatchFlexureBodyElasticRoots) {
+  FlexureGeometry g;
+  g.beam_count = 4;
+  g.hub_radius_m = 0.015;
+  g.rim_radius_m = 0.05;
+  g.beam_width_m = 0.008;
+  g.beam_height_m = 0.01;
+  g.e_pa = kE;
+  g.poisson = kNu;
+  g.shear_deformable = true;
+  g.elastic_roots = true;
+  const FlexureBody body(g);
+  FrameModel f;
+  f.e_pa = kE;
+  f.poisson = kNu;
+  const EndCompliance root = BuiltInRootCompliance(kE, g.beam_width_m, g.beam_height_m);
+  const double split = 0.4 * (g.rim_radius_m - g.hub_radius_m);
+  for (int i = 0; i < 4; ++i) {
+    const double th = i * std::numbers::pi / 2;
+    const Eigen::Vector3d dir(std::cos(th), std::sin(th), 0);
+    f.nodes_m.push_back((g.hub_radius_m + split) * dir);
+    FrameElement inner =
+        Beam({kPlatform, -1, g.hub_radius_m * dir}, {-1, i, {}}, g.beam_width_m, g.beam_height_m);
+    FrameElement outer =
+        Beam({-1, i, {}}, {kGround, -1, g.rim_radius_m * dir}, g.beam_width_m, g.beam_height_m);
+    inner.member_length_m = outer.member_length_m = g.rim_radius_m - g.hub_radius_m;
+    inner.joint_a = root;
+    outer.joint_b = root;
+    f.elements.push_back(inner);
+    f.elements.push_back(outer);
+  }
+  const FrameSolution s(f);
+  EXPECT_LT((s.Stiffness() - body.Stiffness()).norm(), 1e-9 * body.Stiffness().norm());
+  g.elastic_roots = false;
+  EXPECT_LT(body.Stiffness()(2, 2), 0.8 * FlexureBody(g).Stiffness()(2, 2));
+  const double z = 0.5 * g.beam_height_m;
+  for (double at : {0.0, 0.3 * split}) {
+    const Eigen::Matrix<double, 1, 6> expect =
+        body.StrainMatrix(GaugeSite{0, at, BeamFace::kTop, 0, 0}).row(0);
+    EXPECT_LT((s.AxialStrain(0, at, 0, z) - expect).norm(), 1e-9 * expect.norm()) << at;
+  }
+}
+
 // The project's default body: its in-plane bridge's grids sit on the side faces' mid-height line
 // (the out-of-plane neutral axis), so no out-of-plane load (Fz, Mx, My) strains them — off that
 // line they also read the restrained-warping strain of twisted beams that beam theory lacks

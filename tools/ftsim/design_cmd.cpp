@@ -28,6 +28,7 @@ struct DesignArgs {
   double tool_gyration_m = 0.05;
   double yield_mpa = 0;
   double fatigue_mpa = 0;
+  bool elastic_roots = false;
   int list = 8;
   int refine_starts = 6;
   double max_radius_m = 0;
@@ -53,6 +54,7 @@ int RunSensor(const DesignArgs& a, const sim::design::DesignOptions& o,
   if (a.fatigue_mpa > 0) mat.fatigue_pa = a.fatigue_mpa * 1e6;
   sim::FlexureSensorSpec spec = phys->spec();
   spec.body.shear_deformable = true;  // the design explorer's beams are Timoshenko beams
+  spec.body.elastic_roots = a.elastic_roots;
   const sim::PhysicalSensorModel body(spec);
   sim::design::Candidate c;
   c.id = d.name;
@@ -187,6 +189,8 @@ void AddDesignCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("--tool-gyration-m", a->tool_gyration_m, "tool radius of gyration (0.05)");
   cmd->add_option("--yield-mpa", a->yield_mpa, "--sensor: yield stress of the body");
   cmd->add_option("--fatigue-mpa", a->fatigue_mpa, "--sensor: endurance limit of the body");
+  cmd->add_flag("--elastic-roots", a->elastic_roots,
+                "--sensor: beam roots compliant in an elastic hub and rim (O'Donnell)");
   cmd->add_option("--list", a->list, "designs listed (default 8)");
   cmd->add_option("--max-radius-m", a->max_radius_m,
                   "sweep: body envelope radius limit, m (default: none)");
