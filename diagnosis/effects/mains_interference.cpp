@@ -194,9 +194,7 @@ LineSeries ChooseSeries(const Context& cx, LineGains* gains, double f0) {
 /// that harmonic's span is a whole sampling rate wide or wider, for then it folds onto every
 /// frequency of the band (a slow logger: every line is an alias of some mains frequency, with a
 /// new candidate every rate/h).
-bool Distinguishable(const Supply& s, int h, double rate) {
-  return h * (s.hi_hz - s.lo_hz) < rate;
-}
+bool Distinguishable(const Supply& s, int h, double rate) { return h * (s.hi_hz - s.lo_hz) < rate; }
 
 /// Supply fundamentals one of whose harmonics 1..5 is seen at `seen` (directly or folded from
 /// above Nyquist), each once; harmonics that are not Distinguishable at this rate are not
