@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include "diagnosis/engine/data.hpp"
+#include "diagnosis/loader/data.hpp"
 
 namespace ftstack::bench {
 

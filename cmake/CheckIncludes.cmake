@@ -35,14 +35,19 @@ forbid("${daemon_board}" "[<\"](sim|daemon/sim|calibration/fit|diagnosis)/"
        "the daemon's board part includes the simulator, the fitting or the diagnosis")
 # The diagnosis (filters, engine, effect plug-ins, reports) knows recordings and numbers, not the
 # simulator or a CLI; only evaluation/ uses the simulator.
-file(GLOB_RECURSE diagnosis "${ROOT}/diagnosis/filters/*.[ch]pp" "${ROOT}/diagnosis/engine/*.[ch]pp"
+file(GLOB_RECURSE diagnosis "${ROOT}/diagnosis/filters/*.[ch]pp" "${ROOT}/diagnosis/loader/*.[ch]pp"
+     "${ROOT}/diagnosis/engine/*.[ch]pp"
      "${ROOT}/diagnosis/effects/*.[ch]pp" "${ROOT}/diagnosis/report/*.[ch]pp")
 forbid("${diagnosis}" "[<\"](sim|calibration|daemon|tools|tests|CLI)/"
        "the diagnosis engine includes the simulator, a tool or a CLI")
-# Inside diagnosis/ each folder uses only the ones below it: filters < engine < effects < report.
+# Inside diagnosis/ each folder uses only the ones below it: filters, loader < engine < effects <
+# report.
 file(GLOB_RECURSE diag_filters "${ROOT}/diagnosis/filters/*.[ch]pp")
 forbid("${diag_filters}" "[<\"]diagnosis/(engine|effects|report|evaluation)/"
        "a diagnosis filter includes the engine")
+file(GLOB_RECURSE diag_loader "${ROOT}/diagnosis/loader/*.[ch]pp")
+forbid("${diag_loader}" "[<\"]diagnosis/(filters|engine|effects|report|evaluation)/"
+       "the diagnosis loader includes the engine")
 file(GLOB_RECURSE diag_engine "${ROOT}/diagnosis/engine/*.[ch]pp")
 forbid("${diag_engine}" "[<\"]diagnosis/(effects|report|evaluation)/"
        "the diagnosis engine includes an effect plug-in or a report")

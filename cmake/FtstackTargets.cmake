@@ -16,7 +16,8 @@
 #   ftstack_rdt            (daemon) its RDT server; ftstack_daemon links it
 #   ftstack_daemon_sim   ftd's simulated backend (host only)          -> the daemon's + sim, daemon
 #   ftstack_diagnosis_filters  the diagnosis's closed-form filters    -> nothing of ours
-#   ftstack_diagnosis    sim-vs-real diagnosis engine and effects     -> meas, diag_filters
+#   ftstack_diagnosis_loader  recordings into the diagnosis's DiagData -> meas
+#   ftstack_diagnosis    sim-vs-real diagnosis engine and effects     -> meas, diag_filters, diag_loader
 #   ftstack_diagnosis_report  its HTML/JSON reports                   -> meas, diag
 #   ftstack_diagnosis_eval    scorecard, demo, model prediction       -> diag, sim (and below)
 # Every ftstack_* library has one of these layers (a library without one fails configuration).
@@ -123,6 +124,8 @@ function(_ftstack_layer_of target out)
     set(${out} "daemon_sim" PARENT_SCOPE)
   elseif(target STREQUAL "ftstack_diagnosis_filters")
     set(${out} "diag_filters" PARENT_SCOPE)
+  elseif(target STREQUAL "ftstack_diagnosis_loader")
+    set(${out} "diag_loader" PARENT_SCOPE)
   elseif(target STREQUAL "ftstack_diagnosis")
     set(${out} "diag" PARENT_SCOPE)
   elseif(target STREQUAL "ftstack_diagnosis_report")
@@ -147,9 +150,10 @@ function(ftstack_check_layers)
   set(allowed_daemon "hal_if;hal;fw;meas;calfile;daemon")
   set(allowed_daemon_sim "hal_if;hal;fw;meas;calfile;sim;daemon")
   set(allowed_diag_filters "")
-  set(allowed_diag "meas;diag_filters")
-  set(allowed_diag_report "meas;diag_filters;diag")
-  set(allowed_diag_eval "hal_if;hal;meas;calfile;sim;diag_filters;diag")
+  set(allowed_diag_loader "meas")
+  set(allowed_diag "meas;diag_filters;diag_loader")
+  set(allowed_diag_report "meas;diag_filters;diag_loader;diag")
+  set(allowed_diag_eval "hal_if;hal;meas;calfile;sim;diag_filters;diag_loader;diag")
   get_property(libs GLOBAL PROPERTY FTSTACK_LIBRARIES)
   get_property(programs GLOBAL PROPERTY FTSTACK_PROGRAMS)
   foreach(lib IN LISTS libs programs)

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "diagnosis/engine/conditioning.hpp"
-#include "diagnosis/engine/data.hpp"
+#include "diagnosis/loader/data.hpp"
 #include "diagnosis/engine/lag_cache.hpp"
 #include "diagnosis/engine/quantisation.hpp"
 

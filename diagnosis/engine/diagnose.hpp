@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "diagnosis/engine/data.hpp"
+#include "diagnosis/loader/data.hpp"
 #include "diagnosis/engine/effect.hpp"
 
 namespace ftstack::diag {

@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <string>
 
-#include "diagnosis/engine/data.hpp"
+#include "diagnosis/loader/data.hpp"
 
 namespace ftstack::diag {
 

@@ -157,7 +157,7 @@ std::vector<std::vector<Partner>> FitPartners(const Context& cx, const DiagnoseO
         sb->fit.pred = Series();
         partners[t].push_back({{sb->score, spec.name}, std::move(sb->fit)});
       }
-      Progress(options, 0.65 + 0.2 * static_cast<double>(++done) / static_cast<double>(total),
+      Progress(options, Stage::kPartners, static_cast<double>(++done) / static_cast<double>(total),
                "pairs: partners");
     });
   }
@@ -230,8 +230,10 @@ double HoldRms(const Context& cx, const Series& target, const Series* pred) {
   return std::sqrt(s / std::max(1.0, static_cast<double>(cx.n_hold) * cx.nc));
 }
 
-void Progress(const DiagnoseOptions& o, double f, const char* what) {
-  if (o.progress != nullptr) o.progress(f, what, o.progress_user);
+void Progress(const DiagnoseOptions& options, Stage stage, double within, const char* what) {
+  if (options.progress == nullptr) return;
+  const StageShare& s = kStageShares[static_cast<int>(stage)];
+  options.progress(s.from + (s.to - s.from) * within, what, options.progress_user);
 }
 
 /// Every effect fitted alone to the residual and scored on the held-out rows, best first; each is
@@ -260,8 +262,8 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
     const std::lock_guard<std::mutex> lock(mu);
     slot[j] = std::move(s);
     KeepBestPredictions(&slot, kPairStarts);
-    Progress(options, 0.05 + 0.6 * static_cast<double>(++done) / static_cast<double>(order.size()),
-             effects[j].name);
+    Progress(options, Stage::kCandidates,
+             static_cast<double>(++done) / static_cast<double>(order.size()), effects[j].name);
   });
   std::vector<Scored> singles;
   for (auto& q : slot) {
@@ -332,8 +334,8 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Sco
     const auto [t, y] = pairs[k];
     auto p = TryPair(cx, options, singles[top[t]], &partners[t][y], base, best.score);
     const std::lock_guard<std::mutex> lock(mu);
-    Progress(options, 0.85 + 0.13 * static_cast<double>(++done) / static_cast<double>(pairs.size()),
-             "pairs: backfits");
+    Progress(options, Stage::kPairs,
+             static_cast<double>(++done) / static_cast<double>(pairs.size()), "pairs: backfits");
     --left[t];
     // The best qualifying pair wins; of equal scores the earlier start and better partner (as a
     // sequential search would keep).
@@ -508,11 +510,11 @@ bool GrowThird(const Context& cx, const DiagnoseOptions& options,
   }
   const double excess =
       Score(cx, cx.resid, nullptr).hold_sse - static_cast<double>(cx.n_hold) * cx.nc;
-  Progress(options, 0.98, "a third: candidates");
+  Progress(options, Stage::kThird, 0.0, "a third: candidates");
   std::vector<ThirdCandidate> thirds =
       ScanThirds(cx, options, todo, rest, Score(cx, rest, nullptr).hold_sse, excess);
   for (ThirdCandidate& candidate : thirds) {
-    Progress(options, 0.99, "a third: backfits");
+    Progress(options, Stage::kThird, 0.5, "a third: backfits");
     auto best = BackfitThird(cx, options.z_claim, *claimed, rest, excess, &candidate);
     if (!best) continue;
     // Identified beside the refitted pair, or not claimed: an offset per hold, a function of the

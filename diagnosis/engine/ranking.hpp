@@ -8,6 +8,7 @@
 #include "diagnosis/engine/debug.hpp"
 #include "diagnosis/engine/diagnose.hpp"
 #include "diagnosis/engine/effect.hpp"
+#include "diagnosis/engine/stages.hpp"
 
 namespace ftstack::diag {
 
@@ -33,8 +34,6 @@ inline constexpr std::size_t kPairPartners = 3;
 
 /// Held-out RMS of target − pred (pred nullptr: of target), all channels, mV/V.
 double HoldRms(const Context& cx, const Series& target, const Series* pred);
-/// Reports progress through options.progress when set.
-void Progress(const DiagnoseOptions& o, double f, const char* what);
 
 /// Every effect fitted alone to the residual and scored on the held-out rows, best first; each is
 /// listed among r.candidates. The fits run in parallel (options.threads); the result does not

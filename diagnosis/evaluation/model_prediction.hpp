@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "diagnosis/engine/data.hpp"
+#include "diagnosis/loader/data.hpp"
 #include "measurement/units.hpp"
 
 namespace ftstack::diag {

@@ -11,7 +11,7 @@
 #include <unistd.h>
 
 #include "diagnosis/effects/families.hpp"
-#include "diagnosis/engine/data.hpp"
+#include "diagnosis/loader/data.hpp"
 #include "diagnosis/engine/diagnose.hpp"
 #include "diagnosis/engine/effect.hpp"
 #include "diagnosis/engine/plausibility.hpp"

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/engine/data.hpp"
+#include "diagnosis/loader/data.hpp"
 #include "sim/default_sensor.hpp"
 
 namespace ftstack::diag::testing {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/engine/data.hpp"
+#include "diagnosis/loader/data.hpp"
 #include "diagnosis/engine/effect.hpp"
 #include "diagnosis/engine/signal.hpp"
 #include "diagnosis/filters/lowpass.hpp"

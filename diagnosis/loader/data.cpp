@@ -1,4 +1,4 @@
-#include "diagnosis/engine/data.hpp"
+#include "diagnosis/loader/data.hpp"
 
 #include <algorithm>
 #include <cmath>
