@@ -51,6 +51,11 @@ namespace ftstack::diag {
 
 namespace ftstack::diag::fx {
 
+/// The hysteresis families' evidence opening, on the channel that carries e->pred most: "at the
+/// same load bC reads up to X mV/V differently depending on the load's past reversals (Z σ)";
+/// sets e->channels (effects/hysteresis.cpp).
+[[nodiscard]] std::string ReversalEvidence(const Context& cx, EffectFit* e);
+
 /// The shortest creep time constant the data can show (3 samples, 0.2 s, 3 times the typical
 /// excluded window of a lagging load change): the search's lower bound and the range's.
 double CreepTauFloor(const Context& cx);

@@ -234,16 +234,8 @@ std::optional<EffectFit> FitHysteresisPreisach(const Context& cx, const Series& 
   e.params["relay_levels"] = kLevels;
   e.params["loop_half_height_mvv"] = weights;
   e.sigma["loop_half_height_mvv"] = sigmas;
-  const int best_c = fx::DominantChannel(cx, e.pred);
-  e.channels = fx::ChannelsAboveNoise(cx, e.pred);
-  const Eigen::VectorXd col = e.pred.col(best_c).cast<double>();
-  char buf[200];
-  std::snprintf(buf, sizeof buf,
-                "at the same load b%d reads up to %.3g mV/V differently depending on the load's "
-                "past reversals (%.1f σ), a sum of %d relay loops, constant during holds",
-                best_c, col.maxCoeff() - col.minCoeff(),
-                (col.maxCoeff() - col.minCoeff()) / cx.sigma(best_c), kRelays);
-  e.evidence = buf;
+  e.evidence = fx::ReversalEvidence(cx, &e) +
+               Fmt(", a sum of %d relay loops, constant during holds", kRelays);
   return e;
 }
 
@@ -263,3 +255,18 @@ EffectSpec HysteresisPlugin() {
 }
 
 }  // namespace ftstack::diag
+
+namespace ftstack::diag::fx {
+
+std::string ReversalEvidence(const Context& cx, EffectFit* e) {
+  const int c = DominantChannel(cx, e->pred);
+  e->channels = ChannelsAboveNoise(cx, e->pred);
+  const Eigen::VectorXd col = e->pred.col(c).cast<double>();
+  const double range = col.maxCoeff() - col.minCoeff();
+  return Fmt(
+      "at the same load b%d reads up to %.3g mV/V differently depending on the load's past "
+      "reversals (%.1f σ)",
+      c, range, range / cx.sigma(c));
+}
+
+}  // namespace ftstack::diag::fx

@@ -328,18 +328,10 @@ std::optional<EffectFit> FitHysteresisAxes(const Context& cx, const Series& targ
   e.train_sse_w = fit.sse_w;
   const int top_axis = LoopHalfHeights(best.ops, fit, range, &e);
   if (!best.weights_only) e.params["travel_fraction"] = best.travel_fraction;
-  const int bc = fx::DominantChannel(cx, e.pred);
-  e.channels = fx::ChannelsAboveNoise(cx, e.pred);
-  const Eigen::VectorXd col = e.pred.col(bc).cast<double>();
-  char buf[240];
-  std::snprintf(buf, sizeof buf,
-                "at the same load b%d reads up to %.3g mV/V differently depending on the load's "
-                "past reversals (%.1f σ), constant during holds: a loop of %.3g %s on %s",
-                bc, col.maxCoeff() - col.minCoeff(),
-                (col.maxCoeff() - col.minCoeff()) / cx.sigma(bc),
-                2.0 * std::fabs(e.params["loop_half_height"][kAxis[top_axis]].get<double>()),
-                top_axis < 3 ? "N" : "N·m", kAxis[top_axis]);
-  e.evidence = buf;
+  e.evidence = fx::ReversalEvidence(cx, &e) +
+               fx::Fmt(", constant during holds: a loop of %.3g %s on %s",
+                       2.0 * std::fabs(e.params["loop_half_height"][kAxis[top_axis]].get<double>()),
+                       top_axis < 3 ? "N" : "N·m", kAxis[top_axis]);
   return e;
 }
 
