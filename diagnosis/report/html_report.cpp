@@ -21,6 +21,20 @@ std::string Num(double v, const char* f = "%.4g") {
   return b;
 }
 
+/// "a" or "a–b": the smallest and largest grid step of the bridges that have one, times k (mV/V).
+std::string StepRange(const Eigen::VectorXd& step_mvv, double k) {
+  double lo = 0.0;
+  double hi = 0.0;
+  for (Eigen::Index c = 0; c < step_mvv.size(); ++c) {
+    if (step_mvv(c) <= 0) continue;
+    lo = lo > 0 ? std::min(lo, step_mvv(c)) : step_mvv(c);
+    hi = std::max(hi, step_mvv(c));
+  }
+  const std::string a = Num(k * lo, "%.3g");
+  const std::string b = Num(k * hi, "%.3g");
+  return a == b ? a : a + "–" + b;
+}
+
 /// One value, a list of per-channel values, or per channel a list ("b0: …; b1: …").
 std::string Cell(const nlohmann::json& v) {
   if (v.is_number()) return Num(v.get<double>());
@@ -434,11 +448,15 @@ std::string HtmlConditioning(const DiagData& data, const Report& r) {
   }
   const Quantisation& q = r.cx.quantisation;
   if (q.quantised()) {
+    int gridded = 0;
+    for (Eigen::Index c = 0; c < q.step_mvv.size(); ++c) gridded += q.step_mvv(c) > 0 ? 1 : 0;
     h += "<p><b>Quantised record</b> (grid " + HtmlEscape(q.source) + "): steps of " +
-         Num(q.step_mvv.minCoeff(), "%.3g") + "–" + Num(q.step_mvv.maxCoeff(), "%.3g") +
-         " mV/V. An effect smaller than " + Num(kResolvableSteps, "%.0f") + " steps (RMS " +
-         Num(kResolvableSteps * q.step_mvv.minCoeff(), "%.3g") + "–" +
-         Num(kResolvableSteps * q.step_mvv.maxCoeff(), "%.3g") +
+         StepRange(q.step_mvv, 1.0) + " mV/V" +
+         (gridded < q.step_mvv.size() ? " on " + std::to_string(gridded) + " of " +
+                                            std::to_string(q.step_mvv.size()) + " bridges"
+                                      : std::string()) +
+         ". An effect smaller than " + Num(kResolvableSteps, "%.0f") + " steps (RMS " +
+         StepRange(q.step_mvv, kResolvableSteps) +
          " mV/V) is not claimed: the grid's rounding could mimic it.</p>";
   }
   h += "<p>Load transitions measured: " + std::to_string(k.transitions.size()) + "; " +
