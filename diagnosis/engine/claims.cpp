@@ -67,7 +67,9 @@ void SpreadClaims(Context* cx, std::vector<EffectFit>* claimed_effects) {
     }
     PieceSpreads(cx, rest, &claimed[k]);
     const std::string words = SpreadWords(claimed[k]);
-    if (!words.empty()) claimed[k].evidence += "; the pieces of the record disagree: " + words;
+    if (!words.empty()) {
+      claimed[k].evidence += "; the pieces of the record scatter beyond the curvature σ: " + words;
+    }
   }
 }
 

@@ -31,11 +31,12 @@ namespace ftstack::diag {
 void RefineClaims(const Context& cx, std::vector<EffectFit>* claimed_effects);
 
 /// Each claimed fit's parameter spreads across pieces of the record (PieceSpreads), each refitted
-/// to what the other claimed effects leave; pieces that disagree are said in its evidence.
+/// to what the other claimed effects leave; pieces that scatter beyond the curvature σ are said in
+/// its evidence.
 void SpreadClaims(Context* cx, std::vector<EffectFit>* claimed_effects);
 
 /// Claims the engine's rule no longer lets stand once their pieces are known (NotResolved: a
-/// parameter at a bound, not identified, or whose pieces of the record disagree in sign) are not
+/// parameter not resolved by the engine's one status rule, VerdictOf) are not
 /// findings: they leave the claims for r.dropped ("not_claimed"), with the reason. At least one
 /// claim is kept only when it stands (an empty list means nothing is claimed).
 void DropContradictedClaims(const Context& cx, std::vector<EffectFit>* claimed,

@@ -5,7 +5,9 @@ namespace ftstack::diag {
 std::optional<EffectFit> FitNear(const EffectSpec& spec, const Context& cx, const Series& target,
                                  const EffectFit* near, bool uncertainty) {
   if (spec.refit != nullptr && near != nullptr && near->name == spec.name) {
-    return spec.refit(cx, target, *near, uncertainty);
+    std::optional<EffectFit> fit = spec.refit(cx, target, *near, uncertainty);
+    if (fit) fit->sigma_computed = uncertainty;
+    return fit;
   }
   return spec.fit(cx, target);
 }

@@ -19,7 +19,9 @@ struct EffectFit {
   Series pred;  ///< n × N predicted residual, mV/V
   nlohmann::json params = nlohmann::json::object();
   nlohmann::json sigma = nlohmann::json::object();  ///< 1-σ uncertainty of params (same keys)
-  std::vector<int> channels;                        ///< channels the effect acts on
+  /// False for a refit made without uncertainties (FitNear): its σ entries are not judged.
+  bool sigma_computed = true;
+  std::vector<int> channels;  ///< channels the effect acts on
   /// Figures in a standard's terms computed from the fitted shape, by standard (e.g. "oiml_r60").
   nlohmann::json standard = nlohmann::json::object();
   std::string evidence;

@@ -87,8 +87,11 @@ void SelectPiece(Context* cx, const std::vector<std::uint8_t>& train, double t_l
 /// Pieces whose values differ by less than this fraction of their size read as one value.
 constexpr double kSameValue = 1e-4;
 
-/// The spread of one parameter from its per-piece values (piece × element) and curvature σ.
+/// The spread of one parameter from its per-piece values (piece × element) and curvature σ;
+/// "scatter_over_curvature" when the pieces scatter over 3 × what the curvature σ allows (√pieces
+/// σ per piece) on some element — with residuals correlated in time, true effects do.
 nlohmann::json OneSpread(const std::vector<std::vector<double>>& pieces,
+                         const std::vector<std::vector<double>>& piece_sigmas,
                          const nlohmann::json& sigma) {
   const std::vector<double> curv = Values(sigma);
   const std::size_t m = pieces.size();
@@ -97,15 +100,22 @@ nlohmann::json OneSpread(const std::vector<std::vector<double>>& pieces,
   nlohmann::json hi = nlohmann::json::array();
   nlohmann::json sd = nlohmann::json::array();
   nlohmann::json larger = nlohmann::json::array();
-  bool agree = true;
+  nlohmann::json lo_sigma = nlohmann::json::array();  // the own σ of the piece giving the min
+  nlohmann::json hi_sigma = nlohmann::json::array();
+  bool over = false;
   for (std::size_t e = 0; e < dim; ++e) {
     double mn = std::numeric_limits<double>::infinity();
     double mx = -mn;
     double sum = 0.0;
-    for (const auto& p : pieces) {
-      mn = std::min(mn, p[e]);
-      mx = std::max(mx, p[e]);
-      sum += p[e];
+    double s_mn = std::numeric_limits<double>::quiet_NaN();
+    double s_mx = s_mn;
+    for (std::size_t k = 0; k < m; ++k) {
+      const double x = pieces[k][e];
+      if (x < mn) s_mn = piece_sigmas[k][e];
+      if (x > mx) s_mx = piece_sigmas[k][e];
+      mn = std::min(mn, x);
+      mx = std::max(mx, x);
+      sum += x;
     }
     const double mean = sum / static_cast<double>(m);
     double ss = 0.0;
@@ -117,15 +127,23 @@ nlohmann::json OneSpread(const std::vector<std::vector<double>>& pieces,
     // wandering by 0.01 % is one frequency, and "98.28–98.28" is not a disagreement.
     const bool distinct = mx - mn > kSameValue * std::max(std::fabs(mn), std::fabs(mx));
     if (std::isfinite(c) && distinct && sd_piece > 3.0 * std::sqrt(static_cast<double>(m)) * c)
-      agree = false;
+      over = true;
     lo.push_back(mn);
     hi.push_back(mx);
+    lo_sigma.push_back(fx::JsonNum(s_mn));
+    hi_sigma.push_back(fx::JsonNum(s_mx));
     sd.push_back(s_whole);
     larger.push_back(std::isfinite(c) ? std::max(c, s_whole) : s_whole);
   }
   const auto flat = [dim](nlohmann::json a) { return dim == 1 ? a[0] : a; };
-  return {{"pieces", m},       {"min", flat(lo)},        {"max", flat(hi)},
-          {"sigma", flat(sd)}, {"larger", flat(larger)}, {"agree", agree}};
+  return {{"pieces", m},
+          {"min", flat(lo)},
+          {"max", flat(hi)},
+          {"sigma", flat(sd)},
+          {"larger", flat(larger)},
+          {"min_sigma", flat(lo_sigma)},
+          {"max_sigma", flat(hi_sigma)},
+          {"scatter_over_curvature", over}};
 }
 
 /// The element of largest |value| of a parameter (per-channel parameters: the channel that carries
@@ -158,28 +176,128 @@ std::string BoundWords(const EffectFit& fit, const ParamSpec& r) {
   return "";
 }
 
-/// Why the pieces of the record contradict a declared parameter, or "": for a parameter of one
-/// sign by its physics (lo ≥ 0), the pieces' values of its largest-|value| element straddle zero.
-/// A signed parameter (a delay, an angle) near zero may take either sign in a piece; a wide range
-/// of one sign is an uncertain size: its claim stands, its evidence and spread say the pieces
-/// disagree (a range rule dropped true creep on 4-s-hold fixtures, one piece reading 3× the whole
-/// record's fraction).
-std::string PiecesWords(const EffectFit& fit, const ParamSpec& r) {
-  if (r.lo < 0.0 || !fit.spread.contains(r.key) || !fit.params.contains(r.key)) return "";
-  const auto& s = fit.spread[r.key];
+/// The declaration of `key` among `declared`, or nullptr.
+const ParamSpec* DeclarationOf(const std::vector<ParamSpec>& declared, const std::string& key) {
+  for (const ParamSpec& p : declared) {
+    if (key == p.key) return &p;
+  }
+  return nullptr;
+}
+
+/// Whether a σ entry holds only finite numbers (a number or one per channel).
+bool FiniteSigma(const nlohmann::json& sigma) {
+  const std::vector<double> s = FlatValues(sigma);
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](double x) { return std::isfinite(x); });
+}
+
+/// A value the fit chose rather than fitted: a count (a model order, a tally), a list of them
+/// (the channels it acts on) or a label.
+bool Chosen(const nlohmann::json& v) {
+  if (v.is_array() && !v.empty()) {
+    return std::all_of(v.begin(), v.end(), [](const auto& x) { return x.is_number_integer(); });
+  }
+  return v.is_number_integer() || v.is_boolean() || FlatValues(v).empty();
+}
+
+/// Whether `key` is a figure computed from the fit rather than a parameter it searched or
+/// reports with a σ: a number without a declaration and without a σ entry (a derived value such
+/// as a damped frequency, a participation, a span, a linear solve's levels).
+bool Derived(const EffectFit& fit, const std::string& key, const ParamSpec* d) {
+  return d == nullptr && !fit.sigma.contains(key);
+}
+
+/// Pieces of one sign whose values differ by more than this factor do not give one value.
+constexpr double kPiecesFactor = 2.0;
+
+/// Why the pieces of the record contradict a parameter, or "". One of one sign by its declaration
+/// (lo ≥ 0): the pieces' values of its largest-|value| element straddle zero, or, for a scale
+/// searched in log, they differ by more than kPiecesFactor and by more than 3 σ between two pieces
+/// (each piece's σ √pieces times the whole record's curvature σ). Any other:
+/// OppositeBeyondOwnSigma. A signed parameter (a delay, an angle) near zero may take either sign in
+/// a piece; a spread within a factor kPiecesFactor is an uncertain size, which the spread's σ
+/// reports (the curvature σ alone is too small where residuals are correlated).
+std::string PiecesWords(const EffectFit& fit, const std::string& key, const ParamSpec* d) {
+  if (!fit.spread.contains(key) || !fit.params.contains(key)) return "";
+  const auto& s = fit.spread[key];
   if (!s.contains("min")) return "";
-  const auto [e, value] = LargestElement(fit.params[r.key]);
+  const auto [e, value] = LargestElement(fit.params[key]);
   const nlohmann::json& lo_j = s["min"].is_array() ? s["min"][e] : s["min"];
   const nlohmann::json& hi_j = s["max"].is_array() ? s["max"][e] : s["max"];
   if (value == 0.0 || !lo_j.is_number() || !hi_j.is_number()) return "";
   const double lo = lo_j.get<double>();
   const double hi = hi_j.get<double>();
-  if (lo * hi >= 0.0) return "";
-  return Fmt("not resolved: pieces disagree (%s = %.4g, per piece %.4g–%.4g)", r.key, value, lo,
-             hi);
+  const std::vector<double> curv =
+      fit.sigma.contains(key) ? Values(fit.sigma[key]) : std::vector<double>{};
+  // Without a finite σ there is no telling a factor from noise (PieceSpreads always has one).
+  const double c = e < curv.size() ? curv[e] : std::numeric_limits<double>::quiet_NaN();
+  const double piece_sigma = std::sqrt(s.value("pieces", 2.0)) * c;
+  // A signed parameter (a delay, an angle, a linear coefficient) may take either sign in a piece:
+  // a piece without the load's coverage, or on a converter's grid, reads a coefficient of
+  // either sign, however small its own σ (min_sigma, max_sigma).
+  if (d == nullptr || d->lo < 0.0) return "";
+  if (lo * hi < 0.0) {
+    return Fmt("not resolved: pieces disagree (%s = %.4g, per piece %.4g–%.4g)", key.c_str(), value,
+               lo, hi);
+  }
+  // A factor is a scale's test (searched in log); a linear amplitude is fitted at the nonlinear
+  // parameters' values, so its pieces move with theirs by more than its σ says.
+  if (d->scale != ParamScale::kLog || d->lo <= 0.0) return "";
+  const double small = std::min(std::fabs(lo), std::fabs(hi));
+  const double factor = small > 0.0 ? std::max(std::fabs(lo), std::fabs(hi)) / small
+                                    : std::numeric_limits<double>::infinity();
+  if (!std::isfinite(c) || factor <= kPiecesFactor ||
+      hi - lo <= 3.0 * std::sqrt(2.0) * piece_sigma) {
+    return "";
+  }
+  return Fmt("not resolved: pieces disagree (%s = %.4g, per piece %.4g–%.4g, a factor %.3g)",
+             key.c_str(), value, lo, hi, factor);
 }
 
 }  // namespace
+
+ParamVerdict VerdictOf(const EffectFit& fit, const std::string& key,
+                       const std::vector<ParamSpec>& declared) {
+  ParamVerdict out;
+  const nlohmann::json& v = fit.params[key];
+  if (Chosen(v)) {
+    out.status = ParamStatus::kChosen;
+    return out;
+  }
+  const ParamSpec* d = DeclarationOf(declared, key);
+  if (Derived(fit, key, d)) {  // judged by what it is computed from
+    out.derived = true;
+    for (auto it = fit.params.begin(); it != fit.params.end(); ++it) {
+      const ParamSpec* di = DeclarationOf(declared, it.key());
+      if (it.key() == key || Chosen(it.value()) || Derived(fit, it.key(), di)) continue;
+      out.derived_from.push_back(it.key());
+      const ParamVerdict source = VerdictOf(fit, it.key(), declared);
+      if (out.status == ParamStatus::kResolved && source.status != ParamStatus::kResolved) {
+        out.status = source.status;
+        out.why = Fmt("computed from %s: %s", it.key().c_str(), source.why.c_str());
+      }
+    }
+    return out;
+  }
+  const std::vector<double> values = FlatValues(v);
+  if (d != nullptr) out.why = BoundWords(fit, *d);
+  if (out.why.empty() &&
+      !std::all_of(values.begin(), values.end(), [](double x) { return std::isfinite(x); })) {
+    out.why = Fmt("%s is not finite", key.c_str());
+  }
+  if (!out.why.empty()) {
+    const bool finite = out.why.find("not finite") == std::string::npos;
+    out.status = finite ? ParamStatus::kAtBound : ParamStatus::kNotIdentified;
+    return out;
+  }
+  if (fit.sigma_computed && fit.sigma.contains(key) && !FiniteSigma(fit.sigma[key])) {
+    out.status = ParamStatus::kNotIdentified;
+    out.why = Fmt("%s has no finite σ (the fit does not change with it there)", key.c_str());
+    return out;
+  }
+  out.why = PiecesWords(fit, key, d);
+  if (!out.why.empty()) out.status = ParamStatus::kPiecesDisagree;
+  return out;
+}
 
 std::vector<ParamSpec> DeclaredParams(const Context& cx, const EffectFit& fit,
                                       const EffectSpec& spec) {
@@ -195,14 +313,25 @@ std::string NotResolved(const Context& cx, const EffectFit& fit) {
 
 std::string NotResolved(const Context& cx, const EffectFit& fit, const EffectSpec& spec) {
   const std::vector<ParamSpec> declared = DeclaredParams(cx, fit, spec);
+  // The declared parameters first, in their order, then the others; a bound or a flat profile
+  // before the pieces (its words name the cause, not a symptom of it).
+  std::vector<std::string> keys;
   for (const ParamSpec& r : declared) {
-    std::string words = BoundWords(fit, r);
-    if (!words.empty()) return words;
+    if (fit.params.contains(r.key)) keys.emplace_back(r.key);
   }
-  for (const ParamSpec& r : declared) {
-    std::string words = PiecesWords(fit, r);
-    if (!words.empty()) return words;
+  for (auto it = fit.params.begin(); it != fit.params.end(); ++it) {
+    if (DeclarationOf(declared, it.key()) == nullptr) keys.push_back(it.key());
   }
+  std::string pieces;
+  for (const std::string& key : keys) {
+    const ParamVerdict v = VerdictOf(fit, key, declared);
+    if (v.derived || v.status == ParamStatus::kResolved || v.status == ParamStatus::kChosen) {
+      continue;
+    }
+    if (v.status != ParamStatus::kPiecesDisagree) return v.why;
+    if (pieces.empty()) pieces = v.why;
+  }
+  if (!pieces.empty()) return pieces;
   return WithinGrid(cx, fit);
 }
 
@@ -251,10 +380,7 @@ nlohmann::json TypedParameters(const Context& cx, const EffectFit& fit, const Ef
   for (auto it = fit.params.begin(); it != fit.params.end(); ++it) {
     const std::string& key = it.key();
     const nlohmann::json& v = it.value();
-    const ParamSpec* d = nullptr;
-    for (const ParamSpec& p : declared) {
-      if (key == p.key) d = &p;
-    }
+    const ParamSpec* d = DeclarationOf(declared, key);
     nlohmann::json unit = nullptr;
     const EffectParam* vocab =
         spec != nullptr ? FindParam(EffectOf(spec->kind), key, false) : nullptr;
@@ -263,46 +389,30 @@ nlohmann::json TypedParameters(const Context& cx, const EffectFit& fit, const Ef
     } else if (d != nullptr) {
       unit = d->unit;
     }
-    const std::vector<double> values = FlatValues(v);
-    if (v.is_number_integer() || v.is_boolean() || values.empty()) {
+    const ParamVerdict verdict = VerdictOf(fit, key, declared);
+    if (verdict.status == ParamStatus::kChosen) {
       out.push_back(ChosenNotFitted(key, unit, v));
       continue;
-    }
-    const nlohmann::json sigma = fit.sigma.contains(key) ? fit.sigma[key] : nlohmann::json();
-    double largest = 0.0;
-    for (double x : values) largest = std::max(largest, std::fabs(x));
-    ParamStatus status = ParamStatus::kResolved;
-    if (d != nullptr) {
-      const bool scalar = v.is_number();
-      status = scalar ? StatusOf(*d, values[0])
-                      : (largest > d->hi ? ParamStatus::kAtBound : ParamStatus::kResolved);
-    }
-    const std::vector<double> sig = Values(sigma);
-    bool sigma_finite = !sig.empty();
-    for (double s : sig) sigma_finite = sigma_finite && std::isfinite(s);
-    if (status == ParamStatus::kResolved && !sigma_finite) status = ParamStatus::kNotIdentified;
-    nlohmann::json spread = nullptr;
-    std::string spread_why;
-    if (fit.spread.contains(key) && fit.spread[key].contains("sigma")) {
-      spread = fit.spread[key]["sigma"];
-      const auto& agree = fit.spread[key]["agree"];
-      if (status == ParamStatus::kResolved && agree.is_boolean() && !agree.get<bool>()) {
-        status = ParamStatus::kPiecesDisagree;
-      }
-    } else if (fit.spread.contains(key)) {
-      spread_why = "fewer than two pieces resolved it";
-    } else {
-      spread_why = fit.spread.empty() ? "not refitted on pieces (only claimed effects are)"
-                                      : "no σ to compare pieces with";
     }
     nlohmann::json p = {{"key", key},
                         {"unit", unit},
                         {"value", v},
-                        {"sigma", sigma},
+                        {"sigma", fit.sigma.contains(key) ? fit.sigma[key] : nlohmann::json()},
                         {"range", d != nullptr ? nlohmann::json{d->lo, d->hi} : nlohmann::json()},
-                        {"spread", spread},
-                        {"status", StatusName(status)}};
-    if (spread.is_null()) p["spread_why"] = spread_why;
+                        {"spread", nullptr},
+                        {"status", StatusName(verdict.status)}};
+    if (verdict.derived) {
+      p["derived_from"] = verdict.derived_from;
+      p["spread_why"] = "computed from the fitted parameters in derived_from, not fitted itself";
+    } else if (fit.spread.contains(key) && fit.spread[key].contains("sigma")) {
+      p["spread"] = fit.spread[key]["sigma"];
+    } else if (fit.spread.contains(key)) {
+      p["spread_why"] = "fewer than two pieces resolved it";
+    } else {
+      p["spread_why"] = fit.spread.empty() ? "not refitted on pieces (only claimed effects are)"
+                                           : "no σ to compare pieces with";
+    }
+    if (!verdict.why.empty()) p["why"] = verdict.why;
     out.push_back(p);
   }
   return out;
@@ -315,12 +425,20 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit) {
 
 void PieceSpreads(Context* cx, const Series& target, EffectFit* fit, const EffectSpec& spec) {
   if (fit->sigma.empty()) return;
+  const std::vector<ParamSpec> declared = DeclaredParams(*cx, *fit, spec);
   const std::vector<std::uint8_t> train = cx->train;
   const std::size_t n_train = cx->n_train;
   const auto& t = cx->data->t_s;
   const double span = (t.back() - t.front()) / kSpreadPieces;
-  std::vector<std::pair<std::string, std::vector<std::vector<double>>>> values;
-  for (auto it = fit->sigma.begin(); it != fit->sigma.end(); ++it) values.push_back({it.key(), {}});
+  struct PerPiece {
+    std::string key;
+    std::vector<std::vector<double>> values;
+    std::vector<std::vector<double>> sigmas;  ///< each piece's own σ (NaN where it has none)
+  };
+  std::vector<PerPiece> values;
+  for (auto it = fit->sigma.begin(); it != fit->sigma.end(); ++it) {
+    values.push_back({it.key(), {}, {}});
+  }
   int unresolved = 0;
   for (int p = 0; p < kSpreadPieces; ++p) {
     const double t_lo = t.front() + span * p;
@@ -330,19 +448,35 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit, const Effec
       ++unresolved;
       continue;
     }
-    for (auto& [key, per_piece] : values) {
-      if (piece->params.contains(key)) per_piece.push_back(Values(piece->params[key]));
+    for (PerPiece& pp : values) {
+      if (!piece->params.contains(pp.key)) continue;
+      pp.values.push_back(Values(piece->params[pp.key]));
+      std::vector<double> own =
+          piece->sigma.contains(pp.key) ? Values(piece->sigma[pp.key]) : std::vector<double>{};
+      own.resize(pp.values.back().size(), std::numeric_limits<double>::quiet_NaN());
+      pp.sigmas.push_back(own);
     }
   }
   cx->train = train;
   cx->n_train = n_train;
-  for (auto& [key, per_piece] : values) {
-    const std::vector<double> whole = Values(fit->params[key]);
-    std::erase_if(per_piece, [&](const auto& v) { return v.size() != whole.size() || v.empty(); });
+  for (PerPiece& pp : values) {
+    const std::string& key = pp.key;
+    const std::size_t dim = Values(fit->params[key]).size();
+    std::vector<std::vector<double>> per_piece;
+    std::vector<std::vector<double>> own;
+    for (std::size_t k = 0; k < pp.values.size(); ++k) {
+      if (pp.values[k].size() != dim || dim == 0) continue;
+      per_piece.push_back(pp.values[k]);
+      own.push_back(pp.sigmas[k]);
+    }
     nlohmann::json s = {{"pieces", per_piece.size()}, {"agree", nullptr}};
-    if (per_piece.size() >= 2) s = OneSpread(per_piece, fit->sigma[key]);
+    if (per_piece.size() >= 2) s = OneSpread(per_piece, own, fit->sigma[key]);
     s["unresolved_pieces"] = unresolved;
     fit->spread[key] = s;
+    // "agree" is the claim rule's word on the pieces (VerdictOf), nothing else.
+    if (per_piece.size() >= 2) {
+      fit->spread[key]["agree"] = PiecesWords(*fit, key, DeclarationOf(declared, key)).empty();
+    }
   }
 }
 
@@ -350,7 +484,10 @@ std::string SpreadWords(const EffectFit& fit) {
   std::string out;
   for (auto it = fit.spread.begin(); it != fit.spread.end(); ++it) {
     const auto& s = it.value();
-    if (!s.contains("agree") || !s["agree"].is_boolean() || s["agree"].get<bool>()) continue;
+    const bool disagree = s.contains("agree") && s["agree"].is_boolean() && !s["agree"].get<bool>();
+    const bool over =
+        s.contains("scatter_over_curvature") && s["scatter_over_curvature"].get<bool>();
+    if (!disagree && !over) continue;
     if (s["min"].is_number()) {
       out += Fmt("%s%s per piece %.6g–%.6g", out.empty() ? "" : "; ", it.key().c_str(),
                  s["min"].get<double>(), s["max"].get<double>());

@@ -12,13 +12,33 @@
 
 namespace ftstack::diag {
 
-/// The engine's one rule for every effect: why `fit` is never claimed, or "" when it may be. For
-/// every parameter its plug-in declares (EffectSpec::ranges), in order: at_bound or
-/// not_identified by StatusOf ("tau_s = 0.30 s at its lower bound (3 samples)"; per-channel
-/// values: the largest |value| above hi), then, once PieceSpreads has filled fit.spread,
-/// pieces_disagree for a parameter of one sign by its physics (lo ≥ 0) whose pieces' values (of
-/// its largest element) straddle zero ("not resolved: pieces disagree (fraction = -0.01, per
-/// piece -0.02–0.004)"); last, a prediction within the converter's grid (WithinGrid).
+/// One parameter's status by the engine's one rule (docs/spec/diagnosis.md), and why it is not
+/// resolved.
+struct ParamVerdict {
+  ParamStatus status = ParamStatus::kResolved;
+  std::string why;  ///< "" when resolved or chosen ("tau_s = 0.3 at its lower bound (…)")
+  /// A figure computed from the fit (a number without a declaration and without a σ entry): its
+  /// status is the first non-resolved one of the fit's other numbers that are not derived
+  /// (derived_from), else resolved (computed from the linear coefficients of the fit alone).
+  bool derived = false;
+  std::vector<std::string> derived_from;
+};
+/// The status of fit.params[key]: chosen (a count or a label), at_bound (a declared parameter
+/// within kOnBound of a bound or outside its range; per-channel values: the largest |value| above
+/// hi), not_identified (a value that is not finite, or a σ entry that is not finite where the fit
+/// computed its σ: EffectFit::sigma_computed),
+/// pieces_disagree (once PieceSpreads has filled fit.spread: a parameter of one sign by its
+/// declaration, lo ≥ 0, whose pieces' values of its largest element straddle zero, or, a scale
+/// searched in log, differ by more than a factor 2 and 3 σ between two pieces), else resolved. A
+/// declared parameter without a σ entry (a fit made without uncertainties) is judged by its range
+/// and pieces.
+[[nodiscard]] ParamVerdict VerdictOf(const EffectFit& fit, const std::string& key,
+                                     const std::vector<ParamSpec>& declared);
+
+/// The engine's claim rule for every effect: why `fit` is never claimed, or "" when it may be: the
+/// first parameter whose VerdictOf is neither resolved nor chosen (the declared ones first, a
+/// bound or a flat profile before pieces that disagree; a derived figure is judged through what
+/// it is computed from), then a prediction within the converter's grid (WithinGrid).
 [[nodiscard]] std::string NotResolved(const Context& cx, const EffectFit& fit);
 /// The same against a given plug-in (one the registry need not hold).
 [[nodiscard]] std::string NotResolved(const Context& cx, const EffectFit& fit,
@@ -41,10 +61,11 @@ inline constexpr int kSpreadPieces = 4;
 /// consecutive spans of equal length, each fit reading only its span's training rows. For every
 /// parameter with a σ, fit->spread[key] = {"pieces", "min", "max" (per channel for per-channel
 /// parameters), "sigma" (the pieces' standard deviation / √pieces: the spread σ of the whole
-/// record's estimate), "larger" (max of that and the curvature σ), "agree"} — "agree" false when
-/// the pieces scatter over 3 × what the curvature σ allows (√pieces σ per piece). A piece whose
-/// refit fails or is not resolved is left out and counted in "unresolved_pieces". cx's hold-out
-/// mask is restored before returning.
+/// record's estimate), "larger" (max of that and the curvature σ), "min_sigma"/"max_sigma" (the
+/// own σ of the pieces giving min and max, null without one), "scatter_over_curvature" (the
+/// pieces scatter over 3 × what the curvature σ allows, √pieces σ per piece), "agree" (false when
+/// VerdictOf says pieces_disagree)}. A piece whose refit fails or is not resolved is left out
+/// and counted in "unresolved_pieces". cx's hold-out mask is restored before returning.
 void PieceSpreads(Context* cx, const Series& target, EffectFit* fit);
 /// The same with a given plug-in (one the registry need not hold).
 void PieceSpreads(Context* cx, const Series& target, EffectFit* fit, const EffectSpec& spec);
@@ -54,12 +75,10 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit, const Effec
 
 /// The report's typed `parameters` of a fit (docs/spec/diagnosis.md): one object per key of
 /// fit.params (a count or a label the fit chose: sigma, range and spread null, "chosen") with
-/// "key",
-/// "unit" (the vocabulary's, else the effect's declaration, else null), "value", "sigma" (null
-/// without one), "range" ([lo, hi] from the declaration, else null), "spread" (the pieces' σ, or
-/// null) with "spread_why" when null, and "status": at_bound or not_identified by the declared
-/// range and σ (StatusOf), pieces_disagree when the spread says so, else resolved; a parameter
-/// without a declaration and without a σ is not_identified.
+/// "key", "unit" (the vocabulary's, else the effect's declaration, else null), "value", "sigma"
+/// (null without one), "range" ([lo, hi] from the declaration, else null), "spread" (the pieces'
+/// σ, or null) with "spread_why" when null, "status" by VerdictOf (the claim rule's), "why" when
+/// not resolved, and "derived_from" for a figure computed from the fit.
 [[nodiscard]] nlohmann::json TypedParameters(const Context& cx, const EffectFit& fit);
 /// The same against a given plug-in (one the registry need not hold).
 [[nodiscard]] nlohmann::json TypedParameters(const Context& cx, const EffectFit& fit,

@@ -290,17 +290,28 @@ TEST(DiagHonesty, RingingPerChangeIsCheckedAgainstItsOwnDeclaredRange) {
   }
 }
 
+/// The typed status of `key` in a TypedParameters list, or "" without it.
+std::string StatusIn(const nlohmann::json& typed, const std::string& key) {
+  for (const auto& p : typed) {
+    if (p["key"] == key) return p["status"].get<std::string>();
+  }
+  return "";
+}
+
 // The pieces rule in closed form: a claim is contradicted when the pieces' values of its largest
 // element straddle zero (here b1's creep fraction −0.01, pieces −0.02…+0.004); b0's pieces
-// straddle zero too but b0 does not carry the effect; pieces of one sign leave the claim standing.
-// The evidence words name the channel whose pieces they quote.
-TEST(DiagHonesty, PiecesStraddlingZeroContradictAClaimAndOneSignDoesNot) {
+// straddle zero too but b0 does not carry the effect; the pieces of a scale searched in log (τ)
+// contradict it when they differ by more than a factor 2 and by more than 3 σ between two pieces
+// (σ per piece √4 × the curvature σ), not within a factor 2. The evidence words name the channel
+// whose pieces they quote.
+TEST(DiagHonesty, PiecesStraddlingZeroOrAFactorApartContradictAClaim) {
   const auto fx = testing::MakeFixture({}, 3, 200.0, kNoise, 4.0);
   const Context cx = MakeContext(fx.data);
   EffectFit f;
   f.name = "creep";
   f.params["tau_s"] = 12.0;
   f.params["fraction"] = {0.004, -0.01, 0.001};
+  f.sigma["fraction"] = {1e-4, 1e-4, 1e-4};
   f.spread["fraction"] = {{"pieces", 4},
                           {"agree", false},
                           {"min", {-0.001, -0.02, 0.0005}},
@@ -310,8 +321,21 @@ TEST(DiagHonesty, PiecesStraddlingZeroContradictAClaimAndOneSignDoesNot) {
   EXPECT_EQ(SpreadWords(f), "fraction on b1 per piece -0.02–0.004");
   f.spread["fraction"]["min"] = {-0.001, -0.03, 0.0005};
   f.spread["fraction"]["max"] = {0.005, -0.002, 0.002};
-  EXPECT_EQ(NotResolved(cx, f), "");
+  EXPECT_EQ(NotResolved(cx, f), "");  // one sign: a linear amplitude is not judged by a factor
   EXPECT_EQ(SpreadWords(f), "fraction on b1 per piece -0.03–-0.002");
+  // τ, a scale searched in log: pieces 6–30 s (a factor 5) over 3 σ apart (8.5e-2 s) contradict.
+  f.spread.erase("fraction");
+  f.sigma["tau_s"] = 0.01;
+  f.spread["tau_s"] = {{"pieces", 4}, {"min", 6.0}, {"max", 30.0}};
+  EXPECT_NE(NotResolved(cx, f).find("tau_s = 12, per piece 6–30, a factor 5"), std::string::npos)
+      << NotResolved(cx, f);
+  EXPECT_EQ(StatusIn(TypedParameters(cx, f), "tau_s"), "pieces_disagree");
+  f.spread["tau_s"]["min"] = 16.0;
+  EXPECT_EQ(NotResolved(cx, f), "");  // a factor 1.9
+  EXPECT_EQ(StatusIn(TypedParameters(cx, f), "tau_s"), "resolved");
+  f.spread["tau_s"]["min"] = 6.0;
+  f.sigma["tau_s"] = 3.0;
+  EXPECT_EQ(NotResolved(cx, f), "");  // a factor 5 within 3 σ between two pieces (25 s)
   // A parameter without a stated range (an onset time is the piece's own) never contradicts.
   EffectFit o;
   o.name = "overload_shift";
@@ -319,6 +343,19 @@ TEST(DiagHonesty, PiecesStraddlingZeroContradictAClaimAndOneSignDoesNot) {
   o.spread["onset_s"] = {{"pieces", 3}, {"agree", false}, {"min", -1.0}, {"max", 3.0}};
   EXPECT_EQ(NotResolved(cx, o), "");
   EXPECT_EQ(SpreadWords(o), "onset_s per piece -1–3");
+  // Nor does a signed coefficient whose pieces straddle zero, even where each piece's own σ is
+  // small: a true cubic on a converter's grid reads −0.92…0.99 per piece.
+  EffectFit g;
+  g.name = "overload_shift";
+  g.params["recovering_shift"] = {0.001, 0.3};
+  g.sigma["recovering_shift"] = {1e-3, 1e-3};
+  g.spread["recovering_shift"] = {{"pieces", 2},
+                                  {"min", {-0.001, -0.2}},
+                                  {"max", {0.002, 0.3}},
+                                  {"min_sigma", {1e-3, 0.01}},
+                                  {"max_sigma", {1e-3, 0.01}}};
+  EXPECT_EQ(NotResolved(cx, g), "");
+  EXPECT_EQ(StatusIn(TypedParameters(cx, g), "recovering_shift"), "resolved");
 }
 
 // The spread across pieces of the record covers the truth on data the creep model describes, and
@@ -355,7 +392,12 @@ TEST(DiagFixtureNone, NoiseOnlyMakesNoClaim) {
 TEST(DiagFixturePairs, OffsetAndCreepAreBothNamed) {
   const auto fx = testing::MakeFixture({{"zero_offset", 5}, {"creep", 5}}, 2, 200.0, kNoise, 4.0);
   const Report r = Diagnose(fx.data);
-  ASSERT_EQ(r.effects.size(), 2u);
+  std::string said;
+  for (const auto& e : r.effects)
+    said += e.fit.name + " " + TypedParameters(r.cx, e.fit).dump() + "\n";
+  for (const auto& d : r.dropped) said += "not claimed: " + d + "\n";
+  for (const auto& c : r.candidates) said += "candidate " + c.name + ": " + c.not_resolved + "\n";
+  ASSERT_EQ(r.effects.size(), 2u) << said;
   std::vector<std::string> names{r.effects[0].fit.name, r.effects[1].fit.name};
   std::sort(names.begin(), names.end());
   EXPECT_EQ(names, (std::vector<std::string>{"creep", "zero_offset"}));

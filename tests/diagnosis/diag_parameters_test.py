@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """ftdiag's typed `parameters` on real and generated recordings: every key of every effect's,
 finding's `params` has an entry (and every candidate's entry) with key, unit, value, sigma, range, spread and
-status, and its unit is the effect vocabulary's.
+status, and its unit is the effect vocabulary's. No claimed effect carries a parameter whose
+status is not resolved (or chosen), and a candidate that carries one is not resolved.
 
 The reference for the units is the vocabulary's source (measurement/effect_vocabulary.hpp), read
 here with a regular expression, not ftdiag's writer. Recordings: the vendored real files
@@ -68,6 +69,13 @@ def check(report, what, units, failures):
                     failures.append(f"{where} value {p.get('value')!r} != params {value!r}")
                 if p.get("status") not in STATUSES:
                     failures.append(f"{where} status {p.get('status')!r}")
+                # The claim rule and the status are one: a claim carries no parameter that is
+                # not resolved (a count or label is "chosen"); a candidate with one says why.
+                unresolved = p.get("status") not in ("resolved", "chosen")
+                if unresolved and section == "effects":
+                    failures.append(f"{where} is claimed with status {p.get('status')!r}")
+                if unresolved and section == "candidates" and not e.get("not_resolved"):
+                    failures.append(f"{where} is {p.get('status')!r}, the candidate resolved")
                 checked += 1
     print(f"{what}: {checked} parameters checked")
     if checked == 0:

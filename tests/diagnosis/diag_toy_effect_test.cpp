@@ -44,6 +44,7 @@ std::optional<EffectFit> FitWarmup(const Context& cx, const Series& target) {
   e.params["warmup_tau_s"] = s.param.value;
   e.sigma["warmup_tau_s"] = fx::JsonNum(s.param.sigma);
   fx::PutChannelCoef(cx, s.linear, 0, "amplitude_mvv", &e);
+  e.params["warmup_half_life_s"] = s.param.value * std::log(2.0);  // derived: no σ, no range
   e.evidence = fx::Fmt("a transient decaying with τ = %.3g s", s.param.value);
   return e;
 }
@@ -76,6 +77,24 @@ EffectSpec ToyGain() {
   EffectSpec s;
   s.fit = &FitGain;
   s.ranges = &GainSpecs;
+  return s;
+}
+
+/// The same gain declared as a scale (searched in log, 0.01 % to 5 %): its pieces are judged by
+/// a factor too.
+std::vector<ParamSpec> GainScaleSpecs(const Context& /*cx*/) {
+  return {{.key = "gain_fraction",
+           .lo = 1e-4,
+           .hi = 0.05,
+           .lo_what = "0.01 %",
+           .hi_what = "5 %",
+           .scale = ParamScale::kLog}};
+}
+
+EffectSpec ToyGainScale() {
+  EffectSpec s;
+  s.fit = &FitGain;
+  s.ranges = &GainScaleSpecs;
   return s;
 }
 
@@ -138,6 +157,10 @@ TEST(DiagToyEffect, SearchedInsideItsRangeAndTyped) {
   ASSERT_FALSE(amp.is_null());
   EXPECT_NEAR(fit->params["amplitude_mvv"][0].get<double>(), 0.05, 2e-3);
   EXPECT_EQ(amp["status"], "resolved");
+  // A figure computed from the fitted ones is typed as such, with their status.
+  const auto& half = Typed(typed, "warmup_half_life_s");
+  EXPECT_EQ(half["status"], "resolved") << half.dump();
+  EXPECT_EQ(half["derived_from"], nlohmann::json({"amplitude_mvv", "warmup_tau_s"}));
 }
 
 TEST(DiagToyEffect, TruthOutsideItsRangeEndsAtTheBoundAndIsNotResolved) {
@@ -152,16 +175,18 @@ TEST(DiagToyEffect, TruthOutsideItsRangeEndsAtTheBoundAndIsNotResolved) {
   const auto& p = Typed(typed, "warmup_tau_s");
   ASSERT_FALSE(p.is_null()) << typed.dump();
   EXPECT_EQ(p["status"], "at_bound");
+  // The derived half-life is no better than the τ it is computed from.
+  EXPECT_EQ(Typed(typed, "warmup_half_life_s")["status"], "at_bound") << typed.dump();
 }
 
 /// 3 bridges at 100 Hz for 60 s on random load steps; real = sim·(1 + g) + noise 1e-4, g = +1 %
-/// on every bridge, except from `flip_s` on, where it is −1 %.
-DiagData GainFlip(double flip_s, unsigned seed) {
+/// on every bridge, except from `switch_s` on, where it is `gain_after`.
+DiagData GainSwitch(double switch_s, double gain_after, unsigned seed) {
   DiagData d = Warmup(1.0, seed);  // its load steps; its real columns are replaced
   std::mt19937 rng(seed + 1U);
   std::normal_distribution<double> g(0.0, 1.0);
   for (Eigen::Index i = 0; i < d.sim_mvv.rows(); ++i) {
-    const double gain = d.t_s[static_cast<std::size_t>(i)] < flip_s ? 0.01 : -0.01;
+    const double gain = d.t_s[static_cast<std::size_t>(i)] < switch_s ? 0.01 : gain_after;
     for (Eigen::Index c = 0; c < d.sim_mvv.cols(); ++c) {
       d.real_mvv(i, c) = d.sim_mvv(i, c) * (1.0 + gain) + 1e-4 * g(rng);
     }
@@ -175,7 +200,7 @@ DiagData GainFlip(double flip_s, unsigned seed) {
 TEST(DiagToyEffect, PiecesThatDisagreeInSignAreNeverClaimed) {
   const EffectSpec spec = ToyGain();
   for (const double flip_s : {46.0, 1e9}) {
-    const DiagData d = GainFlip(flip_s, 11);
+    const DiagData d = GainSwitch(flip_s, -0.01, 11);
     Context cx = MakeContext(d);
     auto fit = FitGain(cx, cx.resid);
     ASSERT_TRUE(fit);
@@ -183,11 +208,48 @@ TEST(DiagToyEffect, PiecesThatDisagreeInSignAreNeverClaimed) {
     PieceSpreads(&cx, cx.resid, &*fit, spec);
     ASSERT_TRUE(fit->spread.contains("gain_fraction")) << fit->spread.dump();
     const std::string why = NotResolved(cx, *fit, spec);
+    const std::string status = Typed(TypedParameters(cx, *fit, spec), "gain_fraction")["status"];
     if (flip_s < 60.0) {
       EXPECT_NE(why.find("pieces disagree (gain_fraction"), std::string::npos)
           << why << " " << fit->spread.dump();
+      EXPECT_EQ(status, "pieces_disagree");
     } else {
       EXPECT_EQ(why, "") << fit->spread.dump();
+      EXPECT_EQ(status, "resolved");
+    }
+  }
+}
+
+// Pieces of one sign of a scale: a gain of +1 % that becomes +3 % in the last of the 4 pieces (a
+// factor 3, far over the noise) is not one value: never claimed, its status pieces_disagree, and
+// the claim rule and the typed status say the same. A gain that becomes +1.5 % (a factor 1.5)
+// scatters over the curvature σ but is one uncertain value: claimed, resolved, the scatter
+// reported.
+TEST(DiagToyEffect, PiecesThatDifferByMoreThanAFactorTwoAreNeverClaimed) {
+  const EffectSpec spec = ToyGainScale();
+  struct Case {
+    double gain_after;
+    bool claimed;
+  };
+  for (const Case c : {Case{0.03, false}, Case{0.015, true}, Case{0.01, true}}) {
+    const DiagData d = GainSwitch(46.0, c.gain_after, 12);
+    Context cx = MakeContext(d);
+    auto fit = FitGain(cx, cx.resid);
+    ASSERT_TRUE(fit);
+    PieceSpreads(&cx, cx.resid, &*fit, spec);
+    const std::string why = NotResolved(cx, *fit, spec);
+    const nlohmann::json typed = Typed(TypedParameters(cx, *fit, spec), "gain_fraction");
+    const auto& s = fit->spread["gain_fraction"];
+    if (c.claimed) {
+      EXPECT_EQ(why, "") << c.gain_after << " " << s.dump();
+      EXPECT_EQ(typed["status"], "resolved") << typed.dump();
+      EXPECT_TRUE(s["agree"].get<bool>());
+      EXPECT_EQ(s["scatter_over_curvature"].get<bool>(), c.gain_after != 0.01) << s.dump();
+    } else {
+      EXPECT_NE(why.find("a factor"), std::string::npos) << why << " " << s.dump();
+      EXPECT_EQ(typed["status"], "pieces_disagree") << typed.dump();
+      EXPECT_EQ(typed["why"], why);
+      EXPECT_FALSE(s["agree"].get<bool>());
     }
   }
 }
