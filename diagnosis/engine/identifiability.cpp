@@ -6,8 +6,10 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <optional>
 
 #include "diagnosis/engine/debug.hpp"
+#include "diagnosis/engine/parallel.hpp"
 #include "diagnosis/engine/signal.hpp"
 
 namespace ftstack::diag {
@@ -442,7 +444,7 @@ bool RowIdentifies(const Context& cx, const EffectFit& fit, const ConfounderRow&
 }  // namespace
 
 Confounding CheckConfounders(const Context& cx, const Series& target, const EffectFit& fit,
-                             double z_claim) {
+                             double z_claim, int threads) {
   Confounding out;
   const EffectSpec* spec = FindEffect(fit.name);
   if (spec == nullptr || spec->confounders == kNoConfounders) return out;
@@ -475,13 +477,23 @@ Confounding CheckConfounders(const Context& cx, const Series& target, const Effe
     *z_rest = JointBeyond(cx, target, fit, *spec, confounder, s_alone, &delta);
     return *z_rest > z_claim && delta > 0.0;
   };
-  std::vector<std::string> words;
+  // The rows are independent tests: run side by side (threads), reported in the table's order.
+  std::vector<const ConfounderRow*> rows;
   for (const ConfounderRow& row : kConfounderTable) {
-    if ((spec->confounders & row.bit) == 0U) continue;
+    if ((spec->confounders & row.bit) != 0U) rows.push_back(&row);
+  }
+  std::vector<std::optional<std::string>> confounds(rows.size());
+  ParallelFor(rows.size(), threads, [&](std::size_t k) {
     std::string sentence;
-    if (RowIdentifies(cx, fit, row, z_claim, z_alone, simpler, beyond, &sentence)) continue;
-    out.with.emplace_back(row.name);
-    words.push_back(std::move(sentence));
+    if (!RowIdentifies(cx, fit, *rows[k], z_claim, z_alone, simpler, beyond, &sentence)) {
+      confounds[k] = std::move(sentence);
+    }
+  });
+  std::vector<std::string> words;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    if (!confounds[k]) continue;
+    out.with.emplace_back(rows[k]->name);
+    words.push_back(std::move(*confounds[k]));
   }
   if ((spec->confounders & kTimeDrift) != 0U && cx.data->has_temp()) {
     std::string sentence = DriftInTimeConfounds(cx, target, beyond, &out);
