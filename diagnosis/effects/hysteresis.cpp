@@ -122,14 +122,9 @@ struct RelayGrid {
 };
 
 RelayGrid MakeGrid(const double* x, std::size_t n) {
-  std::vector<double> sorted(x, x + n);
-  std::sort(sorted.begin(), sorted.end());
   std::array<double, kLevels> level{};
-  for (int k = 0; k < kLevels; ++k) {
-    const double q = (k + 0.5) / kLevels;
-    level[static_cast<std::size_t>(k)] =
-        sorted[static_cast<std::size_t>(q * static_cast<double>(n - 1))];
-  }
+  std::vector<double> work(x, x + n);
+  MidQuantiles(&work, kLevels, level.data());
   RelayGrid g;
   g.level = level;
   int j = 0;

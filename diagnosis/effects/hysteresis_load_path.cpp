@@ -196,12 +196,8 @@ AxisOperators AxisRelays(const DiagData& d, const std::vector<int>& axes) {
   o.per_axis = kLevels * (kLevels - 1) / 2;
   for (int a : axes) {
     std::vector<double> v(d.wrench.col(a).data(), d.wrench.col(a).data() + d.wrench.rows());
-    std::sort(v.begin(), v.end());
     std::array<double, kLevels> level{};
-    for (int k = 0; k < kLevels; ++k) {
-      level[static_cast<std::size_t>(k)] =
-          v[static_cast<std::size_t>((k + 0.5) / kLevels * static_cast<double>(v.size() - 1))];
-    }
+    MidQuantiles(&v, kLevels, level.data());
     for (int lo = 0; lo < kLevels; ++lo) {
       for (int hi = lo + 1; hi < kLevels; ++hi) {
         o.down.push_back(level[static_cast<std::size_t>(lo)]);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "diagnosis/engine/parallel.hpp"
 #include "diagnosis/engine/plausibility.hpp"
 #include "diagnosis/engine/ranking.hpp"
 #include "diagnosis/engine/signal.hpp"
@@ -22,13 +23,14 @@ Eigen::VectorXd ChannelRms(const Series& a, const Series* b) {
   return v;
 }
 
-std::vector<Confounding> DropUnidentifiedPartner(const Context& cx, double z_claim,
+std::vector<Confounding> DropUnidentifiedPartner(const Context& cx, const DiagnoseOptions& options,
                                                  std::vector<EffectFit>* claimed,
                                                  std::vector<std::string>* dropped) {
   std::vector<Confounding> partner_conf;
   if (claimed->size() != 2 || HasTrait((*claimed)[0], kTimeBased)) return partner_conf;
   const Series rest = cx.resid - (*claimed)[0].pred;
-  partner_conf.push_back(CheckConfounders(cx, rest, (*claimed)[1], z_claim));
+  partner_conf.push_back(
+      CheckConfounders(cx, rest, (*claimed)[1], options.z_claim, ResolveThreads(options.threads)));
   const auto& with = partner_conf.back().with;
   if (std::find(with.begin(), with.end(), "hold_offsets") != with.end() ||
       std::find(with.begin(), with.end(), "load_polynomial") != with.end()) {
@@ -104,9 +106,10 @@ void RecordClaims(Report& r, const DiagnoseOptions& options, std::vector<EffectF
     ce.rms_after = ChannelRms(cx.resid, &cum);
     // Each effect is tested against its confounders on what the other claimed effects leave.
     const auto check = [&] {
-      if (k == 0) return CheckConfounders(cx, cx.resid, f, options.z_claim);
+      const int threads = ResolveThreads(options.threads);
+      if (k == 0) return CheckConfounders(cx, cx.resid, f, options.z_claim, threads);
       const Series others_left = cx.resid - (cum - f.pred);
-      return CheckConfounders(cx, others_left, f, options.z_claim);
+      return CheckConfounders(cx, others_left, f, options.z_claim, threads);
     };
     const Confounding conf = k == 1 && !partner_conf.empty() ? partner_conf.front() : check();
     ce.confounded_with = conf.with;

@@ -20,7 +20,8 @@ namespace ftstack::diag {
 /// of the load, which a time curve follows) is not claimed: the data cannot tell it from the first
 /// effect's remainder. Returns the partner's
 /// confounding when it stays (empty otherwise).
-[[nodiscard]] std::vector<Confounding> DropUnidentifiedPartner(const Context& cx, double z_claim,
+[[nodiscard]] std::vector<Confounding> DropUnidentifiedPartner(const Context& cx,
+                                                               const DiagnoseOptions& options,
                                                                std::vector<EffectFit>* claimed,
                                                                std::vector<std::string>* dropped);
 

@@ -6,8 +6,10 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <optional>
 
 #include "diagnosis/engine/debug.hpp"
+#include "diagnosis/engine/parallel.hpp"
 #include "diagnosis/engine/signal.hpp"
 
 namespace ftstack::diag {
@@ -326,6 +328,9 @@ double JointBeyond(const Context& cx, const Series& target, const EffectFit& fit
 
 namespace {
 
+/// Bytes of joint fits CheckConfounders may hold beside the first to test rows side by side.
+constexpr double kRowsBatchBytes = 64.0 * 1024 * 1024;
+
 /// Tests whether one confounder, fitted in `n_params` parameters, leaves the effect identified
 /// (CheckConfounders' test); *z_rest gets the effect's z beyond it.
 using BeyondFn =
@@ -442,7 +447,7 @@ bool RowIdentifies(const Context& cx, const EffectFit& fit, const ConfounderRow&
 }  // namespace
 
 Confounding CheckConfounders(const Context& cx, const Series& target, const EffectFit& fit,
-                             double z_claim) {
+                             double z_claim, int threads) {
   Confounding out;
   const EffectSpec* spec = FindEffect(fit.name);
   if (spec == nullptr || spec->confounders == kNoConfounders) return out;
@@ -475,13 +480,28 @@ Confounding CheckConfounders(const Context& cx, const Series& target, const Effe
     *z_rest = JointBeyond(cx, target, fit, *spec, confounder, s_alone, &delta);
     return *z_rest > z_claim && delta > 0.0;
   };
-  std::vector<std::string> words;
+  // The rows are independent tests: run side by side (threads), reported in the table's order.
+  std::vector<const ConfounderRow*> rows;
   for (const ConfounderRow& row : kConfounderTable) {
-    if ((spec->confounders & row.bit) == 0U) continue;
+    if ((spec->confounders & row.bit) != 0U) rows.push_back(&row);
+  }
+  std::vector<std::optional<std::string>> confounds(rows.size());
+  // Memory: a row's joint fit holds about four n × N series; side by side only while those of
+  // the extra threads fit in kRowsBatchBytes (10^5 rows × 8 channels do; 10^6 run one by one,
+  // which keeps the peak of the largest records where it was).
+  const double row_bytes = 4.0 * static_cast<double>(cx.n) * cx.nc * sizeof(float);
+  const int side_by_side = row_bytes * (threads - 1) <= kRowsBatchBytes ? threads : 1;
+  ParallelFor(rows.size(), side_by_side, [&](std::size_t k) {
     std::string sentence;
-    if (RowIdentifies(cx, fit, row, z_claim, z_alone, simpler, beyond, &sentence)) continue;
-    out.with.emplace_back(row.name);
-    words.push_back(std::move(sentence));
+    if (!RowIdentifies(cx, fit, *rows[k], z_claim, z_alone, simpler, beyond, &sentence)) {
+      confounds[k] = std::move(sentence);
+    }
+  });
+  std::vector<std::string> words;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    if (!confounds[k]) continue;
+    out.with.emplace_back(rows[k]->name);
+    words.push_back(std::move(*confounds[k]));
   }
   if ((spec->confounders & kTimeDrift) != 0U && cx.data->has_temp()) {
     std::string sentence = DriftInTimeConfounds(cx, target, beyond, &out);

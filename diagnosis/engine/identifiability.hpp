@@ -37,8 +37,9 @@ struct Confounding {
 ///    channel (28 terms): a smooth function of the load, ramps included;
 ///  - kTimeDrift (the kDriftInTime effect, reported by its name): where the temperature is
 ///    monotone in time (|Spearman ρ| > 0.95).
+/// The table's rows are tested on up to `threads` threads (the result does not depend on it).
 [[nodiscard]] Confounding CheckConfounders(const Context& cx, const Series& target,
-                                           const EffectFit& fit, double z_claim);
+                                           const EffectFit& fit, double z_claim, int threads = 1);
 
 /// Group of every row for an offset confounder (kSegmentOffsets, kLoadOffsets, kHoldOffsets);
 /// empty when it does not apply to the data. *groups receives the number of groups.

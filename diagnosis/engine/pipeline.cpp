@@ -123,7 +123,7 @@ Report DiagnoseWith(Context context, const DiagnoseOptions& options) {
   RefineClaims(cx, &claimed);
   DebugTime("claims", "refinements", t0);
   std::vector<Confounding> partner_conf =
-      DropUnidentifiedPartner(cx, options.z_claim, &claimed, &r.dropped);
+      DropUnidentifiedPartner(cx, options, &claimed, &r.dropped);
   DebugTime("claims", "partner identifiability", t0);
   // A third refits the pair beside it: the partner's confounders are then checked anew.
   if (claimed.size() == 2 && GrowThird(cx, options, near, &claimed)) partner_conf.clear();

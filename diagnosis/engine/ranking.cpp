@@ -407,8 +407,18 @@ std::vector<ThirdCandidate> ScanThirds(const Context& cx, const DiagnoseOptions&
                                        const std::vector<const EffectFit*>& todo,
                                        const Series& rest, double rest_hold_sse, double excess) {
   std::vector<std::optional<Scored>> tried(todo.size());
+  // The costliest fits start first (the threads then end together); each lands in its own slot.
+  std::vector<std::size_t> order(todo.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  const auto cost = [&](std::size_t k) {
+    const EffectSpec* spec = FindEffect(todo[k]->name);
+    return spec != nullptr ? spec->cost : 0;
+  };
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t u, std::size_t v) { return cost(u) > cost(v); });
   std::mutex mu;
-  ParallelFor(todo.size(), ResolveThreads(options.threads), [&](std::size_t k) {
+  ParallelFor(order.size(), ResolveThreads(options.threads), [&](std::size_t o) {
+    const std::size_t k = order[o];
     const EffectSpec* spec = FindEffect(todo[k]->name);
     const auto t0 = std::chrono::steady_clock::now();
     auto f = spec != nullptr ? FitNear(*spec, cx, rest, todo[k], false) : std::nullopt;
@@ -521,7 +531,8 @@ bool GrowThird(const Context& cx, const DiagnoseOptions& options,
     // load or a drift in time that explains it as well leaves the pair as it was.
     Series others = cx.resid - (*best)[0].pred;
     others -= (*best)[1].pred;
-    const Confounding conf = CheckConfounders(cx, others, (*best)[2], options.z_claim);
+    const Confounding conf =
+        CheckConfounders(cx, others, (*best)[2], options.z_claim, ResolveThreads(options.threads));
     if (DebugOn()) {
       std::fprintf(stderr, "third %s beside the pair: confounded with %zu\n",
                    (*best)[2].name.c_str(), conf.with.size());

@@ -84,6 +84,19 @@ NormalEq::Result NormalEq::Solve() const {
   return r;
 }
 
+void MidQuantiles(std::vector<double>* v, int levels, double* level) {
+  const auto n = static_cast<double>(v->size() - 1);
+  auto from = v->begin();
+  for (int k = 0; k < levels; ++k) {
+    const auto at = v->begin() + static_cast<std::ptrdiff_t>((k + 0.5) / levels * n);
+    if (at >= from) {
+      std::nth_element(from, at, v->end());
+      from = at + 1;
+    }
+    level[k] = *at;
+  }
+}
+
 void DahlOperator(const double* x, std::size_t n, double width, double* z) {
   if (n == 0) return;
   double zz = 0.0;

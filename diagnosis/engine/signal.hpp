@@ -60,6 +60,11 @@ void DahlOperator(const double* x, std::size_t n, double width, double* z);
 [[nodiscard]] double InterpolateNear(const double* t, const double* x, std::size_t n, double tq,
                                      bool uniform, std::size_t guess);
 
+/// The values at sorted positions ⌊(k + ½)/levels · (n − 1)⌋, k = 0 … levels − 1, of *v (n ≥ 1
+/// values; reordered) into level[k]: exactly those of a full sort, selected (nth_element) each in
+/// what the previous leaves above it.
+void MidQuantiles(std::vector<double>* v, int levels, double* level);
+
 /// Pearson correlation of two equally long series.
 [[nodiscard]] double Correlation(const double* a, const double* b, std::size_t n);
 /// The same of single-precision series, each value widened to double (the same sums, in the same
