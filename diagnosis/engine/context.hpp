@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "diagnosis/engine/conditioning.hpp"
-#include "diagnosis/loader/data.hpp"
 #include "diagnosis/engine/lag_cache.hpp"
 #include "diagnosis/engine/quantisation.hpp"
+#include "diagnosis/loader/data.hpp"
 
 namespace ftstack::diag {
 

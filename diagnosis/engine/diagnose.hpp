@@ -7,8 +7,8 @@
 #include <utility>
 #include <vector>
 
-#include "diagnosis/loader/data.hpp"
 #include "diagnosis/engine/effect.hpp"
+#include "diagnosis/loader/data.hpp"
 
 namespace ftstack::diag {
 

@@ -11,12 +11,12 @@
 #include <unistd.h>
 
 #include "diagnosis/effects/families.hpp"
-#include "diagnosis/loader/data.hpp"
 #include "diagnosis/engine/diagnose.hpp"
 #include "diagnosis/engine/effect.hpp"
 #include "diagnosis/engine/plausibility.hpp"
 #include "diagnosis/engine/signal.hpp"
 #include "diagnosis/filters/lowpass.hpp"
+#include "diagnosis/loader/data.hpp"
 #include "diagnosis/report/html_report.hpp"
 #include "diagnosis/report/json_report.hpp"
 #include "tests/diagnosis/diag_fixture.hpp"

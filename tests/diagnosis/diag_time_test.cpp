@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/loader/data.hpp"
 #include "diagnosis/engine/effect.hpp"
 #include "diagnosis/engine/signal.hpp"
 #include "diagnosis/filters/lowpass.hpp"
+#include "diagnosis/loader/data.hpp"
 #include "measurement/recording.hpp"
 
 namespace ftstack::diag {
