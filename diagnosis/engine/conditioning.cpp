@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "diagnosis/engine/context.hpp"
+#include "diagnosis/engine/parallel.hpp"
 
 namespace ftstack::diag {
 
@@ -91,7 +92,11 @@ void NeighbourLine(Get x, int i, double* at_i, double* spread) {
 /// ramp is found as on a hold). The residual there becomes the line's value through its
 /// neighbours' residuals (so spectra and filters see no spike) and the row is excluded.
 void FindGlitches(Context* cx, Conditioning* out) {
-  for (int c = 0; c < cx->nc; ++c) {
+  // Channels side by side: each repairs its own column of the residual; the rows to exclude are
+  // marked afterwards, in channel order.
+  std::vector<std::vector<Glitch>> found(static_cast<std::size_t>(cx->nc));
+  ParallelFor(found.size(), cx->threads, [&](std::size_t ch) {
+    const int c = static_cast<int>(ch);
     const std::vector<double> x = RealColumn(*cx, c);
     const auto at = [&x](int i) { return x[static_cast<std::size_t>(i)]; };
     double scale = 0.0;
@@ -114,8 +119,13 @@ void FindGlitches(Context* cx, Conditioning* out) {
       NeighbourLine([cx, c](int k) { return static_cast<double>(cx->resid(k, c)); }, i, &repaired,
                     &spread);
       cx->resid(i, c) = static_cast<float>(repaired);
-      out->glitches.push_back({i, c, cx->data->t_s[static_cast<std::size_t>(i)], dev});
-      Exclude(cx, i, i);
+      found[ch].push_back({i, c, cx->data->t_s[static_cast<std::size_t>(i)], dev});
+    }
+  });
+  for (const std::vector<Glitch>& g : found) {
+    for (const Glitch& one : g) {
+      out->glitches.push_back(one);
+      Exclude(cx, one.row, one.row);
     }
   }
   std::sort(out->glitches.begin(), out->glitches.end(),
@@ -379,10 +389,11 @@ void ConditionData(Context* cx) {
   Conditioning out;
   FindGlitches(cx, &out);
   std::vector<double> sigma(static_cast<std::size_t>(cx->nc));
-  for (int c = 0; c < cx->nc; ++c) {
+  ParallelFor(sigma.size(), cx->threads, [&](std::size_t ch) {
+    const int c = static_cast<int>(ch);
     const auto at = [&](int i) { return static_cast<double>(cx->resid(i, c)); };
-    sigma[static_cast<std::size_t>(c)] = DiffSigma(at, 0, cx->n);
-  }
+    sigma[ch] = DiffSigma(at, 0, cx->n);
+  });
   const std::vector<std::uint8_t> moving = MovingRows(*cx);
   FindTransitions(cx, &out, moving, sigma);
   MeasureQuietNoise(*cx, &out, moving);

@@ -1,6 +1,7 @@
 // The diagnosis context (residual, noise, hold-out blocks, sim zero and sensitivity, spectral
 // lines) and the whitened train/hold-out sums.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -8,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "diagnosis/engine/debug.hpp"
+#include "diagnosis/engine/parallel.hpp"
 #include "diagnosis/engine/separable_fit.hpp"
 #include "diagnosis/engine/signal.hpp"
 
@@ -20,7 +23,7 @@ namespace {
 /// Spectral lines of the whitened residual, summed over channels: the five strongest peaks over
 /// four times the median level (cx.peak_hz, cx.peak_ratio).
 void FindSpectralLines(Context& cx) {
-  const auto lines = SpectralLines(cx, cx.resid);
+  const auto lines = SpectralLines(cx, cx.resid, cx.threads);
   for (std::size_t j = 0; j < std::min<std::size_t>(lines.size(), 5); ++j) {
     cx.peak_ratio.push_back(lines[j].first);
     cx.peak_hz.push_back(lines[j].second);
@@ -48,7 +51,8 @@ constexpr std::size_t kLagCacheBytes = std::size_t{48} << 20;
 void EstimateNoise(Context& cx, const Eigen::VectorXd* sigma) {
   cx.sigma.resize(cx.nc);
   cx.weight.resize(cx.nc);
-  for (int c = 0; c < cx.nc; ++c) {
+  ParallelFor(static_cast<std::size_t>(cx.nc), cx.threads, [&](std::size_t ch) {
+    const int c = static_cast<int>(ch);
     // The quiet holds' noise (typical_sigma_mvv) where the conditioning measured one and the
     // whole-record floor is over kQuietNoiseRatio × it: load changes and ringing lift that floor,
     // which would make real structure look like noise. Within that ratio the floor is kept (a
@@ -66,7 +70,7 @@ void EstimateNoise(Context& cx, const Eigen::VectorXd* sigma) {
     if (sigma != nullptr) s = (*sigma)(c);
     cx.sigma(c) = s;
     cx.weight(c) = 1.0 / (s * s);
-  }
+  });
 }
 
 /// Segment restarts and the hold-out split: interleaved blocks of about block_s (≥ 20 rows, ≥ 30
@@ -109,7 +113,8 @@ void SplitSim(Context& cx, const DiagData& d, Mat sim) {
   cx.zero = Vec::Zero(cx.nc);
   cx.sens = Mat::Zero(cx.nc, 6);
   if (d.has_wrench()) {
-    for (int c = 0; c < cx.nc; ++c) {
+    ParallelFor(static_cast<std::size_t>(cx.nc), cx.threads, [&](std::size_t ch) {
+      const int c = static_cast<int>(ch);
       NormalEq ne(7);
       double x[7];
       for (int i = 0; i < cx.n; ++i) {
@@ -120,7 +125,7 @@ void SplitSim(Context& cx, const DiagData& d, Mat sim) {
       const auto r = ne.Solve();
       cx.zero(c) = r.beta(0);
       for (int k = 0; k < 6; ++k) cx.sens(c, k) = r.beta(k + 1);
-    }
+    });
   }
   sim.rowwise() -= cx.zero.transpose();
   cx.load = std::move(sim);
@@ -147,8 +152,9 @@ void SetTemperature(Context& cx, const DiagData& d) {
 
 /// The context from the residual and the sim's outputs (n × N each, mV/V): `sim` becomes the load.
 Context Build(const DiagData& d, Series resid, Mat sim, double block_s,
-              const Eigen::VectorXd* sigma, Quantisation quantisation) {
+              const Eigen::VectorXd* sigma, Quantisation quantisation, int threads) {
   Context cx;
+  cx.threads = ResolveThreads(threads);
   cx.quantisation = std::move(quantisation);
   cx.data = &d;
   cx.n = static_cast<int>(d.rows());
@@ -157,30 +163,39 @@ Context Build(const DiagData& d, Series resid, Mat sim, double block_s,
   cx.rate_hz = d.rate_hz();
   cx.dt = 1.0 / cx.rate_hz;
   cx.uniform = UniformClock(d, cx.dt);
+  auto t0 = std::chrono::steady_clock::now();
   SplitHoldOut(cx, d, block_s);
   SplitSim(cx, d, std::move(sim));
+  DebugTime("context", "hold-out split and sim zero", t0);
+  t0 = std::chrono::steady_clock::now();
   ConditionData(&cx);
+  DebugTime("context", "conditioning", t0);
+  t0 = std::chrono::steady_clock::now();
   EstimateNoise(cx, sigma);
   SetTemperature(cx, d);
+  DebugTime("context", "noise", t0);
+  t0 = std::chrono::steady_clock::now();
   FindSpectralLines(cx);
+  DebugTime("context", "spectral lines", t0);
   return cx;
 }
 
 }  // namespace
 
-Context MakeContext(const DiagData& d, double block_s, const Eigen::VectorXd* sigma) {
+Context MakeContext(const DiagData& d, double block_s, const Eigen::VectorXd* sigma, int threads) {
   return Build(d, (d.real_mvv - d.sim_mvv).cast<float>(), d.sim_mvv, block_s, sigma,
-               FindQuantisation(d));
+               FindQuantisation(d), threads);
 }
 
-Context MakeContext(DiagData* d, double block_s, const Eigen::VectorXd* sigma) {
+Context MakeContext(DiagData* d, double block_s, const Eigen::VectorXd* sigma, int threads) {
   d->released_channels = d->channels();
   // Real − sim in double, rounded once; the real bridges are released as soon as it is formed.
   Series resid = (d->real_mvv - d->sim_mvv).cast<float>();
   Quantisation quantisation = FindQuantisation(*d);
   d->real_mvv = Mat();
   Mat sim = std::move(d->sim_mvv);  // both matrices are left empty
-  return Build(*d, std::move(resid), std::move(sim), block_s, sigma, std::move(quantisation));
+  return Build(*d, std::move(resid), std::move(sim), block_s, sigma, std::move(quantisation),
+               threads);
 }
 
 void SetNoise(Context* cx, const Eigen::VectorXd& sigma) {

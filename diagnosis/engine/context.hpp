@@ -57,6 +57,9 @@ struct Context {
   /// The load's lags the searches computed (lag_cache.hpp); shared by the fits on this context.
   std::shared_ptr<LagCache> lag_cache;
   std::vector<double> peak_ratio;
+  /// Worker threads (≥ 1) for the engine's own per-channel and per-piece work on this context;
+  /// the results do not depend on it.
+  int threads = 1;
 
   /// Whether row i is a held-out row (not trained on, not excluded).
   [[nodiscard]] bool held_out(std::size_t i) const {
@@ -69,12 +72,13 @@ struct Context {
 
 /// Builds the context: residual, noise, hold-out blocks (every third block of ~block_s).
 /// `sigma` (one per channel), when given, replaces the robust noise estimate.
+/// `threads`: as DiagnoseOptions::threads (0: the machine's).
 [[nodiscard]] Context MakeContext(const DiagData& d, double block_s = 0.5,
-                                  const Eigen::VectorXd* sigma = nullptr);
+                                  const Eigen::VectorXd* sigma = nullptr, int threads = 0);
 /// The same, taking the memory of d->real_mvv and d->sim_mvv for the residual and the load (both
 /// are left empty; d->released_channels keeps their width). Memory: two n × N matrices fewer.
 [[nodiscard]] Context MakeContext(DiagData* d, double block_s = 0.5,
-                                  const Eigen::VectorXd* sigma = nullptr);
+                                  const Eigen::VectorXd* sigma = nullptr, int threads = 0);
 /// Replaces the context's noise per channel (and what depends on it: weights, spectral lines);
 /// the same as MakeContext with `sigma`, without the data's bridge matrices.
 void SetNoise(Context* cx, const Eigen::VectorXd& sigma);

@@ -328,9 +328,6 @@ double JointBeyond(const Context& cx, const Series& target, const EffectFit& fit
 
 namespace {
 
-/// Bytes of joint fits CheckConfounders may hold beside the first to test rows side by side.
-constexpr double kRowsBatchBytes = 64.0 * 1024 * 1024;
-
 /// Tests whether one confounder, fitted in `n_params` parameters, leaves the effect identified
 /// (CheckConfounders' test); *z_rest gets the effect's z beyond it.
 using BeyondFn =
@@ -486,11 +483,10 @@ Confounding CheckConfounders(const Context& cx, const Series& target, const Effe
     if ((spec->confounders & row.bit) != 0U) rows.push_back(&row);
   }
   std::vector<std::optional<std::string>> confounds(rows.size());
-  // Memory: a row's joint fit holds about four n × N series; side by side only while those of
-  // the extra threads fit in kRowsBatchBytes (10^5 rows × 8 channels do; 10^6 run one by one,
-  // which keeps the peak of the largest records where it was).
+  // Memory: a row's joint fit holds about four n × N series (10^5 rows × 8 channels fit the
+  // side-by-side budget; 10^6 run one by one).
   const double row_bytes = 4.0 * static_cast<double>(cx.n) * cx.nc * sizeof(float);
-  const int side_by_side = row_bytes * (threads - 1) <= kRowsBatchBytes ? threads : 1;
+  const int side_by_side = SideBySide(threads, row_bytes);
   ParallelFor(rows.size(), side_by_side, [&](std::size_t k) {
     std::string sentence;
     if (!RowIdentifies(cx, fit, *rows[k], z_claim, z_alone, simpler, beyond, &sentence)) {

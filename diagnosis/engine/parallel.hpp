@@ -18,6 +18,17 @@ inline int ResolveThreads(int requested) {
   return static_cast<int>(std::clamp(hw, 1U, 4U));
 }
 
+/// Bytes that work run side by side may hold beyond what one thread of it holds: a fit's own
+/// copies of the record's series. Over this the work runs one by one, which keeps the peak of the
+/// largest records where one thread puts it.
+inline constexpr double kSideBySideBytes = 64.0 * 1024 * 1024;
+
+/// The threads for work of which each extra thread holds `bytes_per_thread` more: `threads` while
+/// the extra threads' bytes fit in kSideBySideBytes, else 1.
+[[nodiscard]] inline int SideBySide(int threads, double bytes_per_thread) {
+  return bytes_per_thread * (threads - 1) <= kSideBySideBytes ? threads : 1;
+}
+
 /// Calls fn(k) for k = 0 … n − 1 on up to `threads` threads (the caller's among them), each index
 /// once, in the order k = 0, 1, … of being taken. The first exception thrown by fn is rethrown
 /// here after every thread has joined (the remaining indices are skipped).

@@ -72,17 +72,19 @@ std::vector<EffectFit> FirstClaims(const Context& cx, const DiagnoseOptions& opt
 
 Report Diagnose(const DiagData& data, const DiagnoseOptions& options) {
   Progress(options, Stage::kSplit, 0.0, "noise and hold-out split");
-  return WithRefinedNoise(DiagnoseWith(MakeContext(data, options.block_s), options), options);
+  return WithRefinedNoise(
+      DiagnoseWith(MakeContext(data, options.block_s, nullptr, options.threads), options), options);
 }
 
 Report Diagnose(DiagData* data, const DiagnoseOptions& options) {
   Progress(options, Stage::kSplit, 0.0, "noise and hold-out split");
-  return WithRefinedNoise(DiagnoseWith(MakeContext(data, options.block_s), options), options);
+  return WithRefinedNoise(
+      DiagnoseWith(MakeContext(data, options.block_s, nullptr, options.threads), options), options);
 }
 
 Report DiagnoseOnce(const DiagData& data, const DiagnoseOptions& options,
                     const Eigen::VectorXd* sigma) {
-  return DiagnoseWith(MakeContext(data, options.block_s, sigma), options);
+  return DiagnoseWith(MakeContext(data, options.block_s, sigma, options.threads), options);
 }
 
 Report DiagnoseWith(Context context, const DiagnoseOptions& options) {

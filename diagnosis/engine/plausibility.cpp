@@ -4,11 +4,13 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "diagnosis/engine/parallel.hpp"
 #include "diagnosis/engine/separable_fit.hpp"
 
 namespace ftstack::diag {
@@ -439,12 +441,35 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit, const Effec
   for (auto it = fit->sigma.begin(); it != fit->sigma.end(); ++it) {
     values.push_back({it.key(), {}, {}});
   }
-  int unresolved = 0;
-  for (int p = 0; p < kSpreadPieces; ++p) {
+  // The pieces are independent refits, each on a context whose training rows are its piece's:
+  // side by side, each thread on its own copy of the context (the residual and the load) while
+  // those copies fit the side-by-side budget.
+  const double copy_bytes =
+      static_cast<double>(cx->n) * cx->nc * (sizeof(float) + sizeof(double));
+  const int threads = std::min(SideBySide(cx->threads, copy_bytes), kSpreadPieces);
+  std::vector<Context> copies(static_cast<std::size_t>(threads - 1), *cx);
+  std::vector<Context*> free_contexts{cx};
+  for (Context& c : copies) free_contexts.push_back(&c);
+  std::mutex mu;
+  std::vector<std::optional<EffectFit>> pieces(kSpreadPieces);
+  ParallelFor(pieces.size(), threads, [&](std::size_t k) {
+    Context* pcx = nullptr;
+    {
+      const std::lock_guard<std::mutex> lock(mu);
+      pcx = free_contexts.back();
+      free_contexts.pop_back();
+    }
+    const int p = static_cast<int>(k);
     const double t_lo = t.front() + span * p;
-    SelectPiece(cx, train, t_lo, p + 1 == kSpreadPieces ? t.back() + 1.0 : t_lo + span);
-    std::optional<EffectFit> piece = FitNear(spec, *cx, target, fit, false);
-    if (!piece || !NotResolved(*cx, *piece, spec).empty()) {
+    SelectPiece(pcx, train, t_lo, p + 1 == kSpreadPieces ? t.back() + 1.0 : t_lo + span);
+    std::optional<EffectFit> piece = FitNear(spec, *pcx, target, fit, false);
+    if (piece && NotResolved(*pcx, *piece, spec).empty()) pieces[k] = std::move(piece);
+    const std::lock_guard<std::mutex> lock(mu);
+    free_contexts.push_back(pcx);
+  });
+  int unresolved = 0;
+  for (const std::optional<EffectFit>& piece : pieces) {
+    if (!piece) {
       ++unresolved;
       continue;
     }

@@ -1,10 +1,12 @@
-// Private helpers shared by the effect models (see common.hpp).
+// Private helpers shared by the effect models (declared in separable_fit.hpp).
 #include "diagnosis/engine/separable_fit.hpp"
 
 #include <cstdarg>
 #include <cstdio>
 #include <limits>
 #include <memory>
+
+#include "diagnosis/engine/parallel.hpp"
 
 namespace ftstack::diag::fx {
 
@@ -365,10 +367,19 @@ std::vector<std::pair<double, double>> MedianSpectrumLines(const Context& cx, co
 
 }  // namespace
 
-std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Series& r) {
-  auto lines = MeanSpectrumLines(cx, r, false);
-  if (cx.excluded.empty()) return lines;
-  return MergeLines(cx, std::move(lines), MeanSpectrumLines(cx, r, true));
+std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Series& r,
+                                                     int threads) {
+  if (cx.excluded.empty()) return MeanSpectrumLines(cx, r, false);
+  std::vector<std::pair<double, double>> as_is;
+  std::vector<std::pair<double, double>> bridged;
+  ParallelFor(2, threads, [&](std::size_t k) {
+    if (k == 0) {
+      as_is = MeanSpectrumLines(cx, r, false);
+    } else {
+      bridged = MeanSpectrumLines(cx, r, true);
+    }
+  });
+  return MergeLines(cx, std::move(as_is), std::move(bridged));
 }
 
 std::vector<std::pair<double, double>> LocalLines(const Context& cx, const Series& r,

@@ -280,13 +280,14 @@ HatBasis MakeHat(const Context& cx, int k);
 /// first, one that lasts through the holds under the steps' broadband misfit only in the second.
 ///  - SpectralLines: lines of r's Welch spectra, whitened and summed over channels: local maxima
 ///    (from the 4th bin) over 4 × the median level, strongest first, as (level / median level,
-///    frequency in Hz).
+///    frequency in Hz); `threads` > 1 reads the two ways side by side.
 ///  - LocalLines: lines of r's median-periodogram spectra (WelchMedian: load steps in a few
 ///    segments do not lift it), whitened and summed over channels, that stand out of their
 ///    neighbourhood (over `min_ratio` × the median of the 16 bins each side, so a red spectrum's
 ///    slope does not hide them), most prominent first, as (level / local median, frequency in Hz
 ///    interpolated between bins).
-std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Series& r);
+std::vector<std::pair<double, double>> SpectralLines(const Context& cx, const Series& r,
+                                                     int threads = 1);
 std::vector<std::pair<double, double>> LocalLines(const Context& cx, const Series& r,
                                                   double min_ratio = 8.0);
 

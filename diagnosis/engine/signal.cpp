@@ -41,7 +41,7 @@ NormalEq::NormalEq(int p)
 // XᵀWX is kept in its upper triangle, column a holding rows b ≤ a: the inner loop then walks
 // contiguous memory (column-major) and vectorises. Each element receives the same products in
 // the same row order as before, so the sums are bit for bit those of the lower-triangle form.
-void NormalEq::Add(const double* x, double y, double w) {
+void NormalEq::AddWide(const double* x, double y, double w) {
   double* const xtx = xtx_.data();
   double* const xty = xty_.data();
   const auto p = static_cast<std::ptrdiff_t>(p_);
@@ -51,8 +51,6 @@ void NormalEq::Add(const double* x, double y, double w) {
     double* __restrict col = xtx + a * p;
     for (std::ptrdiff_t b = 0; b <= a; ++b) col[b] += wa * x[b];
   }
-  yty_ += w * y * y;
-  rows_ += 1.0;
 }
 
 void NormalEq::AddSparse(const int* idx, const double* val, int nnz, double y, double w) {
