@@ -53,18 +53,6 @@ void NormalEq::AddWide(const double* x, double y, double w) {
   }
 }
 
-void NormalEq::AddSparse(const int* idx, const double* val, int nnz, double y, double w) {
-  for (int a = 0; a < nnz; ++a) {
-    const double wa = w * val[a];
-    xty_(idx[a]) += wa * y;
-    for (int b = 0; b < nnz; ++b) {
-      if (idx[b] <= idx[a]) xtx_(idx[b], idx[a]) += wa * val[b];
-    }
-  }
-  yty_ += w * y * y;
-  rows_ += 1.0;
-}
-
 NormalEq::Result NormalEq::Solve() const {
   Result r;
   r.rows = rows_;

@@ -27,38 +27,48 @@ using numerics::WelchSegment;
 class NormalEq {
  public:
   explicit NormalEq(int p);
-  /// Adds row x (p features), target y, weight w. Inline with the one- and two-feature rows
-  /// written out: the searches add tens of millions of those per diagnosis, where a call and a
-  /// loop cost more than the sums. Every element receives the same products in the same order
-  /// for any p.
-  // GCC's -Warray-bounds reads the two-feature branch inlined at a caller whose row is one double
-  // (p_ = 1 there at run time, so the branch is never taken).
+  /// Adds row x (p features), target y, weight w. Inline, with rows of up to four features
+  /// unrolled: the searches add tens of millions of those per diagnosis, where a call and a loop
+  /// cost more than the sums. Every element receives the same products in the same order for any
+  /// p.
+  // GCC's -Warray-bounds reads a wider branch inlined at a caller whose row is shorter (p_ is
+  // that row's length at run time, so the branch is never taken).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Warray-bounds"
   void Add(const double* x, double y, double w = 1.0) {
-    double* const xtx = xtx_.data();
-    double* const xty = xty_.data();
-    if (p_ == 1) {
-      const double wa = w * x[0];
-      xty[0] += wa * y;
-      xtx[0] += wa * x[0];
-    } else if (p_ == 2) {
-      const double w0 = w * x[0];
-      xty[0] += w0 * y;
-      xtx[0] += w0 * x[0];
-      const double w1 = w * x[1];
-      xty[1] += w1 * y;
-      xtx[2] += w1 * x[0];
-      xtx[3] += w1 * x[1];
-    } else {
-      AddWide(x, y, w);
+    switch (p_) {
+      case 1:
+        AddFixed<1>(x, y, w);
+        break;
+      case 2:
+        AddFixed<2>(x, y, w);
+        break;
+      case 3:
+        AddFixed<3>(x, y, w);
+        break;
+      case 4:
+        AddFixed<4>(x, y, w);
+        break;
+      default:
+        AddWide(x, y, w);
     }
     yty_ += w * y * y;
     rows_ += 1.0;
   }
 #pragma GCC diagnostic pop
-  /// Row with only `nnz` non-zero features at indices idx.
-  void AddSparse(const int* idx, const double* val, int nnz, double y, double w = 1.0);
+  /// Row with only `nnz` non-zero features at indices idx (inline: the callers' nnz is a
+  /// constant, and the loops unroll).
+  void AddSparse(const int* idx, const double* val, int nnz, double y, double w = 1.0) {
+    for (int a = 0; a < nnz; ++a) {
+      const double wa = w * val[a];
+      xty_(idx[a]) += wa * y;
+      for (int b = 0; b < nnz; ++b) {
+        if (idx[b] <= idx[a]) xtx_(idx[b], idx[a]) += wa * val[b];
+      }
+    }
+    yty_ += w * y * y;
+    rows_ += 1.0;
+  }
   struct Result {
     Eigen::VectorXd beta;
     Eigen::MatrixXd cov_unit;  ///< (XᵀWX)⁻¹; times the residual variance gives the covariance
@@ -69,8 +79,24 @@ class NormalEq {
   [[nodiscard]] int p() const { return p_; }
 
  private:
-  /// The upper triangle's and XᵀWy's sums of Add for any p.
+  /// The upper triangle's and XᵀWy's sums of Add for any p: XᵀWX in its upper triangle, column a
+  /// holding rows b ≤ a.
   void AddWide(const double* x, double y, double w);
+  /// The same for p = P (a compile-time row length: the loops unroll).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Warray-bounds"
+  template <int P>
+  void AddFixed(const double* x, double y, double w) {
+    double* const xtx = xtx_.data();
+    double* const xty = xty_.data();
+    for (int a = 0; a < P; ++a) {
+      const double wa = w * x[a];
+      xty[a] += wa * y;
+      double* const col = xtx + a * P;
+      for (int b = 0; b <= a; ++b) col[b] += wa * x[b];
+    }
+  }
+#pragma GCC diagnostic pop
 
   int p_;
   Eigen::MatrixXd xtx_;
