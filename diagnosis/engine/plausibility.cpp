@@ -444,8 +444,7 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit, const Effec
   // The pieces are independent refits, each on a context whose training rows are its piece's:
   // side by side, each thread on its own copy of the context (the residual and the load) while
   // those copies fit the side-by-side budget.
-  const double copy_bytes =
-      static_cast<double>(cx->n) * cx->nc * (sizeof(float) + sizeof(double));
+  const double copy_bytes = static_cast<double>(cx->n) * cx->nc * (sizeof(float) + sizeof(double));
   const int threads = std::min(SideBySide(cx->threads, copy_bytes), kSpreadPieces);
   std::vector<Context> copies(static_cast<std::size_t>(threads - 1), *cx);
   std::vector<Context*> free_contexts{cx};
