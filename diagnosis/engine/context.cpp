@@ -198,6 +198,13 @@ Context MakeContext(DiagData* d, double block_s, const Eigen::VectorXd* sigma, i
                threads);
 }
 
+Context RefitCopy(Context* cx) {
+  Series resid = std::move(cx->resid);
+  Context copy = *cx;
+  cx->resid = std::move(resid);
+  return copy;
+}
+
 void SetNoise(Context* cx, const Eigen::VectorXd& sigma) {
   cx->sigma = sigma;
   cx->weight = sigma.array().square().inverse().matrix();

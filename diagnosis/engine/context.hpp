@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "diagnosis/engine/conditioning.hpp"
@@ -19,6 +20,27 @@ namespace ftstack::diag {
 /// instead of 64 MB); the rounding, 6e-8 of the value, is far below the noise of any recording.
 /// Every sum over a Series is accumulated in double.
 using Series = Eigen::MatrixXf;
+
+/// The sim's load (n × N, mV/V) as the context holds it: read-only once made and shared by the
+/// context's copies, so that a copy for a piece of the record (other training rows) holds the
+/// handle and not the n × N values.
+class SharedLoad {
+ public:
+  SharedLoad() : m_(std::make_shared<const Eigen::MatrixXd>()) {}
+  SharedLoad& operator=(Eigen::MatrixXd m) {
+    m_ = std::make_shared<const Eigen::MatrixXd>(std::move(m));
+    return *this;
+  }
+  [[nodiscard]] double operator()(Eigen::Index i, Eigen::Index c) const { return (*m_)(i, c); }
+  [[nodiscard]] auto col(Eigen::Index c) const { return m_->col(c); }
+  [[nodiscard]] Eigen::Index rows() const { return m_->rows(); }
+  [[nodiscard]] Eigen::Index cols() const { return m_->cols(); }
+  [[nodiscard]] const Eigen::MatrixXd& matrix() const { return *m_; }
+  operator const Eigen::MatrixXd&() const { return *m_; }  // NOLINT(google-explicit-constructor)
+
+ private:
+  std::shared_ptr<const Eigen::MatrixXd> m_;
+};
 
 /// Everything the effect models share, computed once from the data.
 struct Context {
@@ -40,7 +62,7 @@ struct Context {
   std::size_t n_hold = 0;
   double block_s = 0.0;        ///< length of the interleaved hold-out blocks
   Eigen::VectorXd zero;        ///< sim at zero wrench per channel (regression intercept), mV/V
-  Eigen::MatrixXd load;        ///< n × N: sim − zero (the load-induced part)
+  SharedLoad load;             ///< n × N: sim − zero (the load-induced part); shared by copies
   Eigen::MatrixXd sens;        ///< N × 6 sim sensitivity d(mV/V)/d(wrench) by regression
   Eigen::VectorXd load_range;  ///< per channel max − min of load, mV/V
   std::vector<double> dtemp;   ///< temp − 20 °C; empty without temperature
@@ -79,6 +101,10 @@ struct Context {
 /// are left empty; d->released_channels keeps their width). Memory: two n × N matrices fewer.
 [[nodiscard]] Context MakeContext(DiagData* d, double block_s = 0.5,
                                   const Eigen::VectorXd* sigma = nullptr, int threads = 0);
+/// A copy of *cx for refits on other training rows (the pieces of the record): it shares the load
+/// and leaves the residual out (a refit fits a target of its own), so it holds the row masks and
+/// the temperature only. Leaves *cx as it was.
+[[nodiscard]] Context RefitCopy(Context* cx);
 /// Replaces the context's noise per channel (and what depends on it: weights, spectral lines);
 /// the same as MakeContext with `sigma`, without the data's bridge matrices.
 void SetNoise(Context* cx, const Eigen::VectorXd& sigma);

@@ -442,11 +442,14 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit, const Effec
     values.push_back({it.key(), {}, {}});
   }
   // The pieces are independent refits, each on a context whose training rows are its piece's:
-  // side by side, each thread on its own copy of the context (the residual and the load) while
-  // those copies fit the side-by-side budget.
-  const double copy_bytes = static_cast<double>(cx->n) * cx->nc * (sizeof(float) + sizeof(double));
+  // side by side, each thread on its own RefitCopy (the row masks and the temperature; the load is
+  // shared) with its own refit's prediction, while those fit the side-by-side budget.
+  const double copy_bytes =
+      static_cast<double>(cx->n) *
+      (3.0 + (cx->dtemp.empty() ? 0.0 : sizeof(double)) + cx->nc * sizeof(float));
   const int threads = std::min(SideBySide(cx->threads, copy_bytes), kSpreadPieces);
-  std::vector<Context> copies(static_cast<std::size_t>(threads - 1), *cx);
+  std::vector<Context> copies;
+  for (int k = 1; k < threads; ++k) copies.push_back(RefitCopy(cx));
   std::vector<Context*> free_contexts{cx};
   for (Context& c : copies) free_contexts.push_back(&c);
   std::mutex mu;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "diagnosis/engine/context.hpp"
@@ -31,10 +32,11 @@ struct LagFixture {
     cx.data = &data;
     cx.n = n;
     cx.nc = 3;
-    cx.load.resize(n, 3);
+    Eigen::MatrixXd load(n, 3);
     for (int i = 0; i < n; ++i) {
-      for (int c = 0; c < 3; ++c) cx.load(i, c) = ((i / 700 + c) % 3) * (1.0 + c) + 0.01 * i / n;
+      for (int c = 0; c < 3; ++c) load(i, c) = ((i / 700 + c) % 3) * (1.0 + c) + 0.01 * i / n;
     }
+    cx.load = std::move(load);
     cx.lag_cache = std::make_shared<LagCache>(std::size_t{1} << 20);
   }
   /// The whole filter over every row of channel c, at row i (the reference).

@@ -84,7 +84,7 @@ TEST(DiagMemory, SetNoiseEqualsAContextMadeWithThatNoise) {
   EXPECT_EQ(set.peak_hz, made.peak_hz);
   EXPECT_EQ(set.peak_ratio, made.peak_ratio);
   EXPECT_TRUE(set.resid == made.resid);
-  EXPECT_TRUE(set.load == made.load);
+  EXPECT_TRUE(set.load.matrix() == made.load.matrix());
   EXPECT_EQ(set.train, made.train);
 }
 
