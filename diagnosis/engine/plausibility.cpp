@@ -425,25 +425,19 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit) {
   if (spec != nullptr) PieceSpreads(cx, target, fit, *spec);
 }
 
-void PieceSpreads(Context* cx, const Series& target, EffectFit* fit, const EffectSpec& spec) {
-  if (fit->sigma.empty()) return;
-  const std::vector<ParamSpec> declared = DeclaredParams(*cx, *fit, spec);
+namespace {
+
+/// The fit refitted near itself on each of the kSpreadPieces pieces of the record's training rows
+/// (nullopt where a piece's refit fails or is not resolved); leaves cx's training rows as they
+/// were. The pieces are independent refits: side by side, each thread on its own RefitCopy (the row
+/// masks and the temperature; the load is shared) with its own refit's prediction, while those
+/// fit the side-by-side budget.
+std::vector<std::optional<EffectFit>> RefitPieces(Context* cx, const Series& target,
+                                                  const EffectFit& fit, const EffectSpec& spec) {
   const std::vector<std::uint8_t> train = cx->train;
   const std::size_t n_train = cx->n_train;
   const auto& t = cx->data->t_s;
   const double span = (t.back() - t.front()) / kSpreadPieces;
-  struct PerPiece {
-    std::string key;
-    std::vector<std::vector<double>> values;
-    std::vector<std::vector<double>> sigmas;  ///< each piece's own σ (NaN where it has none)
-  };
-  std::vector<PerPiece> values;
-  for (auto it = fit->sigma.begin(); it != fit->sigma.end(); ++it) {
-    values.push_back({it.key(), {}, {}});
-  }
-  // The pieces are independent refits, each on a context whose training rows are its piece's:
-  // side by side, each thread on its own RefitCopy (the row masks and the temperature; the load is
-  // shared) with its own refit's prediction, while those fit the side-by-side budget.
   const double copy_bytes =
       static_cast<double>(cx->n) *
       (3.0 + (cx->dtemp.empty() ? 0.0 : sizeof(double)) + cx->nc * sizeof(float));
@@ -464,11 +458,31 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit, const Effec
     const int p = static_cast<int>(k);
     const double t_lo = t.front() + span * p;
     SelectPiece(pcx, train, t_lo, p + 1 == kSpreadPieces ? t.back() + 1.0 : t_lo + span);
-    std::optional<EffectFit> piece = FitNear(spec, *pcx, target, fit, false);
+    std::optional<EffectFit> piece = FitNear(spec, *pcx, target, &fit, false);
     if (piece && NotResolved(*pcx, *piece, spec).empty()) pieces[k] = std::move(piece);
     const std::lock_guard<std::mutex> lock(mu);
     free_contexts.push_back(pcx);
   });
+  cx->train = train;
+  cx->n_train = n_train;
+  return pieces;
+}
+
+}  // namespace
+
+void PieceSpreads(Context* cx, const Series& target, EffectFit* fit, const EffectSpec& spec) {
+  if (fit->sigma.empty()) return;
+  const std::vector<ParamSpec> declared = DeclaredParams(*cx, *fit, spec);
+  struct PerPiece {
+    std::string key;
+    std::vector<std::vector<double>> values;
+    std::vector<std::vector<double>> sigmas;  ///< each piece's own σ (NaN where it has none)
+  };
+  std::vector<PerPiece> values;
+  for (auto it = fit->sigma.begin(); it != fit->sigma.end(); ++it) {
+    values.push_back({it.key(), {}, {}});
+  }
+  const std::vector<std::optional<EffectFit>> pieces = RefitPieces(cx, target, *fit, spec);
   int unresolved = 0;
   for (const std::optional<EffectFit>& piece : pieces) {
     if (!piece) {
@@ -484,8 +498,6 @@ void PieceSpreads(Context* cx, const Series& target, EffectFit* fit, const Effec
       pp.sigmas.push_back(own);
     }
   }
-  cx->train = train;
-  cx->n_train = n_train;
   for (PerPiece& pp : values) {
     const std::string& key = pp.key;
     const std::size_t dim = Values(fit->params[key]).size();
