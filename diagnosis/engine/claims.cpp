@@ -29,8 +29,8 @@ std::vector<Confounding> DropUnidentifiedPartner(const Context& cx, const Diagno
   std::vector<Confounding> partner_conf;
   if (claimed->size() != 2 || HasTrait((*claimed)[0], kTimeBased)) return partner_conf;
   const Series rest = cx.resid - (*claimed)[0].pred;
-  partner_conf.push_back(
-      CheckConfounders(cx, rest, (*claimed)[1], options.z_claim, ResolveThreads(options.threads)));
+  // A pair is claimed only after its backfits ran side by side (BestPair): after_backfits.
+  partner_conf.push_back(CheckConfounders(cx, rest, (*claimed)[1], options.z_claim, true));
   const auto& with = partner_conf.back().with;
   if (std::find(with.begin(), with.end(), "hold_offsets") != with.end() ||
       std::find(with.begin(), with.end(), "load_polynomial") != with.end()) {
@@ -106,10 +106,9 @@ void RecordClaims(Report& r, const DiagnoseOptions& options, std::vector<EffectF
     ce.rms_after = ChannelRms(cx.resid, &cum);
     // Each effect is tested against its confounders on what the other claimed effects leave.
     const auto check = [&] {
-      const int threads = ResolveThreads(options.threads);
-      if (k == 0) return CheckConfounders(cx, cx.resid, f, options.z_claim, threads);
+      if (k == 0) return CheckConfounders(cx, cx.resid, f, options.z_claim);
       const Series others_left = cx.resid - (cum - f.pred);
-      return CheckConfounders(cx, others_left, f, options.z_claim, threads);
+      return CheckConfounders(cx, others_left, f, options.z_claim);
     };
     const Confounding conf = k == 1 && !partner_conf.empty() ? partner_conf.front() : check();
     ce.confounded_with = conf.with;

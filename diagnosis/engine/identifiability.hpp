@@ -37,9 +37,13 @@ struct Confounding {
 ///    channel (28 terms): a smooth function of the load, ramps included;
 ///  - kTimeDrift (the kDriftInTime effect, reported by its name): where the temperature is
 ///    monotone in time (|Spearman ρ| > 0.95).
-/// The table's rows are tested on up to `threads` threads (the result does not depend on it).
+/// The table's rows are tested side by side on the context's threads while their extra bytes fit
+/// the side-by-side budget (parallel.hpp), or always when `after_backfits`: the caller checks
+/// right after backfits that ran on every thread, each holding about as many n × N series as a
+/// row does, so the rows reuse the heap those grew. The result does not depend on the threads.
 [[nodiscard]] Confounding CheckConfounders(const Context& cx, const Series& target,
-                                           const EffectFit& fit, double z_claim, int threads = 1);
+                                           const EffectFit& fit, double z_claim,
+                                           bool after_backfits = false);
 
 /// Group of every row for an offset confounder (kSegmentOffsets, kLoadOffsets, kHoldOffsets);
 /// empty when it does not apply to the data. *groups receives the number of groups.

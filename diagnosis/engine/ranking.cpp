@@ -531,8 +531,7 @@ bool GrowThird(const Context& cx, const DiagnoseOptions& options,
     // load or a drift in time that explains it as well leaves the pair as it was.
     Series others = cx.resid - (*best)[0].pred;
     others -= (*best)[1].pred;
-    const Confounding conf =
-        CheckConfounders(cx, others, (*best)[2], options.z_claim, ResolveThreads(options.threads));
+    const Confounding conf = CheckConfounders(cx, others, (*best)[2], options.z_claim);
     if (DebugOn()) {
       std::fprintf(stderr, "third %s beside the pair: confounded with %zu\n",
                    (*best)[2].name.c_str(), conf.with.size());
