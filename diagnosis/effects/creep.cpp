@@ -116,12 +116,12 @@ double PickOneTau(const Context& cx, const Series& target, double lt,
                   const std::function<double(double, bool)>& sse_for, bool uncertainty,
                   EffectFit* best, ChannelFit* best_f, bool* best_gamma) {
   const double tau = std::exp(lt);
-  ChannelSums sums[2] = {ChannelSums(cx, 1), ChannelSums(cx, 2)};
+  ChannelSums with_gain(cx, 2);
   ForLaggedLoad(cx, &tau, 1, OnTrainingRows(cx, [&](int i, int c, const double* lag) {
                   const double x[2] = {lag[0], cx.load(i, c)};
-                  sums[0].Add(c, x, target(i, c));
-                  sums[1].Add(c, x, target(i, c));
+                  with_gain.Add(c, x, target(i, c));
                 }));
+  const ChannelSums sums[2] = {with_gain.Leading(1), std::move(with_gain)};
   double best_bic = std::numeric_limits<double>::infinity();
   for (bool gamma : {false, true}) {
     const int p = cx.nc * (gamma ? 2 : 1) + 1;
@@ -482,12 +482,12 @@ bool FitCreepTwo(const Context& cx, const Series& target, double log_tau1, doubl
   if (l1 - lo < kOnBound) return false;
   // Both variants' fits over every row in one streamed pass of the two lags.
   const double t12[2] = {std::exp(l1), std::exp(l2)};
-  ChannelSums sums[2] = {ChannelSums(cx, 2), ChannelSums(cx, 3)};
+  ChannelSums with_gain(cx, 3);
   ForLaggedLoad(cx, t12, 2, OnTrainingRows(cx, [&](int i, int c, const double* lag) {
                   const double x[3] = {lag[0], lag[1], cx.load(i, c)};
-                  sums[0].Add(c, x, target(i, c));
-                  sums[1].Add(c, x, target(i, c));
+                  with_gain.Add(c, x, target(i, c));
                 }));
+  const ChannelSums sums[2] = {with_gain.Leading(2), std::move(with_gain)};
   bool won = false;
   for (bool gamma : {false, true}) {
     const int p = cx.nc * (gamma ? 3 : 2) + 2;

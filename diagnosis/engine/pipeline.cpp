@@ -15,6 +15,7 @@
 #include "diagnosis/engine/claims.hpp"
 #include "diagnosis/engine/diagnose.hpp"
 #include "diagnosis/engine/locate.hpp"
+#include "diagnosis/engine/memory.hpp"
 #include "diagnosis/engine/ranking.hpp"
 #include "diagnosis/engine/stages.hpp"
 
@@ -92,6 +93,7 @@ Report DiagnoseWith(Context context, const DiagnoseOptions& options) {
   Report r;
   auto t0 = std::chrono::steady_clock::now();
   r.cx = std::move(context);
+  ReturnFreedPages();  // the reading's columns, copied into the context
   DebugTime("context", "", t0);
   const Context& cx = r.cx;
   r.rate_hz = cx.rate_hz;
@@ -106,6 +108,7 @@ Report DiagnoseWith(Context context, const DiagnoseOptions& options) {
   const Sums base = Score(cx, cx.resid, nullptr);
   t0 = std::chrono::steady_clock::now();
   std::vector<Scored> singles = FitSingles(r, options, base);
+  ReturnFreedPages();  // the candidates' buffers (all but the pair starts' predictions)
   DebugTime("stage", "singles", t0);
   if (singles.empty() || !singles.front().eligible) {
     r.model = Series::Zero(cx.n, cx.nc);  // allocated only now: nothing claimed
@@ -120,15 +123,18 @@ Report DiagnoseWith(Context context, const DiagnoseOptions& options) {
       have_pair ? SignificantFits(singles) : std::vector<EffectFit>();
   singles.clear();  // memory: the kept single predictions are not used again
   singles.shrink_to_fit();
+  ReturnFreedPages();  // … nor the partners' and backfits' buffers
   // 6. refine
   t0 = std::chrono::steady_clock::now();
   RefineClaims(cx, &claimed);
   DebugTime("claims", "refinements", t0);
   std::vector<Confounding> partner_conf =
       DropUnidentifiedPartner(cx, options, &claimed, &r.dropped);
+  ReturnFreedPages();  // the confounders' joint fits
   DebugTime("claims", "partner identifiability", t0);
   // A third refits the pair beside it: the partner's confounders are then checked anew.
   if (claimed.size() == 2 && GrowThird(cx, options, near, &claimed)) partner_conf.clear();
+  ReturnFreedPages();  // the thirds' fits and backfits
   DebugTime("stage", "third", t0);
   // 7. pieces
   SpreadClaims(&r.cx, &claimed);

@@ -230,8 +230,16 @@ class ChannelSums {
   void Add(int c, const double* x, double y) { eq_[static_cast<std::size_t>(c)].Add(x, y); }
   /// The fit of every channel (FitChannels with all channels active), without a prediction.
   [[nodiscard]] ChannelFit Solve(const Context& cx) const;
+  /// The sums of the first k features alone (NormalEq::Leading): a nested model's fit from the
+  /// same pass.
+  [[nodiscard]] ChannelSums Leading(int k) const {
+    ChannelSums s;
+    for (const NormalEq& e : eq_) s.eq_.push_back(e.Leading(k));
+    return s;
+  }
 
  private:
+  ChannelSums() = default;
   std::vector<NormalEq> eq_;
 };
 /// 0, 1, …, cx.nc − 1.

@@ -41,16 +41,15 @@ NormalEq::NormalEq(int p)
 // XᵀWX is kept in its upper triangle, column a holding rows b ≤ a: the inner loop then walks
 // contiguous memory (column-major) and vectorises. Each element receives the same products in
 // the same row order as before, so the sums are bit for bit those of the lower-triangle form.
-void NormalEq::AddWide(const double* x, double y, double w) {
-  double* const xtx = xtx_.data();
-  double* const xty = xty_.data();
-  const auto p = static_cast<std::ptrdiff_t>(p_);
-  for (std::ptrdiff_t a = 0; a < p; ++a) {
-    const double wa = w * x[a];
-    xty[a] += wa * y;
-    double* __restrict col = xtx + a * p;
-    for (std::ptrdiff_t b = 0; b <= a; ++b) col[b] += wa * x[b];
-  }
+void NormalEq::AddWide(const double* x, double y, double w) { AddUpper<0>(x, y, w); }
+
+NormalEq NormalEq::Leading(int k) const {
+  NormalEq e(k);
+  e.xtx_ = xtx_.topLeftCorner(k, k);
+  e.xty_ = xty_.head(k);
+  e.yty_ = yty_;
+  e.rows_ = rows_;
+  return e;
 }
 
 NormalEq::Result NormalEq::Solve() const {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -38,16 +39,16 @@ class NormalEq {
   void Add(const double* x, double y, double w = 1.0) {
     switch (p_) {
       case 1:
-        AddFixed<1>(x, y, w);
+        AddUpper<1>(x, y, w);
         break;
       case 2:
-        AddFixed<2>(x, y, w);
+        AddUpper<2>(x, y, w);
         break;
       case 3:
-        AddFixed<3>(x, y, w);
+        AddUpper<3>(x, y, w);
         break;
       case 4:
-        AddFixed<4>(x, y, w);
+        AddUpper<4>(x, y, w);
         break;
       default:
         AddWide(x, y, w);
@@ -77,23 +78,28 @@ class NormalEq {
   };
   [[nodiscard]] Result Solve() const;
   [[nodiscard]] int p() const { return p_; }
+  /// The sums of the rows' first k ≤ p features alone: bit for bit what Add of those k features
+  /// would have summed (every element gets the same products in the same order), without a
+  /// second pass.
+  [[nodiscard]] NormalEq Leading(int k) const;
 
  private:
-  /// The upper triangle's and XᵀWy's sums of Add for any p: XᵀWX in its upper triangle, column a
-  /// holding rows b ≤ a.
+  /// The upper triangle's and XᵀWy's sums of Add for any p (AddUpper<0>, out of line).
   void AddWide(const double* x, double y, double w);
-  /// The same for p = P (a compile-time row length: the loops unroll).
+  /// XᵀWX's upper triangle (column a holding rows b ≤ a) and XᵀWy of one row: p = P known at
+  /// compile time (the loops unroll), or P = 0 for p_ at run time.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Warray-bounds"
   template <int P>
-  void AddFixed(const double* x, double y, double w) {
+  void AddUpper(const double* x, double y, double w) {
     double* const xtx = xtx_.data();
     double* const xty = xty_.data();
-    for (int a = 0; a < P; ++a) {
+    const std::ptrdiff_t p = P > 0 ? P : p_;
+    for (std::ptrdiff_t a = 0; a < p; ++a) {
       const double wa = w * x[a];
       xty[a] += wa * y;
-      double* const col = xtx + a * P;
-      for (int b = 0; b <= a; ++b) col[b] += wa * x[b];
+      double* __restrict col = xtx + a * p;
+      for (std::ptrdiff_t b = 0; b <= a; ++b) col[b] += wa * x[b];
     }
   }
 #pragma GCC diagnostic pop

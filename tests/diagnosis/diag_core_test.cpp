@@ -115,6 +115,40 @@ TEST(DiagSignal, NormalEquationsMatchQr) {
   EXPECT_NEAR(r.sse, (y - x * ref).squaredNorm(), 1e-9 * y.squaredNorm());
 }
 
+// A nested model's sums taken from the wider pass are those of its own pass, bit for bit (the
+// creep variants with and without a gain term are fitted from one pass), for the unrolled row
+// lengths and the wide one, weighted rows included; and its fit is the QR solution of its columns.
+TEST(DiagSignal, LeadingSumsAreTheNarrowPassBitForBit) {
+  std::mt19937 rng(9);
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (const int p : {2, 3, 4, 6}) {
+    const int k = p - 1;
+    Eigen::MatrixXd x(300, p);
+    Eigen::VectorXd y(300);
+    NormalEq wide(p);
+    NormalEq narrow(k);
+    for (int i = 0; i < 300; ++i) {
+      for (int j = 0; j < p; ++j) x(i, j) = g(rng) * (j + 1);
+      y(i) = g(rng);
+      const double w = 0.5 + (i % 3);
+      const Eigen::VectorXd row = x.row(i).transpose();
+      wide.Add(row.data(), y(i), w);
+      narrow.Add(row.data(), y(i), w);
+    }
+    const auto lead = wide.Leading(k).Solve();
+    const auto own = narrow.Solve();
+    ASSERT_EQ(lead.beta.size(), k);
+    for (int j = 0; j < k; ++j) EXPECT_EQ(lead.beta(j), own.beta(j)) << "p " << p;
+    EXPECT_EQ(lead.sse, own.sse) << "p " << p;
+    EXPECT_EQ(lead.rows, own.rows);
+    Eigen::VectorXd sw(300);
+    for (int i = 0; i < 300; ++i) sw(i) = std::sqrt(0.5 + (i % 3));
+    const Eigen::MatrixXd xw = sw.asDiagonal() * x.leftCols(k);
+    const Eigen::VectorXd ref = xw.colPivHouseholderQr().solve(sw.asDiagonal() * y);
+    for (int j = 0; j < k; ++j) EXPECT_NEAR(lead.beta(j), ref(j), 1e-9 * (1 + std::fabs(ref(j))));
+  }
+}
+
 TEST(DiagSignal, HysteresisOperatorsAreRateIndependent) {
   // The same monotone-segment path sampled coarsely and 10× finer gives the same output at the
   // common points: the operators depend on the path, not on time.
@@ -525,6 +559,42 @@ TEST(DiagFixtureRatiometric, LoaderReadsTheDeclaredConverter) {
   EXPECT_TRUE(load("ratio.csv"));
   EXPECT_FALSE(load("fixed.csv"));
   EXPECT_FALSE(load("mvv.csv"));
+  std::filesystem::remove_all(dir);
+}
+
+// The two files are read at once, on two threads; the error reported is the one a reading in
+// turn would give: the sim's when both are bad (with its line and column), else the real's.
+TEST(DiagLoader, BothFilesBadReportsTheSimFirst) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("diag_load_errors_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto write = [&](const std::string& name, int bad_row) {
+    std::ofstream f(dir / name);
+    f << "t,Fx,Fy,Fz,Mx,My,Mz,b0\n";
+    for (int i = 0; i < 2000; ++i) {
+      f << 0.1 * i << ",0,0,1,0,0,0," << (i == bad_row ? "0.1x" : "0.1") << "\n";
+    }
+  };
+  write("sim_bad.csv", 1500);  // line 1502
+  write("real_bad.csv", 10);   // line 12
+  write("good.csv", -1);
+  const auto error_of = [&](const std::string& sim, const std::string& real) {
+    try {
+      (void)LoadSimReal((dir / sim).string(), (dir / real).string());
+    } catch (const DiagInputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string both = error_of("sim_bad.csv", "real_bad.csv");
+  EXPECT_NE(both.find((dir / "sim_bad.csv").string() + ":1502:"), std::string::npos) << both;
+  const std::string real_only = error_of("good.csv", "real_bad.csv");
+  EXPECT_NE(real_only.find((dir / "real_bad.csv").string() + ":12:"), std::string::npos)
+      << real_only;
+  const std::string missing = error_of("missing.csv", "real_bad.csv");
+  EXPECT_NE(missing.find((dir / "missing.csv").string() + ": cannot open"), std::string::npos)
+      << missing;
+  EXPECT_EQ(error_of("good.csv", "good.csv"), "no error");
   std::filesystem::remove_all(dir);
 }
 
