@@ -214,10 +214,11 @@ constexpr double kPiecesFactor = 2.0;
 /// Why the pieces of the record contradict a parameter, or "". One of one sign by its declaration
 /// (lo ≥ 0): the pieces' values of its largest-|value| element straddle zero, or, for a scale
 /// searched in log, they differ by more than kPiecesFactor and by more than 3 σ between two pieces
-/// (each piece's σ √pieces times the whole record's curvature σ). Any other:
-/// OppositeBeyondOwnSigma. A signed parameter (a delay, an angle) near zero may take either sign in
-/// a piece; a spread within a factor kPiecesFactor is an uncertain size, which the spread's σ
-/// reports (the curvature σ alone is too small where residuals are correlated).
+/// (each piece's σ √pieces times the whole record's curvature σ). A signed or undeclared parameter
+/// (a delay, an angle, a linear coefficient) is not judged by its pieces: near zero it may take
+/// either sign in a piece; its spread is reported (min, max and their σ). A spread within a factor
+/// kPiecesFactor is an uncertain size, which the spread's σ reports (the curvature σ alone is too
+/// small where residuals are correlated).
 std::string PiecesWords(const EffectFit& fit, const std::string& key, const ParamSpec* d) {
   if (!fit.spread.contains(key) || !fit.params.contains(key)) return "";
   const auto& s = fit.spread[key];
