@@ -314,6 +314,57 @@ void ExpectStreamIsWhole(const Record& rec, Whole whole, Make make, const std::s
   }
 }
 
+// Eight columns and more at once (without restarts: the four-wide vector block) give each column
+// bit for bit what it gives filtered alone (the scalar block), on a jittered clock with gaps
+// (GappyRecord's clock, its restarts left out) and a uniform one, whole and streamed; and the
+// closed form per column.
+TEST(DiagLowPass, FirstOrderEightColumnsAreEachColumnAloneBitForBit) {
+  Record gappy = GappyRecord();
+  Record uniform = LongRecord();
+  for (std::size_t i = 0; i < uniform.t.size(); ++i) {
+    uniform.t[i] = std::ldexp(static_cast<double>(i), -10);  // exactly uniform steps
+  }
+  for (Record* rec : {&gappy, &uniform}) {
+    rec->restart.assign(rec->t.size(), 0);
+    const std::size_t n = rec->t.size();
+    const std::size_t m = 9;  // one vector block of eight and one scalar column
+    std::vector<std::vector<double>> x(m, std::vector<double>(n));
+    for (std::size_t c = 0; c < m; ++c) {
+      for (std::size_t i = 0; i < n; ++i) {
+        x[c][i] = rec->x[c % 3][i] * (1.0 + 0.1 * static_cast<double>(c)) + 0.01 * (c / 3);
+      }
+    }
+    std::vector<const double*> in;
+    for (const auto& col : x) in.push_back(col.data());
+    for (double tau : {0.003, 0.3, 1000.0}) {
+      std::vector<std::vector<double>> all(m, std::vector<double>(n));
+      std::vector<double*> out;
+      for (auto& col : all) out.push_back(col.data());
+      FirstOrderLowPassColumns(rec->t.data(), n, tau, in.data(), out.data(), m);
+      FirstOrderLowPassStream stream(rec->t.data(), n, tau, in.data(), m);
+      std::vector<std::size_t> streamed(m, 0);
+      while (stream.Next()) {
+        for (std::size_t c = 0; c < m; ++c) {
+          for (std::size_t j = 0; j < stream.size(); ++j) {
+            ASSERT_EQ(stream.col(c)[j], all[c][stream.begin() + j]) << "tau " << tau << " c " << c;
+          }
+        }
+      }
+      for (std::size_t c = 0; c < m; ++c) {
+        std::vector<double> alone(n);
+        FirstOrderLowPass(rec->t.data(), x[c].data(), n, tau, alone.data());
+        for (std::size_t i = 0; i < n; ++i) {
+          ASSERT_EQ(all[c][i], alone[i]) << "tau " << tau << " column " << c << " row " << i;
+        }
+        const std::vector<double> ref = ReferenceFirstOrder(rec->t, x[c], rec->restart, tau);
+        double worst = 0.0;
+        for (std::size_t i = 0; i < n; ++i) worst = std::max(worst, std::fabs(all[c][i] - ref[i]));
+        EXPECT_LT(worst, 1e-11) << "tau " << tau << " column " << c;
+      }
+    }
+  }
+}
+
 TEST(DiagLowPass, StreamsGiveTheWholeColumnsBitForBit) {
   const Record rec = LongRecord();
   const std::uint8_t* restart = rec.restart.data();
