@@ -300,6 +300,41 @@ void SecondOrderBlock(const SecondOrderChunk& k, double lag, std::size_t i0, std
   }
 }
 
+/// SecondOrderBlock<4> without restarts, the four columns' states in four-wide vectors: the same
+/// products and sums in the same order per column (vector lanes round like scalars, and no FMA:
+/// lowpass_kernels.hpp), so the same bits.
+void SecondOrderBlock4(const SecondOrderChunk& k, double lag, std::size_t i0, std::size_t len,
+                       const double* const* x, double* const* y, std::ptrdiff_t y_off,
+                       double* pos_io, double* vel_io) {
+  using V4 = double __attribute__((vector_size(32)));
+  const auto at = [&](std::size_t i) { return static_cast<std::ptrdiff_t>(i) - y_off; };
+  V4 pos = {pos_io[0], pos_io[1], pos_io[2], pos_io[3]};
+  V4 vel = {vel_io[0], vel_io[1], vel_io[2], vel_io[3]};
+  V4 xp = {x[0][i0 - 1], x[1][i0 - 1], x[2][i0 - 1], x[3][i0 - 1]};
+  const V4 lag4 = {lag, lag, lag, lag};
+  for (std::size_t j = 0; j < len; ++j) {
+    const std::size_t i = i0 + j;
+    const V4 p00 = {k.p00[j], k.p00[j], k.p00[j], k.p00[j]};
+    const V4 p01 = {k.p01[j], k.p01[j], k.p01[j], k.p01[j]};
+    const V4 p10 = {k.p10[j], k.p10[j], k.p10[j], k.p10[j]};
+    const V4 p11 = {k.p11[j], k.p11[j], k.p11[j], k.p11[j]};
+    const V4 inv_dt = {k.inv_dt[j], k.inv_dt[j], k.inv_dt[j], k.inv_dt[j]};
+    const V4 xi = {x[0][i], x[1][i], x[2][i], x[3][i]};
+    const V4 slope = (xi - xp) * inv_dt;
+    const V4 e0 = pos - (xp - lag4 * slope);
+    const V4 e1 = vel - slope;
+    pos = xi - lag4 * slope + p00 * e0 + p01 * e1;
+    vel = slope + p10 * e0 + p11 * e1;
+    xp = xi;
+    const std::ptrdiff_t o = at(i);
+    for (int b = 0; b < 4; ++b) y[b][o] = pos[b];
+  }
+  for (int b = 0; b < 4; ++b) {
+    pos_io[b] = pos[b];
+    vel_io[b] = vel[b];
+  }
+}
+
 /// Rows [i_begin, i_end) (i_begin − 1 a multiple of kChunk) of m columns from the states pos, vel
 /// (row i_begin − 1), row i of column c at y[c][i − y_off].
 // Flattened: every helper inlined, which the compiler does not do on its own here and which is
@@ -314,7 +349,11 @@ FTSTACK_LOWPASS_TARGETS [[gnu::flatten]] void SecondOrderRows(
     // Four columns at a time (their states in registers), then the rest together.
     std::size_t c = 0;
     for (; c + 4 <= m; c += 4) {
-      SecondOrderBlock<4>(*k, lag, i0, len, x + c, y + c, y_off, pos + c, vel + c, restart);
+      if (restart == nullptr) {
+        SecondOrderBlock4(*k, lag, i0, len, x + c, y + c, y_off, pos + c, vel + c);
+      } else {
+        SecondOrderBlock<4>(*k, lag, i0, len, x + c, y + c, y_off, pos + c, vel + c, restart);
+      }
     }
     const std::size_t r = m - c;
     if (r == 3)

@@ -314,52 +314,105 @@ void ExpectStreamIsWhole(const Record& rec, Whole whole, Make make, const std::s
   }
 }
 
-// Eight columns and more at once (without restarts: the four-wide vector block) give each column
-// bit for bit what it gives filtered alone (the scalar block), on a jittered clock with gaps
-// (GappyRecord's clock, its restarts left out) and a uniform one, whole and streamed; and the
-// closed form per column.
-TEST(DiagLowPass, FirstOrderEightColumnsAreEachColumnAloneBitForBit) {
-  Record gappy = GappyRecord();
-  Record uniform = LongRecord();
-  for (std::size_t i = 0; i < uniform.t.size(); ++i) {
-    uniform.t[i] = std::ldexp(static_cast<double>(i), -10);  // exactly uniform steps
+/// Nine columns of distinct inputs on the clock of `rec` (its restarts left out: the columns are
+/// then filtered in four-wide vector blocks, and one scalar column).
+std::vector<std::vector<double>> NineColumns(Record* rec) {
+  rec->restart.assign(rec->t.size(), 0);
+  std::vector<std::vector<double>> x(9, std::vector<double>(rec->t.size()));
+  for (std::size_t c = 0; c < x.size(); ++c) {
+    for (std::size_t i = 0; i < rec->t.size(); ++i) {
+      x[c][i] = rec->x[c % 3][i] * (1.0 + 0.1 * static_cast<double>(c)) + 0.01 * (c / 3);
+    }
   }
-  for (Record* rec : {&gappy, &uniform}) {
-    rec->restart.assign(rec->t.size(), 0);
-    const std::size_t n = rec->t.size();
-    const std::size_t m = 9;  // one vector block of eight and one scalar column
-    std::vector<std::vector<double>> x(m, std::vector<double>(n));
+  return x;
+}
+
+/// Filters the columns of x at once (`columns`), streamed (`stream`) and each alone (`alone`):
+/// every row of every column the same bits three ways, and within `tol` × the input scale of
+/// `ref` per column.
+template <class Columns, class Stream, class Alone, class Ref>
+void ExpectColumnsAreEachAlone(const Record& rec, const std::vector<std::vector<double>>& x,
+                               Columns columns, Stream stream, Alone alone, Ref ref, double tol,
+                               const std::string& what) {
+  const std::size_t n = rec.t.size();
+  const std::size_t m = x.size();
+  std::vector<const double*> in;
+  for (const auto& col : x) in.push_back(col.data());
+  std::vector<std::vector<double>> all(m, std::vector<double>(n));
+  std::vector<double*> out;
+  for (auto& col : all) out.push_back(col.data());
+  columns(in.data(), out.data(), m);
+  const auto s = stream(in.data(), m);
+  while (s->Next()) {
     for (std::size_t c = 0; c < m; ++c) {
-      for (std::size_t i = 0; i < n; ++i) {
-        x[c][i] = rec->x[c % 3][i] * (1.0 + 0.1 * static_cast<double>(c)) + 0.01 * (c / 3);
+      for (std::size_t j = 0; j < s->size(); ++j) {
+        ASSERT_EQ(s->col(c)[j], all[c][s->begin() + j]) << what << " streamed, column " << c;
       }
     }
-    std::vector<const double*> in;
-    for (const auto& col : x) in.push_back(col.data());
+  }
+  double scale = 0.0;
+  for (const auto& col : x) {
+    for (double v : col) scale = std::max(scale, std::fabs(v));
+  }
+  for (std::size_t c = 0; c < m; ++c) {
+    std::vector<double> one(n);
+    alone(x[c].data(), one.data());
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(all[c][i], one[i]) << what << " column " << c << " row " << i;
+    }
+    const std::vector<double> r = ref(x[c]);
+    double worst = 0.0;
+    for (std::size_t i = 0; i < n; ++i) worst = std::max(worst, std::fabs(all[c][i] - r[i]));
+    EXPECT_LT(worst, tol * scale) << what << " column " << c;
+  }
+}
+
+/// A long record on an exactly uniform clock (steps of 2^-10 s).
+Record UniformRecord() {
+  Record rec = LongRecord();
+  for (std::size_t i = 0; i < rec.t.size(); ++i) rec.t[i] = std::ldexp(static_cast<double>(i), -10);
+  return rec;
+}
+
+// Nine columns at once (two four-wide vector blocks and one scalar column) give each column bit
+// for bit what it gives filtered alone (the scalar block), on a jittered clock with gaps and on a
+// uniform one, whole and streamed; and the independent reference per column (to 1e-11 of the
+// input's scale: the rounding of a slow filter's recursion adds up over these 10 500 rows).
+TEST(DiagLowPass, ManyColumnsAreEachColumnAloneBitForBit) {
+  for (Record rec : {GappyRecord(), UniformRecord()}) {
+    const std::vector<std::vector<double>> x = NineColumns(&rec);
+    const double* t = rec.t.data();
+    const std::size_t n = rec.t.size();
     for (double tau : {0.003, 0.3, 1000.0}) {
-      std::vector<std::vector<double>> all(m, std::vector<double>(n));
-      std::vector<double*> out;
-      for (auto& col : all) out.push_back(col.data());
-      FirstOrderLowPassColumns(rec->t.data(), n, tau, in.data(), out.data(), m);
-      FirstOrderLowPassStream stream(rec->t.data(), n, tau, in.data(), m);
-      std::vector<std::size_t> streamed(m, 0);
-      while (stream.Next()) {
-        for (std::size_t c = 0; c < m; ++c) {
-          for (std::size_t j = 0; j < stream.size(); ++j) {
-            ASSERT_EQ(stream.col(c)[j], all[c][stream.begin() + j]) << "tau " << tau << " c " << c;
-          }
-        }
-      }
-      for (std::size_t c = 0; c < m; ++c) {
-        std::vector<double> alone(n);
-        FirstOrderLowPass(rec->t.data(), x[c].data(), n, tau, alone.data());
-        for (std::size_t i = 0; i < n; ++i) {
-          ASSERT_EQ(all[c][i], alone[i]) << "tau " << tau << " column " << c << " row " << i;
-        }
-        const std::vector<double> ref = ReferenceFirstOrder(rec->t, x[c], rec->restart, tau);
-        double worst = 0.0;
-        for (std::size_t i = 0; i < n; ++i) worst = std::max(worst, std::fabs(all[c][i] - ref[i]));
-        EXPECT_LT(worst, 1e-11) << "tau " << tau << " column " << c;
+      ExpectColumnsAreEachAlone(
+          rec, x,
+          [&](const double* const* in, double* const* out, std::size_t m) {
+            FirstOrderLowPassColumns(t, n, tau, in, out, m);
+          },
+          [&](const double* const* in, std::size_t m) {
+            return std::make_unique<FirstOrderLowPassStream>(t, n, tau, in, m);
+          },
+          [&](const double* in, double* out) { FirstOrderLowPass(t, in, n, tau, out); },
+          [&](const std::vector<double>& col) {
+            return ReferenceFirstOrder(rec.t, col, rec.restart, tau);
+          },
+          1e-11, "first order tau " + std::to_string(tau));
+    }
+    for (double zeta : {0.01, 1.0, 1.5}) {
+      for (double f : {0.5, 30.0}) {
+        ExpectColumnsAreEachAlone(
+            rec, x,
+            [&](const double* const* in, double* const* out, std::size_t m) {
+              SecondOrderLowPassColumns(t, n, f, zeta, in, out, m);
+            },
+            [&](const double* const* in, std::size_t m) {
+              return std::make_unique<SecondOrderLowPassStream>(t, n, f, zeta, in, m);
+            },
+            [&](const double* in, double* out) { SecondOrderLowPass(t, in, n, f, zeta, out); },
+            [&](const std::vector<double>& col) {
+              return ReferenceSecondOrder(rec.t, col, rec.restart, f, zeta);
+            },
+            1e-11, "second order f " + std::to_string(f) + " zeta " + std::to_string(zeta));
       }
     }
   }
