@@ -25,12 +25,13 @@ Eigen::VectorXd ChannelRms(const Series& a, const Series* b) {
 
 std::vector<Confounding> DropUnidentifiedPartner(const Context& cx, const DiagnoseOptions& options,
                                                  std::vector<EffectFit>* claimed,
-                                                 std::vector<std::string>* dropped) {
+                                                 std::vector<std::string>* dropped,
+                                                 int backfit_threads) {
   std::vector<Confounding> partner_conf;
   if (claimed->size() != 2 || HasTrait((*claimed)[0], kTimeBased)) return partner_conf;
   const Series rest = cx.resid - (*claimed)[0].pred;
-  // A pair is claimed only after its backfits ran side by side (BestPair): after_backfits.
-  partner_conf.push_back(CheckConfounders(cx, rest, (*claimed)[1], options.z_claim, true));
+  partner_conf.push_back(
+      CheckConfounders(cx, rest, (*claimed)[1], options.z_claim, backfit_threads));
   const auto& with = partner_conf.back().with;
   if (std::find(with.begin(), with.end(), "hold_offsets") != with.end() ||
       std::find(with.begin(), with.end(), "load_polynomial") != with.end()) {

@@ -19,11 +19,13 @@ namespace ftstack::diag {
 /// function of the load explains as well (a misfit of the first effect's shape left as a function
 /// of the load, which a time curve follows) is not claimed: the data cannot tell it from the first
 /// effect's remainder. Returns the partner's
-/// confounding when it stays (empty otherwise).
+/// confounding when it stays (empty otherwise). `backfit_threads`: the threads the pair's
+/// backfits just ran on side by side (CheckConfounders' rows may run on as many).
 [[nodiscard]] std::vector<Confounding> DropUnidentifiedPartner(const Context& cx,
                                                                const DiagnoseOptions& options,
                                                                std::vector<EffectFit>* claimed,
-                                                               std::vector<std::string>* dropped);
+                                                               std::vector<std::string>* dropped,
+                                                               int backfit_threads);
 
 /// Refines the claimed effects whose plug-in has a refine_claim, each fitted to what the other
 /// claimed effects leave (ranked without it, so a refinement never wins a claim on its own): the

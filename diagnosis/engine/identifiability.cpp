@@ -444,7 +444,7 @@ bool RowIdentifies(const Context& cx, const EffectFit& fit, const ConfounderRow&
 }  // namespace
 
 Confounding CheckConfounders(const Context& cx, const Series& target, const EffectFit& fit,
-                             double z_claim, bool after_backfits) {
+                             double z_claim, int backfit_threads) {
   Confounding out;
   const EffectSpec* spec = FindEffect(fit.name);
   if (spec == nullptr || spec->confounders == kNoConfounders) return out;
@@ -486,7 +486,8 @@ Confounding CheckConfounders(const Context& cx, const Series& target, const Effe
   // Memory: a row's joint fit holds about four n × N series (10^5 rows × 8 channels fit the
   // side-by-side budget; 10^6 run one by one unless backfits as large just ran side by side).
   const double row_bytes = 4.0 * static_cast<double>(cx.n) * cx.nc * sizeof(float);
-  const int side_by_side = after_backfits ? cx.threads : SideBySide(cx.threads, row_bytes);
+  const int side_by_side =
+      std::max(SideBySide(cx.threads, row_bytes), std::min(cx.threads, backfit_threads));
   ParallelFor(rows.size(), side_by_side, [&](std::size_t k) {
     std::string sentence;
     if (!RowIdentifies(cx, fit, *rows[k], z_claim, z_alone, simpler, beyond, &sentence)) {

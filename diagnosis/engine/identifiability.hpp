@@ -38,12 +38,13 @@ struct Confounding {
 ///  - kTimeDrift (the kDriftInTime effect, reported by its name): where the temperature is
 ///    monotone in time (|Spearman ρ| > 0.95).
 /// The table's rows are tested side by side on the context's threads while their extra bytes fit
-/// the side-by-side budget (parallel.hpp), or always when `after_backfits`: the caller checks
-/// right after backfits that ran on every thread, each holding about as many n × N series as a
-/// row does, so the rows reuse the heap those grew. The result does not depend on the threads.
+/// the side-by-side budget (parallel.hpp), and on at least `backfit_threads` (up to the
+/// context's): the caller checks right after backfits that ran on that many threads side by side,
+/// each holding about as many n × N series as a row does, so the rows reuse the heap those grew.
+/// The result does not depend on the threads.
 [[nodiscard]] Confounding CheckConfounders(const Context& cx, const Series& target,
                                            const EffectFit& fit, double z_claim,
-                                           bool after_backfits = false);
+                                           int backfit_threads = 0);
 
 /// Group of every row for an offset confounder (kSegmentOffsets, kLoadOffsets, kHoldOffsets);
 /// empty when it does not apply to the data. *groups receives the number of groups.

@@ -47,14 +47,15 @@ Report WithRefinedNoise(Report r, const DiagnoseOptions& options) {
 }
 
 /// Stage 5: the best pair when one beats the best single, stronger first (the one whose removal
-/// from the pair costs more on held-out rows); else the best single alone.
+/// from the pair costs more on held-out rows); else the best single alone. *backfit_threads: the
+/// threads the pairs' backfits ran on (BestPair).
 std::vector<EffectFit> FirstClaims(const Context& cx, const DiagnoseOptions& options,
-                                   std::vector<Scored>& singles, const Sums& base,
-                                   bool* have_pair) {
+                                   std::vector<Scored>& singles, const Sums& base, bool* have_pair,
+                                   int* backfit_threads) {
   EffectFit pa;
   EffectFit pb;
   const auto t0 = std::chrono::steady_clock::now();
-  *have_pair = options.pairs && BestPair(cx, options, singles, base, &pa, &pb);
+  *have_pair = options.pairs && BestPair(cx, options, singles, base, &pa, &pb, backfit_threads);
   DebugTime("stage", "pairs", t0);
   std::vector<EffectFit> claimed;
   if (*have_pair) {
@@ -117,7 +118,9 @@ Report DiagnoseWith(Context context, const DiagnoseOptions& options) {
   }
   // 5. pairs
   bool have_pair = false;
-  std::vector<EffectFit> claimed = FirstClaims(cx, options, singles, base, &have_pair);
+  int backfit_threads = 0;
+  std::vector<EffectFit> claimed =
+      FirstClaims(cx, options, singles, base, &have_pair, &backfit_threads);
   // The growth stage starts from the significant singles' fits (their predictions released).
   const std::vector<EffectFit> near =
       have_pair ? SignificantFits(singles) : std::vector<EffectFit>();
@@ -129,7 +132,7 @@ Report DiagnoseWith(Context context, const DiagnoseOptions& options) {
   RefineClaims(cx, &claimed);
   DebugTime("claims", "refinements", t0);
   std::vector<Confounding> partner_conf =
-      DropUnidentifiedPartner(cx, options, &claimed, &r.dropped);
+      DropUnidentifiedPartner(cx, options, &claimed, &r.dropped, backfit_threads);
   ReturnFreedPages();  // the confounders' joint fits
   DebugTime("claims", "partner identifiability", t0);
   // A third refits the pair beside it: the partner's confounders are then checked anew.

@@ -297,7 +297,7 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
 /// on the held-out rows. True with *pa, *pb set when a pair beats every model so far (the best
 /// penalised held-out score among the qualifying pairs; independent of the thread count).
 bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Scored>& singles,
-              const Sums& base, EffectFit* pa, EffectFit* pb) {
+              const Sums& base, EffectFit* pa, EffectFit* pb, int* backfit_threads) {
   const Scored& best = singles.front();
   bool have_pair = false;
   double pair_score = best.score;
@@ -330,6 +330,8 @@ bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Sco
   const auto release = [&](std::size_t t) {
     if (top[t] != 0 || have_pair) singles[top[t]].fit.pred = Series();
   };
+  *backfit_threads =
+      static_cast<int>(std::min<std::size_t>(pairs.size(), ResolveThreads(options.threads)));
   ParallelFor(pairs.size(), ResolveThreads(options.threads), [&](std::size_t k) {
     const auto [t, y] = pairs[k];
     auto p = TryPair(cx, options, singles[top[t]], &partners[t][y], base, best.score);

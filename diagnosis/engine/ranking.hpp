@@ -44,8 +44,9 @@ std::vector<Scored> FitSingles(Report& r, const DiagnoseOptions& options, const 
 /// fitted to what the first leaves, the best partners are kept, each pair is backfitted and scored
 /// on the held-out rows. True with *pa, *pb set when a pair beats every model so far (the best
 /// penalised held-out score among the qualifying pairs; independent of the thread count).
+/// *backfit_threads gets the threads the backfits ran on side by side.
 bool BestPair(const Context& cx, const DiagnoseOptions& options, std::vector<Scored>& singles,
-              const Sums& base, EffectFit* pa, EffectFit* pb);
+              const Sums& base, EffectFit* pa, EffectFit* pb, int* backfit_threads);
 
 /// The significant singles' fits, without their predictions (the growth stage's starting points).
 std::vector<EffectFit> SignificantFits(std::vector<Scored>& singles);

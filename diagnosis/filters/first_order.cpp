@@ -180,7 +180,7 @@ void FirstOrderBlock(const FirstOrderChunk& k, std::size_t i0, std::size_t len,
 
 /// FirstOrderBlock<8> without restarts, the eight columns' states in four-wide vectors: the same
 /// products and sums in the same order per column (vector lanes round like scalars, and no FMA:
-/// lowpass_kernels.hpp), so the same bits, in about half the instructions.
+/// lowpass_kernels.hpp), so the same bits (and faster: docs/diagnosis.md).
 void FirstOrderBlock8(const FirstOrderChunk& k, std::size_t i0, std::size_t len,
                       const double* const* x, double* const* y, std::ptrdiff_t y_off) {
   using V4 = double __attribute__((vector_size(32)));
