@@ -170,7 +170,7 @@ if [ -x "$B/bench_diag" ]; then
             if (u > 0) printf "  1e6 rows: jittered / uniform CPU = %.2f, wall = %.2f\n", j / u,
               t["BM_DiagnoseClock1M/1000000/1/iterations:1"] / t["BM_DiagnoseClock1M/1000000/0/iterations:1"] }'
   [ -s "$B/diag_clock_rss" ] && echo "  peak resident memory of the run (largest case): $(( $(cat "$B/diag_clock_rss") / 1024 )) MB" \
-    "(the benchmark keeps its own copy of the data, about 160 MB at 1e6; the < 500 MB goal is the command's, below)"
+    "(the benchmark keeps its own copy of the data, about 160 MB at 1e6 by its size; the < 500 MB goal is the command's, below)"
   # The real command on the same data written as CSV: wall and CPU time (user + system; reading
   # included; the CPU time is the steadier figure on a loaded machine) and peak memory. With
   # FTDIAG_BASELINE=/path/to/an/older/ftdiag the older binary runs on the same files in the same run
